@@ -1,0 +1,33 @@
+"""robustctl: robust state-feedback design (LQR, RLQR, LMI H-infinity).
+
+>>> import robustctl as rc
+>>> plant = rc.Plant.from_continuous(A, B, dt=0.1)          # doctest: +SKIP
+>>> ctrl = rc.design("rlqr", plant, EF, EG, mu=1e8)          # doctest: +SKIP
+>>> ctrl.K, ctrl.is_stabilizing()                            # doctest: +SKIP
+
+Sign convention everywhere: ``u = K x``.
+"""
+
+from .controller import Controller
+from .design import design
+from .errors import ConvergenceError, InfeasibleError, RankConditionError, RobustCtlError
+from .lqr import lqr
+from .plant import Plant
+from .rlqr import RLQRBatch, rlqr, rlqr_gains
+from .uncertainty import NormBounded
+
+
+def __getattr__(name):  # lazy: cvxpy is slow to import
+    if name in ("hinf", "HinfController"):
+        from . import hinf as _hinf
+
+        return getattr(_hinf, name)
+    raise AttributeError(f"module 'robustctl' has no attribute {name!r}")
+
+
+__all__ = [
+    "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
+    "hinf", "HinfController",
+    "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError",
+]
+__version__ = "0.1.0"

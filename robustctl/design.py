@@ -1,0 +1,34 @@
+"""One entry point, :func:`design`, over every state-feedback design method."""
+
+from __future__ import annotations
+
+from importlib import import_module
+
+from .controller import Controller
+from .plant import Plant
+
+__all__ = ["design", "METHODS"]
+
+# name -> "module:function"; imported lazily (cvxpy takes a second to import).
+METHODS = {
+    "lqr": "robustctl.lqr:lqr",
+    "rlqr": "robustctl.rlqr:rlqr",
+    "hinf": "robustctl.hinf:hinf",
+}
+
+
+def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
+    """Design a state feedback ``u = K x`` for ``plant`` with the named method.
+
+    ``design(method, plant, ...)`` is ``robustctl.<method>(plant, ...)``: the
+    remaining arguments are those of the named function (:func:`robustctl.lqr`,
+    :func:`robustctl.rlqr`, :func:`robustctl.hinf`), which documents them.
+
+    >>> ctrl = design("rlqr", plant, EF, EG, mu, Q=Q, R=R)   # doctest: +SKIP
+    """
+    if not isinstance(method, str) or method.lower() not in METHODS:
+        raise ValueError(f"unknown design method {method!r}; valid: {', '.join(sorted(METHODS))}")
+    if not isinstance(plant, Plant):
+        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+    module, func = METHODS[method.lower()].split(":")
+    return getattr(import_module(module), func)(plant, *args, **kwargs)

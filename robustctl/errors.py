@@ -1,0 +1,26 @@
+"""Exceptions raised by :mod:`robustctl`.
+
+Every error is also a standard Python exception (``ValueError`` or
+``RuntimeError``) so that callers who do not know this module can still catch
+it the usual way.
+"""
+
+from __future__ import annotations
+
+__all__ = ["RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError"]
+
+
+class RobustCtlError(Exception):
+    """Base class of the errors this package raises on its own account."""
+
+
+class ConvergenceError(RobustCtlError, RuntimeError):
+    """An iteration (e.g. the steady-state RLQR recursion) did not converge."""
+
+
+class RankConditionError(RobustCtlError, ValueError):
+    """A rank condition a design needs does not hold (e.g. RLQR with ``mu = inf``)."""
+
+
+class InfeasibleError(RobustCtlError, ValueError):
+    """A convex program (LMI) is infeasible, or the solver could not certify a solution."""
