@@ -1,0 +1,210 @@
+"""Tests of the two control-design MOPs (moo.problems.generic / moo.problems.applied).
+
+References used (independent of the batched code under test):
+
+* a plain loop over individuals calling ``robustctl.design("rlqr", ...)`` and a
+  straightforward per-scenario, per-initial-state, per-step simulation written here;
+* for long horizons, scipy's discrete Lyapunov solver (the infinite-horizon
+  regulation error from the unit initial states is ``diag(X)``, ``X = A X A^T + I``);
+* hand-built populations whose designs are known to be unstable / not computable.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+import robustctl as rc
+from moo.problems.generic import GenericRLQRProblem
+
+F = np.array([[0.9, 0.8, 0.7], [0.01, 0.1, 0.3], [0.0, 0.25, 0.1]])
+G = np.array([[0.6], [0.1], [0.25]])
+H = np.ones((3, 1))
+EF_TRUE = np.array([[0.1, 0.2, 0.2]])
+EG_TRUE = np.array([[0.1]])
+
+# well-conditioned, stabilising designs of the generic MOP (checked below)
+GENERIC_Z = np.array([
+    [19.933888, 19.999998, 20.000000, 16.339275, 20.000000],   # the paper's z*
+    [0.1, 0.2, 0.2, 0.1, 16.0],                                 # the true uncertainty, mu = 1e4
+    [5.0, 1.0, 2.0, 30.0, 60.0],
+    [50.0, 120.0, 10.0, 150.0, 4.0],
+    [1.0, 1.0, 1.0, 1.0, 1.0],
+])
+
+
+def _generic_reference(z, *, deltas, x0s, horizon, Q=np.eye(3), R=np.eye(1), aggregate="mean"):
+    """One individual at a time: design with robustctl.design, simulate with plain loops."""
+    out = []
+    for zi in np.atleast_2d(z):
+        ctrl = rc.design("rlqr", rc.Plant(F, G, dt=1.0), zi[None, :3], zi[None, 3:4],
+                         10.0 ** np.sqrt(zi[4]), Q=Q, R=R, H=H)
+        per_delta = []
+        for d in deltas:
+            Fd = F + d * H @ EF_TRUE
+            Gd = G + d * H @ EG_TRUE
+            e = np.zeros(3)
+            for x0 in x0s:
+                x = np.array(x0, dtype=float)
+                for _ in range(horizon + 1):
+                    e += x**2
+                    u = ctrl.K @ x
+                    x = Fd @ x + Gd @ u
+            per_delta.append(e)
+        per_delta = np.array(per_delta)
+        out.append(per_delta.mean(0) if aggregate == "mean" else per_delta.max(0))
+    return np.array(out)
+
+
+@pytest.fixture(scope="module")
+def generic():
+    return GenericRLQRProblem()
+
+
+# ------------------------------------------------------------------ generic --
+def test_generic_shape_and_bounds(generic):
+    assert generic.n_var == 5 and generic.n_obj == 3
+    np.testing.assert_array_equal(generic.xl, np.zeros(5))
+    np.testing.assert_array_equal(generic.xu, np.full(5, 200.0))
+    assert generic.hv_ref_point.shape == (3,) and generic.molsp_ref_point.shape == (3,)
+
+
+def test_generic_deltas_are_seeded_and_include_extremes():
+    a, b = GenericRLQRProblem(), GenericRLQRProblem()
+    np.testing.assert_array_equal(a.deltas, b.deltas)
+    assert -1.0 in a.deltas and 1.0 in a.deltas and a.deltas.size == 8
+    assert np.all(np.abs(a.deltas) <= 1.0)
+    c = GenericRLQRProblem(seed=7)
+    assert not np.array_equal(a.deltas, c.deltas)
+
+
+def test_generic_batched_equals_per_individual_loop(generic):
+    got = generic.evaluate(GENERIC_Z)
+    want = _generic_reference(GENERIC_Z, deltas=generic.deltas, x0s=np.eye(3), horizon=generic.horizon)
+    assert np.all(want < generic.penalty)      # the chosen designs are stable and computable
+    np.testing.assert_allclose(got, want, rtol=1e-8)
+
+
+def test_generic_options_match_reference():
+    """Non-default Q, R, initial states, horizon, deltas and the worst-case aggregate."""
+    Q = np.diag([2.0, 1.0, 0.5])
+    R = np.array([[3.0]])
+    x0s = np.array([[1.0, -1.0, 0.5], [0.0, 2.0, 0.0]])
+    deltas = [-1.0, -0.2, 0.7, 1.0]
+    p = GenericRLQRProblem(Q=Q, R=R, initial_states=x0s, horizon=40, deltas=deltas, aggregate="max")
+    z = GENERIC_Z[:3]
+    want = _generic_reference(z, deltas=deltas, x0s=x0s, horizon=40, Q=Q, R=R, aggregate="max")
+    np.testing.assert_allclose(p.evaluate(z), want, rtol=1e-8)
+
+
+def test_generic_long_horizon_equals_lyapunov_gramian():
+    """N -> inf: f_j = mean_s [X_s]_jj with X_s = A_s X_s A_s^T + I (scipy, independent)."""
+    p = GenericRLQRProblem(horizon=3000)
+    z = GENERIC_Z[:2]
+    K = np.stack([rc.design("rlqr", p.plant, zi[None, :3], zi[None, 3:4], 10.0 ** np.sqrt(zi[4]),
+                            H=H).K for zi in z])
+    want = []
+    for Ki in K:
+        diag = [np.diag(scipy.linalg.solve_discrete_lyapunov(
+            F + d * H @ EF_TRUE + (G + d * H @ EG_TRUE) @ Ki, np.eye(3))) for d in p.deltas]
+        want.append(np.mean(diag, axis=0))
+    np.testing.assert_allclose(p.evaluate(z), np.array(want), rtol=1e-9)
+
+
+def test_generic_paper_optimum_is_finite_and_sensible(generic):
+    f = generic.evaluate(generic.paper_optimum[None])[0]
+    assert np.all(np.isfinite(f))
+    assert np.all(f >= 1.0)                      # the k = 0 term of the unit initial states
+    assert np.all(f < generic.hv_ref_point)      # dominates both reference points
+    assert np.all(f < generic.molsp_ref_point)
+    # better than leaving the plant open loop on every state
+    e0, _ = generic.regulation_errors(np.zeros((1, 1, 3)))
+    assert np.all(f < e0.mean(axis=1)[0])
+
+
+def test_generic_unstable_designs_get_finite_penalties(generic):
+    # mu = 1e14 forces EF + EG K ~ 0, i.e. K ~ -EF/EG = [-200, 0, 0]: violently unstable
+    z = np.array([[200.0, 0.0, 0.0, 1.0, 196.0]])
+    K = generic.gains(z).K[0]
+    rho = max(np.max(np.abs(np.linalg.eigvals(F + d * H @ EF_TRUE + (G + d * H @ EG_TRUE) @ K)))
+              for d in generic.deltas)
+    assert rho > 1.0
+    f = generic.evaluate(z)
+    assert np.all(np.isfinite(f)) and np.all(f >= generic.penalty) and np.all(f <= 2 * generic.penalty)
+
+
+def test_generic_not_computable_designs_get_finite_penalties(generic, monkeypatch):
+    """A design the RLQR reports as failed (ok False, NaN gain) gets 2 * penalty, the others are untouched."""
+    z = GENERIC_Z[:3]
+    real = rc.rlqr_gains
+
+    def failing(plant, EF, EG, mu, **kw):
+        b = real(plant, EF, EG, mu, **kw)
+        K = np.array(b.K, copy=True)
+        ok = np.array(b.ok, copy=True)
+        K[1] = np.nan
+        ok[1] = False
+        return type("Batch", (), {"K": K, "ok": ok, "P": b.P, "iterations": b.iterations})()
+
+    good = generic.evaluate(z)
+    monkeypatch.setattr(rc, "rlqr_gains", failing)
+    f = generic.evaluate(z)
+    np.testing.assert_array_equal(f[1], np.full(3, 2 * generic.penalty))
+    np.testing.assert_array_equal(f[[0, 2]], good[[0, 2]])
+
+
+def test_generic_whole_random_population_is_finite(generic):
+    z = np.random.default_rng(0).uniform(0.0, 200.0, (60, 5))
+    z[:5, 3] = 0.0          # EG = 0: no gain can cancel EF when mu is large
+    z[5] = 0.0
+    z[6] = 200.0
+    f = generic.evaluate(z)
+    assert f.shape == (60, 3) and np.all(np.isfinite(f)) and np.all(f >= 1.0)
+    assert np.all(f <= 2 * generic.penalty)
+
+
+def test_generic_max_aggregate_dominates_mean():
+    z = GENERIC_Z
+    assert np.all(GenericRLQRProblem(aggregate="max").evaluate(z) >= GenericRLQRProblem().evaluate(z) - 1e-12)
+
+
+def test_generic_decode():
+    p = GenericRLQRProblem()
+    EF, EG, mu = p.decode([1.0, 2.0, 3.0, 4.0, 9.0])
+    np.testing.assert_array_equal(EF, [[[1.0, 2.0, 3.0]]])
+    np.testing.assert_array_equal(EG, [[[4.0]]])
+    np.testing.assert_allclose(mu, [1e3])
+
+
+@pytest.mark.parametrize("kwargs, exc, words", [
+    (dict(Q=np.eye(2)), ValueError, "Q"),
+    (dict(Q=-np.eye(3)), ValueError, "Q"),
+    (dict(R=np.eye(2)), ValueError, "R"),
+    (dict(alpha=0.0), ValueError, "alpha"),
+    (dict(deltas=[0.5, 1.5]), ValueError, "deltas"),
+    (dict(deltas=np.ones((2, 2))), ValueError, "deltas"),
+    (dict(deltas=[np.nan]), ValueError, "deltas"),
+    (dict(n_deltas=1), ValueError, "n_deltas"),
+    (dict(n_deltas=2.5), TypeError, "n_deltas"),
+    (dict(initial_states=np.ones((2, 4))), ValueError, "initial_states"),
+    (dict(horizon=0), ValueError, "horizon"),
+    (dict(horizon=10.0), TypeError, "horizon"),
+    (dict(aggregate="median"), ValueError, "aggregate"),
+    (dict(penalty=-1.0), ValueError, "penalty"),
+    (dict(penalty=np.inf), ValueError, "penalty"),
+    (dict(hv_ref_point=[1.0, 2.0]), ValueError, "hv_ref_point"),
+    (dict(molsp_ref_point=[1.0, -2.0, 3.0]), ValueError, "molsp_ref_point"),
+])
+def test_generic_bad_arguments(kwargs, exc, words):
+    with pytest.raises(exc, match=words):
+        GenericRLQRProblem(**kwargs)
+
+
+def test_generic_bad_population(generic):
+    with pytest.raises(ValueError, match="K must have shape"):
+        generic.regulation_errors(np.zeros((2, 3)))
+    with pytest.raises(ValueError, match=r"\(B, 5\)"):
+        generic.decode(np.zeros((2, 4)))
+    with pytest.raises(ValueError, match="finite"):
+        generic.decode(np.full(5, np.nan))
