@@ -1,0 +1,293 @@
+"""Quality indicators of a Pareto-front approximation (paper Section 4.1.3).
+
+All functions take objective vectors as a 2-D array ``F`` of shape
+``(n_points, n_obj)`` (minimisation), usually the non-dominated set a run
+returned; none of them filters dominated points, pass the set you mean to
+assess. ``ref_set`` is a reference set ``P*`` sampling the true front (for the
+control-design MOPs, whose front is unknown, the non-dominated union of all
+runs, see PAPER_NOTES.md).
+
+=================  =====================  ========  ======================================
+indicator          function               better    source
+=================  =====================  ========  ======================================
+IGD                :func:`igd`            lower     Coello & Reyes Sierra (2004)
+Spacing (SP)       :func:`spacing`        lower     Schott (1995)
+Hypervolume (HV)   :func:`hypervolume`    higher    While et al. (2006); moocore
+Pure diversity     :func:`pure_diversity` higher    Wang, Jin & Yao (2017)
+Spread             :func:`spread`         lower     Zhou et al. (2006); Wang, Wu & Yuan (2010)
+=================  =====================  ========  ======================================
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import moocore
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.spatial.distance import cdist
+
+from robustctl._validation import as_matrix
+
+__all__ = ["igd", "spacing", "hypervolume", "pure_diversity", "spread"]
+
+#: Largest set :func:`pure_diversity` accepts with ``method="exact"`` (2^n subsets).
+PD_EXACT_MAX_POINTS = 16
+
+
+def _points(F: ArrayLike, name: str, *, n_obj: int | None = None, min_rows: int = 1) -> np.ndarray:
+    arr = as_matrix(F, name, cols=n_obj, cols_what="the number of objectives")
+    if arr.shape[0] < min_rows:
+        raise ValueError(f"{name} must have at least {min_rows} points (rows), got shape {arr.shape}")
+    return arr
+
+
+def _nearest_neighbour(D: np.ndarray) -> np.ndarray:
+    """Row-wise minimum of a square distance matrix, the diagonal excluded."""
+    D = D.copy()
+    np.fill_diagonal(D, np.inf)
+    return D.min(axis=1)
+
+
+def igd(F: ArrayLike, ref_set: ArrayLike) -> float:
+    r"""Inverted generational distance, the paper's Eqs. (igd) and (dk).
+
+    .. math::
+
+        IGD(P, P^*) = \frac{1}{|P^*|} \sum_{k \in P^*} \min_{i \in P} \lVert k - i \rVert_2
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m)
+        The approximation ``P``.
+    ref_set : array_like, shape (k, m)
+        The reference set ``P*``.
+
+    Returns
+    -------
+    float
+        Mean Euclidean distance from each reference point to its nearest point of ``F``.
+
+    References
+    ----------
+    C. A. Coello Coello and M. Reyes Sierra (2004), "A study of the parallelization
+    of a coevolutionary multi-objective evolutionary algorithm", MICAI 2004, LNCS 2972.
+    Computed by :func:`moocore.igd`.
+    """
+    A = _points(F, "F")
+    R = _points(ref_set, "ref_set", n_obj=A.shape[1])
+    return float(moocore.igd(A, ref=R))
+
+
+def spacing(F: ArrayLike) -> float:
+    r"""Schott's spacing: sample standard deviation of nearest-neighbour L1 distances.
+
+    .. math::
+
+        SP(P) = \sqrt{\frac{1}{|P| - 1} \sum_{i \in P} (\bar d - d_i)^2},
+        \qquad d_i = \min_{h \in P, h \ne i} \sum_{j=1}^{m} |f_j(i) - f_j(h)|,
+
+    with :math:`\bar d` the mean of the :math:`d_i`. Zero for evenly spaced points.
+
+    Notes
+    -----
+    The paper's Eq. (sp) drops the square of :math:`\bar d - d_i` (a typo: the sum
+    of deviations from the mean is identically zero) and writes a Euclidean
+    :math:`d_i`; we follow Schott's definition, with the L1 (city-block) distance
+    between objective vectors, which is also what PlatEMO, where the paper's
+    experiments ran, computes.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m), n >= 2
+
+    References
+    ----------
+    J. R. Schott (1995), "Fault tolerant design using single and multicriteria
+    genetic algorithm optimization", MSc thesis, MIT.
+    """
+    A = _points(F, "F", min_rows=2)
+    d = _nearest_neighbour(cdist(A, A, metric="cityblock"))
+    return float(np.std(d, ddof=1))
+
+
+def hypervolume(F: ArrayLike, ref_point: ArrayLike) -> float:
+    r"""Hypervolume dominated by ``F`` and bounded by ``ref_point``, Eq. (hv).
+
+    .. math::
+
+        HV(P, r) = \Lambda_m\Big(\bigcup_{i \in P} [f(i), r]\Big),
+
+    the Lebesgue measure of the union of the boxes between each point and ``r``.
+    Points that do not strictly dominate ``r`` contribute nothing. Exact in any
+    dimension (:func:`moocore.hypervolume`: dimension sweep in 2-D, HV3D+ and HV4D+
+    in 3-D/4-D, inclusion-exclusion or recursion above).
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m)
+    ref_point : array_like, shape (m,)
+
+    References
+    ----------
+    L. While, P. Hingston, L. Barone and S. Huband (2006), "A faster algorithm for
+    calculating hypervolume", IEEE TEVC 10(1), 29-38; M. Lopez-Ibanez, moocore.
+    """
+    A = _points(F, "F")
+    r = as_matrix(ref_point, "ref_point", rows=1, cols=A.shape[1],
+                  cols_what="the number of objectives of F").ravel()
+    return float(moocore.hypervolume(A, ref=r))
+
+
+def _minkowski_dissimilarity(A: np.ndarray, p: float) -> np.ndarray:
+    # (sum_j |a_j - b_j|^p)^(1/p); cdist's "minkowski" refuses p < 1, so computed here.
+    diff = np.abs(A[:, None, :] - A[None, :, :])
+    return np.sum(diff**p, axis=2) ** (1.0 / p)
+
+
+def _pd_exact(D: np.ndarray) -> float:
+    """The recursion of Eq. (pd) by dynamic programming over subsets (bitmasks)."""
+    n = D.shape[0]
+    full = (1 << n) - 1
+    pd = np.zeros(1 << n)
+    for mask in range(1, full + 1):
+        members = [i for i in range(n) if mask >> i & 1]
+        if len(members) < 2:
+            continue
+        best = -np.inf
+        for i in members:
+            rest = [j for j in members if j != i]
+            best = max(best, pd[mask & ~(1 << i)] + D[i, rest].min())
+        pd[mask] = best
+    return float(pd[full])
+
+
+def _pd_greedy(D: np.ndarray) -> float:
+    """Graph-based greedy computation (see :func:`pure_diversity`, Notes)."""
+    n = D.shape[0]
+    component = np.arange(n)          # component label of each point in the link graph
+    active = np.ones(n, dtype=bool)
+    total = 0.0
+    for _ in range(n - 1):
+        allowed = component[:, None] != component[None, :]      # links that close no cycle
+        dist = np.where(allowed, D, np.inf)
+        nearest = dist.argmin(axis=1)
+        nn = dist[np.arange(n), nearest]
+        nn[~active] = -np.inf
+        i = int(np.argmax(nn))
+        j = int(nearest[i])
+        total += float(nn[i])
+        component[component == component[j]] = component[i]
+        active[i] = False
+    return total
+
+
+def pure_diversity(F: ArrayLike, *, p: float = 0.1,
+                   method: Literal["greedy", "exact"] = "greedy") -> float:
+    r"""Pure diversity (PD) of Wang, Jin & Yao (2017), Eqs. (pd) and (ds).
+
+    .. math::
+
+        PD(X) = \max_{s_i \in X}\big(PD(X - s_i) + d(s_i, X - s_i)\big),\quad
+        PD(\{s\}) = 0,\qquad
+        d(s, X) = \min_{s_i \in X} \lVert s - s_i \rVert_p,
+
+    with the Minkowski dissimilarity :math:`\lVert a - b\rVert_p =
+    (\sum_j |a_j - b_j|^p)^{1/p}`, ``p = 0.1`` (an L_p "norm" with p < 1, which
+    Wang et al. chose because it separates points better in many objectives).
+    The paper's Eq. (ds) prints ``max`` in :math:`d(s, X)`; the original
+    definition, followed here, is the dissimilarity to the *nearest* individual.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m)
+    p : float, default 0.1
+        Minkowski exponent (> 0).
+    method : {"greedy", "exact"}
+        ``"exact"`` evaluates the recursion exactly by dynamic programming over
+        subsets, O(2^n n^2), for n <= 16. ``"greedy"`` (default) is the practical
+        graph-based computation: each point starts as its own component; n - 1
+        times, among the points not yet withdrawn, the one whose dissimilarity to
+        its nearest point *in another component* (withdrawn points included) is
+        the largest is withdrawn, that dissimilarity is added to PD, and the two
+        components are joined (so no link closes a cycle). This is the computation
+        used in practice for PD (e.g. by PlatEMO, in which the paper's PD values
+        were computed), O(n^3). It is not always equal to the recursion (points
+        0, 1, 3 on a line: greedy 3, exact 4); prefer ``"greedy"`` to compare with
+        published values.
+
+    Returns
+    -------
+    float
+        Larger is more diverse; 0 for a single point.
+
+    References
+    ----------
+    H. Wang, Y. Jin and X. Yao (2017), "Diversity assessment in many-objective
+    optimization", IEEE Trans. Cybernetics 47(6), 1510-1522.
+    """
+    A = _points(F, "F")
+    if isinstance(p, bool) or not isinstance(p, (int, float, np.integer, np.floating)) or not p > 0:
+        raise ValueError(f"p must be a number > 0, got {p!r}")
+    if method not in ("greedy", "exact"):
+        raise ValueError(f"method must be 'greedy' or 'exact', got {method!r}")
+    n = A.shape[0]
+    if n == 1:
+        return 0.0
+    D = _minkowski_dissimilarity(A, float(p))
+    if method == "exact":
+        if n > PD_EXACT_MAX_POINTS:
+            raise ValueError(f"method='exact' handles at most {PD_EXACT_MAX_POINTS} points, "
+                             f"F has {n}; use method='greedy'")
+        return _pd_exact(D)
+    return _pd_greedy(D)
+
+
+def spread(F: ArrayLike, ref_set: ArrayLike) -> float:
+    r"""Generalised spread, the paper's Eq. (sprd).
+
+    .. math::
+
+        \Delta(P) = \frac{\sum_{i=1}^{m} d(e_i, P) + \sum_{x \in P} |d(x, P) - \bar d|}
+                         {\sum_{i=1}^{m} d(e_i, P) + |P|\,\bar d},
+
+    where :math:`e_i` is the point of ``ref_set`` with the largest ``i``-th
+    objective (the ``i``-th extreme of the reference front; first one on ties),
+    :math:`d(e_i, P)` its Euclidean distance to the nearest point of ``P``,
+    :math:`d(x, P)` the Euclidean distance from ``x`` to its nearest *other*
+    point of ``P``, and :math:`\bar d = \frac{1}{|P|}\sum_{x\in P} d(x, P)`.
+
+    Notes
+    -----
+    The paper's Eq. (dm) averages :math:`d(\chi, P)` over :math:`P^*`; that
+    contradicts its own numerator (deviations of the points of ``P`` from the
+    mean) and the definition it cites, so the mean is taken over ``P`` as in
+    Zhou et al. (2006). Zero for evenly spaced points that reach the reference
+    extremes; if every point of ``P`` coincides with the extremes and all
+    nearest-neighbour distances are zero the ratio is 0/0 and 0.0 is returned.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m), n >= 2
+    ref_set : array_like, shape (k, m)
+
+    References
+    ----------
+    A. Zhou, Y. Jin, Q. Zhang, B. Sendhoff and E. Tsang (2006), "Combining
+    model-based and genetics-based offspring generation for multi-objective
+    optimization using a convergence criterion", IEEE CEC 2006, 892-899;
+    Y.-N. Wang, L.-H. Wu and X.-F. Yuan (2010), "Multi-objective self-adaptive
+    differential evolution with elitist archive and crowding entropy-based
+    diversity measure", Soft Computing 14(3), 193-209.
+    """
+    A = _points(F, "F", min_rows=2)
+    R = _points(ref_set, "ref_set", n_obj=A.shape[1])
+    extremes = R[np.argmax(R, axis=0)]
+    d_ext = cdist(extremes, A).min(axis=1).sum()
+    d = _nearest_neighbour(cdist(A, A))
+    d_bar = d.mean()
+    numerator = d_ext + np.abs(d - d_bar).sum()
+    denominator = d_ext + len(A) * d_bar
+    if denominator == 0.0:
+        return 0.0
+    return float(numerator / denominator)
