@@ -1,0 +1,166 @@
+"""The one place where :mod:`robustctl` solves a cvxpy problem.
+
+:func:`solve_sdp` takes named linear-matrix-inequality blocks and plain
+constraints, builds the cvxpy problem, runs the solver with explicit
+tolerances, checks the status, and checks the *certificate*: the smallest
+eigenvalue of every LMI block evaluated at the returned point. Nothing else in
+the package calls ``Problem.solve``.
+
+Conventions
+-----------
+* An LMI ``M >= 0`` is always imposed on the explicitly symmetrised block
+  ``(M + M') / 2`` minus ``margin * I``. (cvxpy's ``M >> 0`` only constrains
+  the symmetric part of ``M``; writing it out makes the intention visible and
+  keeps a non-symmetric block from passing silently: the asymmetry is
+  checked after the solve.)
+* A status of ``optimal`` is accepted; ``optimal_inaccurate`` is accepted
+  only if the certificate holds, and is recorded; ``infeasible`` (also
+  ``infeasible_inaccurate``) raises :class:`~robustctl.errors.InfeasibleError`
+  with the caller's explanation; anything else raises
+  :class:`~robustctl.errors.ConvergenceError`.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from .errors import ConvergenceError, InfeasibleError
+
+__all__ = ["LMI", "SolveReport", "solve_sdp", "SOLVER_TOL"]
+
+# Clarabel settings (cvxpy passes them through). Tight on purpose: the
+# H-infinity level must agree to 1e-5 relative with an independent Riccati
+# computation, and the problems are small.
+SOLVER_TOL = 1e-10
+_CLARABEL = dict(tol_gap_abs=SOLVER_TOL, tol_gap_rel=SOLVER_TOL, tol_feas=SOLVER_TOL,
+                 tol_infeas_abs=1e-10, tol_infeas_rel=1e-10, tol_ktratio=1e-8,
+                 reduced_tol_gap_abs=1e-7, reduced_tol_gap_rel=1e-7, reduced_tol_feas=1e-7,
+                 max_iter=200)
+# Certificate: an LMI block counts as satisfied if its smallest eigenvalue is
+# at least -_CERT_TOL * max(1, largest |entry|) (solver rounding).
+_CERT_TOL = 1e-7
+
+
+@dataclass(frozen=True)
+class LMI:
+    """A named block ``M >= margin * I``.
+
+    ``M`` is a square cvxpy expression; ``margin`` a float or a scalar cvxpy
+    expression (e.g. a variable that the objective maximises).
+    """
+
+    name: str
+    M: object
+    margin: object = 0.0
+
+
+@dataclass(frozen=True)
+class SolveReport:
+    """What a solve returned: status, value, timing, iterations and the certificate.
+
+    ``certificate`` maps each LMI name to the smallest eigenvalue of its
+    symmetrised block at the solution (before subtracting the margin).
+    """
+
+    status: str
+    value: float
+    solver: str
+    solve_time: float
+    setup_time: float | None
+    iterations: int | None
+    certificate: Mapping[str, float] = field(default_factory=dict)
+
+    def as_dict(self, prefix: str = "") -> dict:
+        return {f"{prefix}status": self.status, f"{prefix}value": self.value,
+                f"{prefix}solver": self.solver, f"{prefix}solve_time": self.solve_time,
+                f"{prefix}iterations": self.iterations,
+                f"{prefix}certificate": dict(self.certificate)}
+
+
+def _settings(solver: str) -> dict:
+    return dict(_CLARABEL) if solver == "CLARABEL" else {}
+
+
+def check_solver(solver) -> str:
+    """Validate a cvxpy solver name (upper-cased); raise ValueError listing the installed ones."""
+    import cvxpy as cp
+
+    if not isinstance(solver, str):
+        raise TypeError(f"solver must be a string naming a cvxpy solver, got {type(solver).__name__}")
+    name = solver.upper()
+    sdp = [s for s in cp.installed_solvers() if s in ("CLARABEL", "SCS", "MOSEK", "CVXOPT", "COPT", "SDPA")]
+    if name not in sdp:
+        raise ValueError(f"solver must be an installed SDP solver, one of {sdp}; got {solver!r}")
+    return name
+
+
+def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, solver: str = "CLARABEL",
+              infeasible_msg: str = "the LMI problem is infeasible") -> SolveReport:
+    """Solve ``objective`` subject to the LMI blocks and the other constraints.
+
+    Parameters
+    ----------
+    objective : cvxpy.Minimize or cvxpy.Maximize
+    lmis : sequence of LMI
+        Each block is imposed as ``(M + M')/2 - margin I >> 0``.
+    constraints : sequence of cvxpy constraints
+        Anything else (equalities, scalar bounds).
+    solver : str
+        A cvxpy solver name; Clarabel gets tight explicit tolerances.
+    infeasible_msg : str
+        Message of the :class:`InfeasibleError` raised if the problem is
+        infeasible or the certificate fails.
+
+    Returns
+    -------
+    SolveReport
+        The variables of the problem hold the solution (``var.value``).
+    """
+    import cvxpy as cp
+
+    cons = list(constraints)
+    syms = []
+    for lmi in lmis:
+        M = lmi.M
+        k = M.shape[0]
+        S = 0.5 * (M + M.T)
+        syms.append(S)
+        cons.append(S - lmi.margin * np.eye(k) >> 0)
+    prob = cp.Problem(objective, cons)
+    try:
+        with warnings.catch_warnings():
+            # cvxpy warns on 'optimal_inaccurate'; the status is checked below instead.
+            warnings.simplefilter("ignore", UserWarning)
+            prob.solve(solver=solver, **_settings(solver))
+    except cp.error.SolverError as exc:
+        raise ConvergenceError(f"{solver} failed on the LMI problem: {exc}") from None
+    status = prob.status
+    stats = prob.solver_stats
+    if status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
+        raise InfeasibleError(f"{infeasible_msg} (solver status: {status})")
+    if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+        raise ConvergenceError(f"{solver} returned status {status!r} on the LMI problem; {infeasible_msg}?")
+    cert = {}
+    bad = []
+    for lmi, S in zip(lmis, syms):
+        val = np.asarray(lmi.M.value, dtype=float)
+        if not np.all(np.isfinite(val)):
+            raise ConvergenceError(f"{solver} returned non-finite values in LMI {lmi.name!r}")
+        scale = max(1.0, float(np.max(np.abs(val))))
+        asym = float(np.max(np.abs(val - val.T)))
+        if asym > 1e-8 * scale:
+            raise ValueError(f"internal error: LMI block {lmi.name!r} is not symmetric (asymmetry {asym:.3g})")
+        eig = float(np.linalg.eigvalsh(0.5 * (val + val.T)).min())
+        cert[lmi.name] = eig
+        if eig < -_CERT_TOL * scale:
+            bad.append(f"{lmi.name}: smallest eigenvalue {eig:.3g}")
+    if bad:
+        raise InfeasibleError(f"{infeasible_msg}: {solver} reported {status!r} but the certificate "
+                              f"fails ({'; '.join(bad)})")
+    return SolveReport(status=status, value=float(prob.value), solver=solver,
+                       solve_time=float(stats.solve_time) if stats.solve_time is not None else float("nan"),
+                       setup_time=stats.setup_time, iterations=stats.num_iters, certificate=cert)

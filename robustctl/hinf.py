@@ -1,0 +1,480 @@
+r"""H-infinity state feedback by LMI optimisation (cvxpy + Clarabel).
+
+Plant, with the gain ``u = K x`` (the paper's sign convention)::
+
+    x+ = F x + Bw w + G u         (discrete, dt > 0; x' = ... for dt = None)
+    z  = Cz x + Dzw w + Dzu u
+
+The closed loop ``T_zw`` has ``A_K = F + G K``, ``C_K = Cz + Dzu K``. With the
+change of variables ``Y = K X`` (Bernussou, Peres & Geromel 1989) the
+bounded-real lemma becomes linear in ``(X, Y, mu)``, ``mu = gamma^2``.
+
+Discrete time (``X > 0``; storage ``V(x) = x' X^-1 x``)::
+
+    [ X      A X + G Y   Bw   0            ]
+    [ *      X           0    (Cz X + Dzu Y)' ]  > 0
+    [ *      *           I    Dzw'         ]
+    [ *      *           *    mu I         ]
+
+Continuous time::
+
+    [ He(F X + G Y)   Bw    (Cz X + Dzu Y)' ]
+    [ *               -I    Dzw'            ]  < 0,   He(M) = M + M'
+    [ *               *     -mu I           ]
+
+Either inequality says ``V(x+) - V(x) <= |w|^2 - |z|^2 / gamma^2`` (or
+``dV/dt <= ...``), hence ``||T_zw||_inf < gamma`` and internal stability.
+This is the *gamma^2 form*: the same ``X`` bounds the reachable set,
+``x' X^-1 x <= E`` for every disturbance of energy ``sum |w|^2 <= E``
+(Boyd, El Ghaoui, Feron & Balakrishnan 1994, Sec. 6.1.3), so
+``|u_j| = |k_j x| <= u_max_j`` holds whenever (Sec. 7.2.3)::
+
+    [ u_max_j^2 / E   y_j ]
+    [ y_j'            X   ]  >= 0       (y_j: row j of Y).
+
+Polytopic plants: the LMI is imposed at every vertex ``(F_i, G_i)`` with one
+common ``(X, Y)``; it is affine in ``(F, G)``, so the gain is guaranteed for
+every plant in the convex hull (even time-varying). The *extended* (slack
+variable) discrete-time condition of de Oliveira, Bernussou & Geromel (1999)
+and de Oliveira, Geromel & Bernussou (2002) uses a vertex-dependent ``P_i``
+and a common slack ``S`` (not symmetric), ``K = L S^-1``::
+
+    [ P_i    F_i S + G_i L   Bw   0               ]
+    [ *      S + S' - P_i    0    (Cz S + Dzu L)' ]  > 0
+    [ *      *               I    Dzw'            ]
+    [ *      *               *    mu I            ]
+
+It reduces to the standard one for ``S = P_i = X`` (never more
+conservative) and guarantees the bound for every *constant* plant of the
+hull (storage ``x' P(a)^-1 x`` with ``P(a) = sum a_i P_i``). The input bound
+then uses ``[[u_max_j^2/E, l_j], [l_j', S + S' - P_i]] >= 0`` at each vertex
+(``S + S' - P <= S' P^-1 S``).
+
+Numerics
+--------
+* States are balanced by a diagonal similarity (SLICOT ``TB01ID`` on
+  ``[[F, [Bw G]], [Cz, 0]]``) before the LMIs are built.
+* ``gamma_opt`` comes from minimising ``mu``. At that optimum ``X`` can be
+  nearly singular and ``K = Y X^-1`` huge (in continuous time the optimum is
+  often reached only as ``|K| -> inf``). Therefore, unless ``backoff=0``,
+  the gain comes from a second problem at the fixed level
+  ``gamma = (1 + backoff) gamma_opt`` that maximises the smallest eigenvalue
+  ``t`` of every LMI block (a well-centred strictly feasible point).
+* Every solve goes through :func:`robustctl._cvx.solve_sdp`: status check,
+  explicit symmetrisation, certificate eigenvalues.
+
+References
+----------
+S. Boyd, L. El Ghaoui, E. Feron, V. Balakrishnan, *Linear Matrix Inequalities
+in System and Control Theory*, SIAM 1994, Sec. 6.1.3, 7.2.3, 7.5.
+M. C. de Oliveira, J. Bernussou, J. C. Geromel, "A new discrete-time robust
+stability condition", Systems & Control Letters 37, 1999.
+M. C. de Oliveira, J. C. Geromel, J. Bernussou, "Extended H2 and H-infinity
+norm characterizations and controller parametrizations for discrete-time
+systems", Int. J. Control 75(9), 2002.
+P. Gahinet, P. Apkarian, "A linear matrix inequality approach to
+H-infinity control", Int. J. Robust Nonlinear Control 4, 1994.
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from . import _cvx
+from ._validation import as_matrix, check_positive_scalar
+from .controller import Controller
+from .errors import ConvergenceError, InfeasibleError
+from .plant import Plant
+
+__all__ = ["hinf", "HinfController"]
+
+# Strictness margin (relative to the largest data entry, after balancing) of
+# the LMI blocks when minimising gamma; small so that gamma_opt is not biased.
+_MIN_MARGIN = 1e-9
+# Smallest acceptable centring margin t of the gain-extraction problem.
+_STRICT = 1e-9
+# u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that rounding cannot exceed u_max.
+_U_SLACK = 1e-6
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class HinfController(Controller):
+    """An H-infinity state feedback ``u = K x`` with its guaranteed level.
+
+    Attributes
+    ----------
+    gamma : float
+        Level guaranteed by the returned gain: ``||T_zw||_inf < gamma`` for
+        the plant (and every plant of the hull of ``vertices``). Equals
+        ``(1 + backoff) * gamma_opt``, or the requested ``gamma``.
+    gamma_opt : float or None
+        The optimal level of the LMI problem (``None`` when ``gamma`` was fixed).
+    """
+
+    gamma: float = float("nan")
+    gamma_opt: float | None = None
+
+    def __repr__(self) -> str:
+        opt = "None" if self.gamma_opt is None else f"{self.gamma_opt:.6g}"
+        base = super().__repr__()
+        return base.replace("Controller(", f"HinfController(gamma={self.gamma:.6g}, gamma_opt={opt}, ", 1)
+
+
+# ---------------------------------------------------------------- validation
+def _vertices(plant: Plant, vertices) -> list[Plant]:
+    plants = [plant]
+    if vertices is None:
+        return plants
+    if isinstance(vertices, Plant) or not isinstance(vertices, Sequence):
+        raise TypeError("vertices must be a list of robustctl.Plant")
+    for i, v in enumerate(vertices):
+        if not isinstance(v, Plant):
+            raise TypeError(f"vertices[{i}] must be a robustctl.Plant, got {type(v).__name__}")
+        if (v.n, v.m) != (plant.n, plant.m):
+            raise ValueError(f"vertices[{i}] must have n={plant.n} states and m={plant.m} inputs like plant, "
+                             f"got n={v.n}, m={v.m}")
+        if v.dt != plant.dt:
+            raise ValueError(f"vertices[{i}] must have the sampling time of plant (dt={plant.dt}), got dt={v.dt}")
+        plants.append(v)
+    return plants
+
+
+def _performance(plant: Plant, Bw, Cz, Dzu, Dzw):
+    n, m = plant.n, plant.m
+    Bw = as_matrix(Bw, "Bw", rows=n, cols=1 if np.ndim(Bw) == 1 else None, rows_what="the number of states")
+    Cz = as_matrix(Cz, "Cz", cols=n, cols_what="the number of states")
+    p, q = Cz.shape[0], Bw.shape[1]
+    Dzu = as_matrix(Dzu, "Dzu", rows=p, cols=m, rows_what="rows of Cz", cols_what="the number of inputs")
+    Dzw = np.zeros((p, q)) if Dzw is None else as_matrix(
+        Dzw, "Dzw", rows=p, cols=q, rows_what="rows of Cz", cols_what="columns of Bw")
+    return Bw, Cz, Dzu, Dzw
+
+
+def _u_max(u_max, m: int) -> np.ndarray:
+    if isinstance(u_max, (str, bytes)):
+        raise TypeError(f"u_max must be a positive number or {m} positive numbers, got {type(u_max).__name__}")
+    try:
+        arr = np.array(u_max, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"u_max must be a positive number or {m} positive numbers") from None
+    if arr.ndim == 0:
+        arr = np.full(m, float(arr))
+    if arr.shape != (m,):
+        raise ValueError(f"u_max must be a scalar or have {m} entries (the number of inputs), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("u_max must be finite (use u_max=None for no input bound)")
+    if np.any(arr <= 0):
+        raise ValueError(f"u_max must be > 0 for every input, got {arr.tolist()}")
+    return arr
+
+
+def _check_stabilisable(plants: list[Plant]) -> None:
+    """PBH test at every unstable eigenvalue of every vertex; plain-English error if it fails."""
+    for i, p in enumerate(plants):
+        F, G = p.F, p.G
+        n = p.n
+        scale = max(1.0, np.linalg.norm(np.hstack([F, G]), 2))
+        for lam in np.linalg.eigvals(F):
+            unstable = abs(lam) >= 1.0 - 1e-12 if p.is_discrete else lam.real >= -1e-12 * scale
+            if not unstable:
+                continue
+            smin = np.linalg.svd(np.hstack([F - lam * np.eye(n), G]), compute_uv=False)[-1]
+            if smin <= 1e-9 * scale:
+                where = "plant" if i == 0 else f"vertices[{i - 1}]"
+                kind = "|lambda| >= 1" if p.is_discrete else "Re(lambda) >= 0"
+                raise InfeasibleError(
+                    f"{where} is not stabilisable: its mode lambda = {complex(lam):.6g} ({kind}) cannot be moved "
+                    "by the input G (PBH rank test), so no gain u = K x makes the loop stable and no finite "
+                    "gamma exists")
+
+
+# ---------------------------------------------------------------- scaling
+def _balance(F, Bw, G, Cz) -> np.ndarray:
+    """Diagonal state scaling ``d`` (x = diag(d) x~) balancing ``[[F, [Bw G]], [Cz, 0]]``."""
+    n = F.shape[0]
+    B = np.hstack([Bw, G])
+    try:
+        from slycot import tb01id
+
+        _, _, _, _, d = tb01id(n, B.shape[1], Cz.shape[0], 0.0, F.copy(), B.copy(), Cz.copy(), job="A")
+        d = np.asarray(d, dtype=float)
+    except Exception:  # slycot missing or failed: no scaling
+        return np.ones(n)
+    if d.shape != (n,) or not np.all(np.isfinite(d)) or np.any(d <= 0):
+        return np.ones(n)
+    # TB01ID returns D with A~ = D^-1 A D, i.e. x = D x~.
+    return d
+
+
+# ---------------------------------------------------------------- LMIs
+class _Problem:
+    """The scaled data and the LMI builders for one synthesis."""
+
+    def __init__(self, plants, Bw, Cz, Dzu, Dzw, extended, u_max, w_energy):
+        import cvxpy as cp
+
+        self.cp = cp
+        self.discrete = plants[0].is_discrete
+        F0 = plants[0].F
+        d = _balance(F0, Bw, plants[0].G, Cz)
+        self.d = d
+        Ti = 1.0 / d
+        self.F = [Ti[:, None] * p.F * d[None, :] for p in plants]
+        self.G = [Ti[:, None] * p.G for p in plants]
+        self.Bw = Ti[:, None] * Bw
+        self.Cz = Cz * d[None, :]
+        self.Dzu, self.Dzw = Dzu, Dzw
+        self.n, self.m = plants[0].n, plants[0].m
+        self.p, self.q = Cz.shape[0], Bw.shape[1]
+        self.extended = extended
+        self.u_max, self.w_energy = u_max, w_energy
+        self.scale = max(1.0, max(np.max(np.abs(f)) for f in self.F), max(np.max(np.abs(g)) for g in self.G),
+                         np.max(np.abs(self.Bw)), np.max(np.abs(self.Cz)), np.max(np.abs(Dzu)),
+                         np.max(np.abs(Dzw)) if Dzw.size else 0.0)
+
+    def variables(self):
+        cp = self.cp
+        n, m = self.n, self.m
+        if self.extended:
+            V = {"P": [cp.Variable((n, n), symmetric=True, name=f"P{i}") for i in range(len(self.F))],
+                 "S": cp.Variable((n, n), name="S"), "L": cp.Variable((m, n), name="L")}
+        else:
+            V = {"X": cp.Variable((n, n), symmetric=True, name="X"), "Y": cp.Variable((m, n), name="Y")}
+        return V
+
+    def lmis(self, V, mu, margin) -> list:
+        cp = self.cp
+        n, p, q = self.n, self.p, self.q
+        Iq, Ip = np.eye(q), np.eye(p)
+        out = []
+        for i, (F, G) in enumerate(zip(self.F, self.G)):
+            if self.extended:
+                P, S, L = V["P"][i], V["S"], V["L"]
+                AS = F @ S + G @ L
+                CS = self.Cz @ S + self.Dzu @ L
+                M = cp.bmat([
+                    [P, AS, self.Bw, np.zeros((n, p))],
+                    [AS.T, S + S.T - P, np.zeros((n, q)), CS.T],
+                    [self.Bw.T, np.zeros((q, n)), Iq, self.Dzw.T],
+                    [np.zeros((p, n)), CS, self.Dzw, mu * Ip]])
+            elif self.discrete:
+                X, Y = V["X"], V["Y"]
+                AX = F @ X + G @ Y
+                CX = self.Cz @ X + self.Dzu @ Y
+                M = cp.bmat([
+                    [X, AX, self.Bw, np.zeros((n, p))],
+                    [AX.T, X, np.zeros((n, q)), CX.T],
+                    [self.Bw.T, np.zeros((q, n)), Iq, self.Dzw.T],
+                    [np.zeros((p, n)), CX, self.Dzw, mu * Ip]])
+            else:
+                X, Y = V["X"], V["Y"]
+                AX = F @ X + G @ Y
+                CX = self.Cz @ X + self.Dzu @ Y
+                # -(continuous BRL) >= 0
+                M = cp.bmat([
+                    [-(AX + AX.T), -self.Bw, -CX.T],
+                    [-self.Bw.T, Iq, -self.Dzw.T],
+                    [-CX, -self.Dzw, mu * Ip]])
+            out.append(_cvx.LMI(f"hinf[{i}]", M, margin))
+        if not self.discrete:
+            out.append(_cvx.LMI("X", V["X"], margin))
+        if self.u_max is not None:
+            for j, umax in enumerate(self.u_max):
+                c = np.array([[umax**2 * (1.0 - _U_SLACK) / self.w_energy]])
+                if self.extended:
+                    for i, P in enumerate(V["P"]):
+                        S, L = V["S"], V["L"]
+                        M = cp.bmat([[c, L[j:j + 1, :]], [L[j:j + 1, :].T, S + S.T - P]])
+                        out.append(_cvx.LMI(f"u_max[{j}][{i}]", M, 0.0))
+                else:
+                    M = cp.bmat([[c, V["Y"][j:j + 1, :]], [V["Y"][j:j + 1, :].T, V["X"]]])
+                    out.append(_cvx.LMI(f"u_max[{j}]", M, 0.0))
+        return out
+
+    def gain(self, V) -> tuple[np.ndarray, np.ndarray]:
+        """``(K, X)`` in the original coordinates (``X``: Lyapunov matrix of the nominal vertex)."""
+        if self.extended:
+            S, L = V["S"].value, V["L"].value
+            Ks = np.linalg.solve(S.T, L.T).T
+            Xs = V["P"][0].value
+        else:
+            Xs, Y = V["X"].value, V["Y"].value
+            Xs = 0.5 * (Xs + Xs.T)
+            Ks = np.linalg.solve(Xs, Y.T).T
+        d = self.d
+        return Ks / d[None, :], d[:, None] * Xs * d[None, :]
+
+
+# ---------------------------------------------------------------- public
+def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | None = None,
+         gamma: float | None = None, u_max=None, w_energy: float | None = None,
+         backoff: float = 1e-3, extended: bool = False, solver: str = "CLARABEL") -> HinfController:
+    r"""H-infinity state feedback ``u = K x`` by LMI optimisation.
+
+    Finds ``K`` minimising ``gamma`` such that ``||T_zw||_inf < gamma`` for
+
+    ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u`` (discrete plant) or
+    ``x' = F x + Bw w + G u`` (continuous plant, ``plant.dt is None``; ``F``,
+    ``G`` are then ``A``, ``B``). The LMIs are given in the module docstring.
+
+    Parameters
+    ----------
+    plant : Plant
+        The nominal plant ``(F, G)``.
+    Bw : (n, q) array_like
+        Disturbance input matrix.
+    Cz : (p, n) array_like
+        Performance output matrix.
+    Dzu : (p, m) array_like
+        Feedthrough from ``u`` to ``z``. With ``Dzu`` not of full column rank
+        the optimum may need an unbounded gain (the backoff then matters).
+    Dzw : (p, q) array_like, optional
+        Feedthrough from ``w`` to ``z`` (default zero).
+    vertices : list of Plant, optional
+        Further plants (same ``n``, ``m``, ``dt``). The bound then holds for
+        every plant in the convex hull of ``[plant] + vertices``.
+    gamma : float, optional
+        Fixed level: solve the feasibility problem at this ``gamma`` (no
+        minimisation). Raises :class:`~robustctl.errors.InfeasibleError`
+        naming ``gamma`` if no gain achieves it.
+    u_max : float or (m,) array_like, optional
+        Bound on each ``|u_j|``, guaranteed (from ``x0 = 0``) for every
+        disturbance with ``sum_k |w_k|^2 <= w_energy`` (continuous time:
+        ``int |w|^2 dt <= w_energy``). Uses the reachable-set ellipsoid of
+        the same Lyapunov matrix, so ``gamma_opt`` is then the best level
+        *subject to* the bound.
+    w_energy : float, optional
+        Disturbance energy for ``u_max`` (default 1). Only valid with ``u_max``.
+    backoff : float, default 1e-3
+        The gain is computed at ``gamma = (1 + backoff) gamma_opt`` from a
+        well-centred strictly feasible point. ``0`` returns the optimal
+        point's gain (can be badly conditioned).
+    extended : bool, default False
+        Use the slack-variable condition of de Oliveira et al. (discrete time
+        only): less conservative with ``vertices``, equal without.
+    solver : str, default "CLARABEL"
+        cvxpy SDP solver. Clarabel is run with tight tolerances (1e-10);
+        other solvers use their defaults and may not reach 1e-5 accuracy.
+
+    Returns
+    -------
+    HinfController
+        ``K`` (``u = K x``), ``gamma``, ``gamma_opt`` and ``info`` with
+        ``status``, ``solve_time`` (s, summed over solves), ``iterations``,
+        ``certificate`` (smallest eigenvalue of each LMI block of the final
+        solve), ``X_min_eig``, ``margin`` (centring margin ``t``), ``solves``
+        (per-solve diagnostics), ``X`` (Lyapunov matrix; ``P`` of the
+        nominal vertex when ``extended``), ``u_bound`` (guaranteed
+        ``max |u_j|`` for ``w_energy``, when ``u_max`` is given),
+        ``scaling`` (state balancing), ``lmi`` and ``backoff``.
+
+    Raises
+    ------
+    InfeasibleError
+        A vertex is not stabilisable, the fixed ``gamma`` or the input bound
+        cannot be met, or no common Lyapunov matrix exists for the vertices.
+    ValueError, TypeError
+        Bad arguments (named in the message).
+
+    Examples
+    --------
+    >>> ctrl = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)   # doctest: +SKIP
+    >>> ctrl.gamma, ctrl.info["gamma_opt"]                       # doctest: +SKIP
+    """
+    if not isinstance(plant, Plant):
+        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+    plants = _vertices(plant, vertices)
+    Bw, Cz, Dzu, Dzw = _performance(plant, Bw, Cz, Dzu, Dzw)
+    if gamma is not None:
+        gamma = check_positive_scalar(gamma, "gamma")
+    if u_max is not None:
+        u_max = _u_max(u_max, plant.m)
+        w_energy = 1.0 if w_energy is None else check_positive_scalar(w_energy, "w_energy")
+    elif w_energy is not None:
+        raise ValueError("w_energy is only used together with u_max; give u_max or drop w_energy")
+    if isinstance(backoff, bool) or not isinstance(backoff, numbers.Real) or not np.isfinite(backoff) \
+            or backoff < 0:
+        raise ValueError(f"backoff must be a finite number >= 0, got {backoff!r}")
+    if not isinstance(extended, (bool, np.bool_)):
+        raise TypeError(f"extended must be a bool, got {type(extended).__name__}")
+    if extended and not plant.is_discrete:
+        raise ValueError("extended=True is the discrete-time slack-variable LMI; plant is continuous-time (dt=None)")
+    solver = _cvx.check_solver(solver)
+    _check_stabilisable(plants)
+
+    import cvxpy as cp
+
+    prob = _Problem(plants, Bw, Cz, Dzu, Dzw, bool(extended), u_max, w_energy)
+    margin = _MIN_MARGIN * prob.scale
+    what = "a common Lyapunov matrix for all vertices" if len(plants) > 1 else "a stabilising gain"
+    if u_max is not None:
+        what += f" with |u_j| <= u_max for disturbance energy {w_energy:g}"
+    solves = []
+
+    # 1. minimise mu = gamma^2
+    gamma_opt = None
+    if gamma is None:
+        V = prob.variables()
+        mu = cp.Variable(name="mu")
+        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, margin), solver=solver,
+                             infeasible_msg=f"no H-infinity state feedback exists: the LMIs admit no {what}"
+                             + ("" if len(plants) == 1 or extended else " (try extended=True)"))
+        solves.append(rep.as_dict())
+        gamma_opt = float(np.sqrt(max(mu.value, 0.0)))
+        gamma_fix = gamma_opt * (1.0 + backoff)
+    else:
+        gamma_fix = gamma
+
+    # 2. well-centred gain at the fixed level
+    if gamma is None and backoff == 0:
+        final_margin = margin
+    else:
+        V = prob.variables()
+        t = cp.Variable(name="t")
+        msg = (f"no gain achieves gamma={gamma_fix:.6g}" if gamma is not None else
+               f"could not find a strictly feasible gain at gamma={gamma_fix:.6g} = (1 + backoff) gamma_opt; "
+               "increase backoff")
+        rep = _cvx.solve_sdp(cp.Maximize(t), prob.lmis(V, gamma_fix**2, t),
+                             [t <= 1.0, t >= _STRICT * prob.scale], solver=solver,
+                             infeasible_msg=msg + (f" ({what} needed)" if gamma is not None else ""))
+        solves.append(rep.as_dict())
+        final_margin = float(t.value)
+
+    K, X = prob.gain(V)
+    if not np.all(np.isfinite(K)):
+        raise ConvergenceError("the gain K = Y X^-1 is not finite; increase backoff")
+    for i, p in enumerate(plants):
+        poles = np.linalg.eigvals(p.F + p.G @ K)
+        stable = np.max(np.abs(poles)) < 1 if p.is_discrete else np.max(poles.real) < 0
+        if not stable:
+            raise ConvergenceError(f"internal check failed: the LMI gain does not stabilise "
+                                   f"{'plant' if i == 0 else f'vertices[{i - 1}]'}; increase backoff")
+
+    last = solves[-1]
+    Xs = 0.5 * (X + X.T)
+    info = {
+        "gamma": gamma_fix, "gamma_opt": gamma_opt, "backoff": float(backoff) if gamma is None else None,
+        "lmi": ("extended" if extended else "standard") + ("-discrete" if plant.is_discrete else "-continuous"),
+        "vertices": len(plants), "status": last["status"],
+        "solve_time": float(sum(s["solve_time"] for s in solves)),
+        "iterations": int(sum(s["iterations"] or 0 for s in solves)),
+        "certificate": last["certificate"], "X_min_eig": float(np.linalg.eigvalsh(Xs).min()),
+        "margin": final_margin, "solves": solves, "X": Xs, "scaling": prob.d, "solver": solver,
+    }
+    if u_max is not None:
+        Xb = Xs if not extended else None
+        if extended:
+            Pmats = [np.asarray(P.value) for P in V["P"]]
+            d = prob.d
+            bounds = [np.sqrt(w_energy * np.einsum("ij,jk,ik->i", K * d[None, :], Pk, K * d[None, :]))
+                      for Pk in Pmats]
+            info["u_bound"] = np.max(bounds, axis=0)
+        else:
+            info["u_bound"] = np.sqrt(w_energy * np.einsum("ij,jk,ik->i", K, Xb, K))
+        info["u_max"], info["w_energy"] = u_max, w_energy
+    return HinfController(K=K, method="hinf", plant=plant, info=info, gamma=float(gamma_fix),
+                          gamma_opt=gamma_opt)
