@@ -1,0 +1,191 @@
+"""One optimisation run: problem and MOEA by name, optional MO-LSP, an evaluation budget.
+
+:func:`run` builds the problem (:func:`moo.problems.make_problem`) and the
+algorithm (:func:`moo.algorithms.make_algorithm`), wraps it with MO-LSP
+(:func:`moo.molsp.molsp`, reference point ``problem.molsp_ref_point``) if
+asked, runs it with pymoo's ``("n_eval", evals)`` termination and records the
+hypervolume of the non-dominated set after every generation (reference point
+``problem.hv_ref_point``).
+
+Budget rule: pymoo stops at the end of the first generation whose evaluation
+count reaches ``evals``; the last generation may overshoot by less than one
+offspring batch (MO-LSP's mutants never add to the overshoot, see
+:mod:`moo.molsp`). ``n_evals`` reports the evaluations actually used.
+
+Randomness: the seed goes to pymoo's ``setup``, which makes the run's only
+Generator (``algorithm.random_state``); the global numpy state is not touched.
+Same arguments, same result.
+"""
+
+from __future__ import annotations
+
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from importlib.metadata import PackageNotFoundError, version
+
+import numpy as np
+from pymoo.core.callback import Callback
+
+from moo.algorithms import make_algorithm
+from moo.indicators import hypervolume
+from moo.molsp import molsp as add_molsp
+from moo.problems import make_problem
+
+__all__ = ["RunResult", "run"]
+
+
+def _versions() -> dict[str, str]:
+    out = {"python": platform.python_version()}
+    for dist in ("robustctl", "numpy", "scipy", "pymoo", "moocore"):
+        try:
+            out[dist] = version(dist)
+        except PackageNotFoundError:
+            out[dist] = "unknown"
+    return out
+
+
+@dataclass(frozen=True, repr=False)
+class RunResult:
+    """The record of one run (see :func:`run`); :meth:`to_dict` gives its JSON form.
+
+    ``F``/``X`` are the objectives and decision vectors of the final
+    non-dominated set; ``hv_history`` is an ``(n_gen, 2)`` array of
+    (evaluations used, hypervolume) after each generation, the initial one
+    included.
+    """
+
+    problem: str
+    n_obj: int
+    algorithm: str
+    molsp: bool
+    max_leaders: int | None
+    seed: int
+    pop_size: int
+    budget: int
+    n_evals: int
+    n_gen: int
+    molsp_evals: int
+    F: np.ndarray
+    X: np.ndarray
+    hv_ref_point: np.ndarray
+    molsp_ref_point: np.ndarray | None
+    hv_history: np.ndarray
+    wall_time: float
+    versions: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def hv(self) -> float:
+        """Hypervolume of the final non-dominated set."""
+        return float(self.hv_history[-1, 1])
+
+    def to_dict(self) -> dict:
+        """Plain Python types only (lists for arrays), ready for ``json.dump``."""
+        return {
+            "problem": self.problem, "n_obj": self.n_obj, "algorithm": self.algorithm,
+            "molsp": self.molsp, "max_leaders": self.max_leaders, "seed": self.seed,
+            "pop_size": self.pop_size, "budget": self.budget, "n_evals": self.n_evals,
+            "n_gen": self.n_gen, "molsp_evals": self.molsp_evals, "hv": self.hv,
+            "hv_ref_point": self.hv_ref_point.tolist(),
+            "molsp_ref_point": None if self.molsp_ref_point is None else self.molsp_ref_point.tolist(),
+            "F": self.F.tolist(), "X": self.X.tolist(),
+            "hv_history": {"evaluations": self.hv_history[:, 0].astype(int).tolist(),
+                           "hypervolume": self.hv_history[:, 1].tolist()},
+            "wall_time_s": self.wall_time, "versions": dict(self.versions),
+        }
+
+    def __repr__(self) -> str:
+        tag = "+MO-LSP" if self.molsp else ""
+        return (f"RunResult({self.algorithm}{tag} on {self.problem} (M={self.n_obj}), seed={self.seed}, "
+                f"n_evals={self.n_evals}/{self.budget}, n_gen={self.n_gen}, |F|={len(self.F)}, "
+                f"hv={self.hv:.6g}, {self.wall_time:.2f} s)")
+
+
+class _HVHistory(Callback):
+    def __init__(self, ref_point: np.ndarray, progress: Callable[[int, int], None] | None, budget: int):
+        super().__init__()
+        self.ref_point, self.progress, self.budget = ref_point, progress, budget
+        self.rows: list[tuple[int, float]] = []
+
+    def notify(self, algorithm):
+        n_eval = algorithm.evaluator.n_eval
+        F = algorithm.opt.get("F") if algorithm.opt is not None and len(algorithm.opt) else None
+        hv = 0.0 if F is None else hypervolume(F, self.ref_point)
+        self.rows.append((n_eval, hv))
+        if self.progress is not None:
+            self.progress(n_eval, self.budget)
+
+
+def _check_int(value, name: str, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
+    if value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value}")
+    return int(value)
+
+
+def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,
+        molsp: bool = False, pop_size: int = 92, max_leaders: int | None = None,
+        progress: Callable[[int, int], None] | None = None) -> RunResult:
+    """Run one MOEA (optionally with MO-LSP) on one problem to an evaluation budget.
+
+    Parameters
+    ----------
+    problem : str
+        A name of :data:`moo.problems.PROBLEMS`.
+    algorithm : str
+        A name of :data:`moo.algorithms.ALGORITHMS`.
+    seed : int
+        Non-negative seed of the run's Generator.
+    evals : int
+        Evaluation budget; at least the population size.
+    n_obj : int, optional
+        Number of objectives (DTLZ; fixed for the others).
+    molsp : bool
+        Wrap the algorithm with MO-LSP (reference point ``problem.molsp_ref_point``).
+    pop_size : int
+        Population size (the paper's 92 by default; reference-direction
+        algorithms may enlarge it, the size used is recorded).
+    max_leaders : int, optional
+        MO-LSP's cap on candidates per generation (default: none, the paper's).
+    progress : callable, optional
+        Called as ``progress(n_evals, evals)`` after every generation.
+
+    Returns
+    -------
+    RunResult
+    """
+    seed = _check_int(seed, "seed", 0)
+    evals = _check_int(evals, "evals", 1)
+    pop_size = _check_int(pop_size, "pop_size", 4)
+    if max_leaders is not None:
+        max_leaders = _check_int(max_leaders, "max_leaders", 1)
+        if not molsp:
+            raise ValueError("max_leaders needs molsp=True")
+    prob = make_problem(problem, n_obj)
+    alg = make_algorithm(algorithm, n_obj=prob.n_obj, pop_size=pop_size)
+    if evals < alg.pop_size:
+        raise ValueError(f"evals must be at least the population size ({alg.pop_size}), got {evals}")
+    hv_ref = np.asarray(prob.hv_ref_point, dtype=float)
+    molsp_ref = np.asarray(prob.molsp_ref_point, dtype=float) if molsp else None
+    if molsp:
+        alg = add_molsp(alg, ref_point=molsp_ref, max_leaders=max_leaders)
+
+    history = _HVHistory(hv_ref, progress, evals)
+    start = time.perf_counter()
+    alg.setup(prob, termination=("n_eval", evals), seed=seed, callback=history, verbose=False)
+    while alg.has_next():
+        alg.next()
+    wall = time.perf_counter() - start
+
+    opt = alg.opt
+    F = np.asarray(opt.get("F"), dtype=float)
+    X = np.asarray(opt.get("X"), dtype=float)
+    return RunResult(
+        problem=problem.lower(), n_obj=prob.n_obj, algorithm=algorithm.lower(), molsp=bool(molsp),
+        max_leaders=max_leaders, seed=seed, pop_size=int(alg.pop_size), budget=evals,
+        n_evals=int(alg.evaluator.n_eval), n_gen=len(history.rows),
+        molsp_evals=int(alg.data.get("molsp_n_eval", 0)), F=F, X=X, hv_ref_point=hv_ref,
+        molsp_ref_point=molsp_ref, hv_history=np.array(history.rows, dtype=float).reshape(-1, 2),
+        wall_time=wall, versions=_versions())
