@@ -325,7 +325,7 @@ def _n_samples(duration, dt: float) -> int:
     return int(np.floor(duration / dt + 1e-9))
 
 
-#: The road of the default route: an 8.6 km drive (about 515 s at 60 km/h).
+#: The road of the default route: a 9.0 km drive (about 540 s at 60 km/h).
 DEFAULT_ROUTE = (
     Straight(250.0),                  # start (the vehicle may start off the lane centre)
     LaneChange(3.5, 150.0),           # overtaking: one 3.5 m lane to the left ...
@@ -358,7 +358,7 @@ def default_route(*, speed: float = DEFAULT_SPEED, dt: float = 0.1,
                   duration: float | None = None) -> ReferencePath:
     """The reference path of the paper reproduction (the paper does not publish its path).
 
-    An 8.6 km road for a heavy truck at 60 km/h (about 516 s, over the paper's
+    A 9.0 km road for a heavy truck at 60 km/h (about 540 s, over the paper's
     "more than 400 s"): straights, four lane changes of 3.5 m (one lane) over
     120-150 m, and bends of radius 200-500 m (lateral acceleration at most
     ``v^2/R = 1.4 m/s^2``, comfortable for a truck) entered through clothoid
