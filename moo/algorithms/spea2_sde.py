@@ -1,0 +1,385 @@
+"""SPEA2 with shift-based density estimation (SPEA2+SDE).
+
+References
+----------
+.. [1] M. Li, S. Yang and X. Liu, "Shift-based density estimation for
+   Pareto-based algorithms in many-objective optimization", IEEE Trans.
+   Evol. Comput. 18(3), 348-365, 2014.
+.. [2] E. Zitzler, M. Laumanns and L. Thiele, "SPEA2: Improving the strength
+   Pareto evolutionary algorithm", TIK-Report 103, ETH Zurich, 2001.
+
+What is implemented
+-------------------
+SPEA2 [2] with every Euclidean distance replaced by the *shifted* distance of
+SDE [1]. With ``f(i)`` the objective vector of individual ``i`` (minimised)
+and ``n`` the size of the set being ranked (archive plus offspring):
+
+* strength ``S(i) = |{j : i dominates j}|`` and raw fitness
+  ``R(i) = sum_{j dominates i} S(j)`` ([2], Eqs. 1-2), so ``R(i) = 0`` exactly
+  for the non-dominated individuals;
+* shifted distance ([1], Sec. III, Eqs. 4-5): to estimate the density around
+  ``i`` every other individual ``j`` is moved to ``j' = max(f(j), f(i))``
+  (component-wise: an objective in which ``j`` is better than ``i`` is set to
+  ``i``'s value), and
+
+  ``sd(i, j) = || max(f(j), f(i)) - f(i) || = sqrt(sum_k max(0, f_k(j) - f_k(i))^2)``.
+
+  ``sd`` is not symmetric. Row ``i`` of the matrix holds the distances *seen
+  from* ``i``: an individual that is worse than its neighbours in many
+  objectives sees them shifted onto itself and looks crowded;
+* density ``D(i) = 1 / (sigma_i^k + 2)`` with ``sigma_i^k`` the ``k``-th
+  smallest ``sd(i, j)``, ``j != i``, and ``k = floor(sqrt(n))`` ([2], Eq. 3;
+  pymoo's SPEA2 uses the ``(k+1)``-th, we follow the report); fitness
+  ``F(i) = R(i) + D(i)`` (lower is better; ``D < 1/2`` so ``F < 1`` iff
+  non-dominated);
+* environmental selection ([2], Sec. 3.2): keep every individual with
+  ``F < 1``; if fewer than ``N`` fill with the best remaining ``F``; if more,
+  truncate iteratively: remove the individual whose sorted vector of shifted
+  distances to the remaining ones is lexicographically smallest (closest
+  shifted neighbour, ties by the second closest, ...), recomputing after each
+  removal. Exact ties (identical vectors) remove the lowest index;
+* mating selection: binary tournament with replacement on ``F`` (ties at
+  random); infeasible individuals lose to feasible ones and to smaller
+  constraint violations.
+
+Readings where the papers leave a choice
+----------------------------------------
+* Normalisation. ``sd`` is scale dependent. [1] applies SDE to the objective
+  values of its (commensurable) test problems; PlatEMO's implementation, on
+  which the Morais et al. (2022) experiments ran, uses the raw objectives.
+  The control-design problems of this project have objectives of very
+  different magnitudes, so by default (``normalize=True``) the objectives are
+  mapped to ``[0, 1]`` by the minimum and maximum of the set being ranked
+  before the distances are computed (an objective with zero range maps to
+  0). The map is increasing in every objective, so dominance, ``S`` and ``R``
+  are unchanged; only the densities depend on it. ``normalize=False`` gives
+  the raw-objective form.
+* Population and archive have the same size ``N`` (92 by default), as in [1]
+  and in the paper being reproduced.
+* Survival is a function of the set it receives (no hidden state), so it can
+  be called again on any merged population, as MO-LSP does.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.survival import Survival
+from pymoo.operators.sampling.rnd import FloatRandomSampling
+from pymoo.operators.selection.tournament import TournamentSelection
+from pymoo.termination.default import DefaultMultiObjectiveTermination
+from pymoo.util.display.multi import MultiObjectiveOutput
+
+from .operators import POP_SIZE, paper_crossover, paper_mutation
+
+__all__ = [
+    "SPEA2SDE",
+    "SPEA2SDESurvival",
+    "make_spea2_sde",
+    "sde_fitness",
+    "sde_truncation",
+    "shifted_distances",
+]
+
+_FITNESS = "sde_fitness"
+
+
+def _as_objectives(F, name: str = "F") -> np.ndarray:
+    if isinstance(F, (str, bytes)) or F is None:
+        raise TypeError(f"{name} must be a 2-D array of objective values, got {type(F).__name__}")
+    try:
+        arr = np.asarray(F, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be a 2-D array of real numbers ({exc})") from None
+    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
+        raise ValueError(f"{name} must be a non-empty 2-D array (n_individuals, n_obj), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must have finite entries (found NaN or inf)")
+    return arr
+
+
+def _normalise(F: np.ndarray) -> np.ndarray:
+    """Map each objective to [0, 1] by the set's min and max (zero range -> 0)."""
+    fmin = F.min(axis=0)
+    span = F.max(axis=0) - fmin
+    span = np.where(span > 0, span, 1.0)
+    return (F - fmin) / span
+
+
+def shifted_distances(F) -> np.ndarray:
+    """Matrix of SDE shifted distances, ``D[i, j] = sd(i, j)``.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m)
+        Objective vectors (minimised), used as given (normalise beforehand if
+        the objectives are not commensurable).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, n)
+        ``D[i, j] = sqrt(sum_k max(0, F[j, k] - F[i, k])**2)`` for ``i != j``
+        (Li, Yang & Liu 2014, Eqs. 4-5: ``j`` shifted to ``max(F[j], F[i])``),
+        ``inf`` on the diagonal. Row ``i`` is the neighbourhood seen from ``i``.
+    """
+    F = _as_objectives(F)
+    diff = F[None, :, :] - F[:, None, :]          # diff[i, j] = F[j] - F[i]
+    np.maximum(diff, 0.0, out=diff)
+    D = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    np.fill_diagonal(D, np.inf)
+    return D
+
+
+def _domination_matrix(F: np.ndarray) -> np.ndarray:
+    """``dom[i, j]`` is True iff ``F[i]`` Pareto-dominates ``F[j]`` (minimisation)."""
+    n, m = F.shape
+    le = np.ones((n, n), dtype=bool)
+    lt = np.zeros((n, n), dtype=bool)
+    for k in range(m):                      # a loop over objectives, each step an (n, n) array op
+        col = F[:, k]
+        le &= col[:, None] <= col[None, :]
+        lt |= col[:, None] < col[None, :]
+    return le & lt
+
+
+def _fitness(F: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fitness, raw fitness and density from objectives ``F`` and shifted distances ``D``."""
+    n = F.shape[0]
+    dom = _domination_matrix(F)
+    strength = dom.sum(axis=1)
+    raw = (dom * strength[:, None]).sum(axis=0).astype(np.float64)
+    if n == 1:
+        density = np.full(1, 0.5)
+    else:
+        k = min(max(int(np.sqrt(n)), 1), n - 1)
+        sigma = np.partition(D, k - 1, axis=1)[:, k - 1]
+        density = 1.0 / (sigma + 2.0)
+    return raw + density, raw, density
+
+
+def sde_fitness(F, *, normalize: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """SPEA2+SDE fitness ``F(i) = R(i) + D(i)`` of a set of objective vectors.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m)
+        Objective vectors (minimised) of the whole set being ranked.
+    normalize : bool, default True
+        Map each objective to [0, 1] by the set's min/max before computing the
+        shifted distances (dominance is unaffected).
+
+    Returns
+    -------
+    fitness, raw, density : numpy.ndarray, shape (n,)
+        ``raw[i] = R(i) = sum of S(j) over the j dominating i`` with
+        ``S(j)`` the number of individuals ``j`` dominates;
+        ``density[i] = 1 / (sigma_i^k + 2)`` with ``sigma_i^k`` the ``k``-th
+        smallest shifted distance seen from ``i`` and ``k = floor(sqrt(n))``
+        (clipped to ``[1, n - 1]``; ``density = 1/2`` for ``n = 1``);
+        ``fitness = raw + density``, lower is better.
+
+    References
+    ----------
+    Zitzler, Laumanns & Thiele (2001), Eqs. 1-3; Li, Yang & Liu (2014), Sec. III.
+    """
+    F = _as_objectives(F)
+    if not isinstance(normalize, (bool, np.bool_)):
+        raise TypeError(f"normalize must be a bool, got {type(normalize).__name__}")
+    D = shifted_distances(_normalise(F) if normalize else F)
+    return _fitness(F, D)
+
+
+def sde_truncation(dist, n_keep: int) -> np.ndarray:
+    """SPEA2 archive truncation on a (shifted) distance matrix.
+
+    Repeatedly removes the individual ``i`` whose row of distances to the
+    remaining individuals, sorted increasingly, is lexicographically smallest
+    (Zitzler et al. 2001, Sec. 3.2, the relation ``<=_d``), until ``n_keep``
+    remain. Row ``i`` must hold the distances seen from ``i`` (for SDE,
+    :func:`shifted_distances`); the diagonal is ignored. Exact ties remove the
+    lowest index.
+
+    Parameters
+    ----------
+    dist : array_like, shape (n, n)
+    n_keep : int
+        Number of individuals to keep, ``1 <= n_keep <= n``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Sorted indices of the kept individuals.
+
+    Notes
+    -----
+    Each row is sorted once. A pointer per row marks its nearest remaining
+    neighbour; a removal advances only the pointers that pointed at the
+    removed individual, so a step costs ``O(n)`` unless the nearest distances
+    tie, when the tied rows are compared lexicographically over their
+    remaining entries. Total ``O(n^2 log n)`` for the sort plus ``O(r n)``
+    for ``r`` removals in the tie-free case.
+    """
+    if isinstance(dist, (str, bytes)) or dist is None:
+        raise TypeError(f"dist must be a square matrix of numbers, got {type(dist).__name__}")
+    try:
+        D = np.array(dist, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"dist must be a square matrix of real numbers ({exc})") from None
+    if D.ndim != 2 or D.shape[0] != D.shape[1] or D.shape[0] < 1:
+        raise ValueError(f"dist must be a square (n, n) matrix, got shape {D.shape}")
+    n = D.shape[0]
+    if isinstance(n_keep, bool) or not isinstance(n_keep, (int, np.integer)):
+        raise TypeError(f"n_keep must be an integer, got {type(n_keep).__name__}")
+    if not 1 <= n_keep <= n:
+        raise ValueError(f"n_keep must be in [1, {n}] (the number of rows of dist), got {n_keep}")
+    if n_keep == n:
+        return np.arange(n)
+    if np.any(np.isnan(D[~np.eye(n, dtype=bool)])):
+        raise ValueError("dist must not contain NaN off the diagonal")
+    np.fill_diagonal(D, np.inf)
+    # sort each row once and drop the diagonal entry (column id == row id)
+    order = np.argsort(D, axis=1, kind="stable")
+    order = order[order != np.arange(n)[:, None]].reshape(n, n - 1)
+    S = np.take_along_axis(D, order, axis=1)
+    dead = np.zeros(n, dtype=bool)
+    ptr = np.zeros(n, dtype=np.intp)                 # position of each row's nearest living neighbour
+    rows = np.arange(n)
+    for _ in range(n - n_keep):
+        alive = rows[~dead]
+        first = S[alive, ptr[alive]]
+        cand = alive[first == first.min()]
+        if cand.size > 1:
+            # compare the tied rows over their remaining entries (lexsort is stable: lowest id wins ties)
+            live = ~dead[order[cand]]
+            sub = S[cand][live].reshape(cand.size, -1)
+            cand = cand[np.lexsort(sub.T[::-1])]
+        victim = cand[0]
+        dead[victim] = True
+        # advance the pointers that now point at a dead individual
+        alive = rows[~dead]
+        hit = alive[dead[order[alive, ptr[alive]]]]
+        while hit.size:
+            ptr[hit] += 1
+            hit = hit[ptr[hit] < n - 1]           # a lone survivor has no neighbour left
+            hit = hit[dead[order[hit, ptr[hit]]]]
+    return rows[~dead]
+
+
+class SPEA2SDESurvival(Survival):
+    """SPEA2 environmental selection (archive update) with SDE distances.
+
+    Parameters
+    ----------
+    normalize : bool, default True
+        Normalise the objectives by the min/max of the set being ranked before
+        the shifted distances are computed (see the module docstring).
+
+    Notes
+    -----
+    Sets the attribute ``"sde_fitness"`` (the SPEA2+SDE fitness computed on
+    the whole set it receives, lower is better) on the survivors; the mating
+    tournament reads it.
+    """
+
+    def __init__(self, normalize: bool = True):
+        super().__init__(filter_infeasible=True)
+        self.normalize = bool(normalize)
+
+    def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
+        F = pop.get("F").astype(np.float64, copy=False)
+        n = len(pop)
+        if n_survive is None:
+            n_survive = n
+        D = shifted_distances(_normalise(F) if self.normalize else F)
+        fitness, _, _ = _fitness(F, D)
+        pop.set(_FITNESS, fitness)
+        nondom = np.flatnonzero(fitness < 1.0)
+        if nondom.size <= n_survive:
+            # non-dominated first, then the best remaining fitness (stable: ties by index)
+            survivors = np.argsort(fitness, kind="stable")[:n_survive]
+        else:
+            # truncation among the non-dominated, distances in the same (normalised) space
+            kept = sde_truncation(D[np.ix_(nondom, nondom)], n_survive)
+            survivors = nondom[kept]
+        return pop[survivors]
+
+
+def _sde_tournament(pop, P, random_state=None, **kwargs):
+    """Binary tournament: feasibility / CV first, then lower SPEA2+SDE fitness, ties at random."""
+    if P.shape[1] != 2:
+        raise ValueError(f"SPEA2+SDE uses a binary tournament, got tournaments of size {P.shape[1]}")
+    rng = random_state if random_state is not None else np.random.default_rng()
+    fit = pop.get(_FITNESS)
+    if fit is None or fit.dtype == object or np.any(np.isnan(fit.astype(np.float64))):
+        # population not ranked by the survival (e.g. a user-supplied one): rank it now
+        fit, _, _ = sde_fitness(pop.get("F"))
+    fit = np.asarray(fit, dtype=np.float64)
+    cv = pop.get("CV")
+    cv = np.zeros(len(pop)) if cv is None else np.asarray(cv, dtype=np.float64).reshape(len(pop), -1)[:, 0]
+    a, b = P[:, 0], P[:, 1]
+    coin = rng.random(len(P)) < 0.5
+    infeasible = (cv[a] > 0) | (cv[b] > 0)
+    va = np.where(infeasible, cv[a], fit[a])
+    vb = np.where(infeasible, cv[b], fit[b])
+    winner = np.where(va < vb, a, np.where(vb < va, b, np.where(coin, a, b)))
+    return winner[:, None].astype(int)
+
+
+class SPEA2SDE(GeneticAlgorithm):
+    """SPEA2+SDE as a pymoo algorithm (archive = ``pop``, offspring = population).
+
+    Parameters
+    ----------
+    pop_size : int
+        Archive size and number of offspring per generation (``N = N-bar``).
+    sampling, crossover, mutation
+        pymoo operators (defaults: uniform random sampling, the paper's SBX
+        and polynomial mutation).
+    normalize : bool, default True
+        See :class:`SPEA2SDESurvival`.
+    eliminate_duplicates : bool, default True
+        pymoo duplicate elimination of offspring.
+    """
+
+    def __init__(self, pop_size: int = POP_SIZE, sampling=None, crossover=None, mutation=None,
+                 normalize: bool = True, eliminate_duplicates: bool = True, output=None):
+        super().__init__(
+            pop_size=pop_size,
+            sampling=sampling if sampling is not None else FloatRandomSampling(),
+            selection=TournamentSelection(func_comp=_sde_tournament, pressure=2),
+            crossover=crossover if crossover is not None else paper_crossover(),
+            mutation=mutation if mutation is not None else paper_mutation(),
+            survival=SPEA2SDESurvival(normalize=normalize),
+            eliminate_duplicates=eliminate_duplicates,
+            output=output if output is not None else MultiObjectiveOutput(),
+            advance_after_initial_infill=True,
+        )
+        self.termination = DefaultMultiObjectiveTermination()
+
+
+def make_spea2_sde(*, n_obj: int, pop_size: int = POP_SIZE, normalize: bool = True) -> SPEA2SDE:
+    """SPEA2+SDE with the paper's settings (population = archive = 92, SBX, PM).
+
+    Parameters
+    ----------
+    n_obj : int
+        Number of objectives (>= 2); SPEA2+SDE needs no reference directions,
+        it is checked only.
+    pop_size : int, default 92
+        Archive size ``N`` and number of offspring per generation.
+    normalize : bool, default True
+        Normalise objectives by the ranked set's min/max before the shifted
+        distances (``False``: raw objectives, as PlatEMO).
+
+    Returns
+    -------
+    SPEA2SDE
+    """
+    if isinstance(n_obj, bool) or not isinstance(n_obj, (int, np.integer)) or n_obj < 2:
+        raise ValueError(f"n_obj must be an integer >= 2, got {n_obj!r}")
+    if isinstance(pop_size, bool) or not isinstance(pop_size, (int, np.integer)) or pop_size < 2:
+        raise ValueError(f"pop_size must be an integer >= 2, got {pop_size!r}")
+    if not isinstance(normalize, (bool, np.bool_)):
+        raise TypeError(f"normalize must be a bool, got {type(normalize).__name__}")
+    return SPEA2SDE(pop_size=int(pop_size), normalize=bool(normalize))
+
