@@ -212,7 +212,10 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
         the largest is withdrawn, that dissimilarity is added to PD, and the two
         components are joined (so no link closes a cycle). This is the computation
         used in practice for PD (e.g. by PlatEMO, in which the paper's PD values
-        were computed), O(n^3). It is not always equal to the recursion (points
+        were computed), O(n^3). Ties, common since two mutual nearest neighbours
+        share their distance, go to the lexicographically smallest objective
+        vector, so the value does not depend on the order of the rows (PlatEMO
+        breaks them by row order). It is not always equal to the recursion (points
         0, 1, 3 on a line: greedy 3, exact 4); prefer ``"greedy"`` to compare with
         published values.
 
@@ -234,6 +237,7 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
     n = A.shape[0]
     if n == 1:
         return 0.0
+    A = A[np.lexsort(A.T[::-1])]          # canonical order: ties broken by the points, not the rows
     D = _minkowski_dissimilarity(A, float(p))
     if method == "exact":
         if n > PD_EXACT_MAX_POINTS:
