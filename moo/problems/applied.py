@@ -1,0 +1,205 @@
+"""The applied robust-control MOP of the paper: truck path following (Morais et al. 2022, Section 4.5).
+
+A decision vector ``z = (E_F (4), E_G (2), (log10 mu)^2)`` in ``(0, 500]^7``
+parametrises a steady-state robust LQR (RLQR) gain ``u = K x`` for the truck
+with the doubled steering column (``G2 = [G G]``, steering ``alpha = u1 + u2``,
+:func:`robustctl.models.truck.truck_plant`), designed on the nominal-payload
+model with ``H = [1, 1, 1, 1]^T`` and ``mu = 10**sqrt(z7)``. The gain then
+drives the truck along a reference path at several payloads
+(:func:`robustctl.simulate.simulate`), and the four objectives are the mean
+squared path-following errors
+
+* ``f1``: lateral displacement ``rho`` [m^2],
+* ``f2``: yaw rate ``psidot`` [(rad/s)^2],
+* ``f3``: lateral velocity ``ydot`` [(m/s)^2],
+* ``f4``: orientation ``theta`` [rad^2],
+
+averaged over the payload scenarios (or their worst case), so that the chosen
+design is robust to the payload.
+
+References
+----------
+D. C. Morais et al., "Robust path-following control design of heavy vehicles
+based on multiobjective evolutionary optimization", Expert Systems with
+Applications 192 (2022) 116304, Sections 2.1, 3.3, 4.5 and Appendix A.
+A. M. Barbosa et al., "Robust path-following control for articulated heavy-duty
+vehicles", Control Engineering Practice 85 (2019) (the doubled steering column).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pymoo.core.problem import Problem
+
+import robustctl as rc
+from robustctl._validation import check_positive_scalar
+from robustctl.models import truck
+from robustctl.path import ReferencePath, default_route
+from robustctl.simulate import DEFAULT_BOUND, simulate
+
+from .generic import (_as_population, _check_aggregate, _check_penalty, _check_ref_point, _decode, _penalise,
+                      _spectral_radius, _weights)
+
+__all__ = ["AppliedRLQRProblem"]
+
+#: Lower bound of every variable: the paper's open interval (0, 500] closed at 1e-6.
+Z_LOWER = 1e-6
+Z_UPPER = 500.0
+
+
+class AppliedRLQRProblem(Problem):
+    r"""Truck path-following RLQR tuning problem: 7 variables in ``(0, 500]``, 4 objectives.
+
+    For each decision vector ``z`` (one row of the population):
+
+    1. ``E_F = z[0:4]`` (1 x 4), ``E_G = z[4:6]`` (1 x 2), ``mu = 10**sqrt(z[6])``;
+    2. ``K`` (2 x 4) = steady-state RLQR gain (:func:`robustctl.rlqr_gains`) of the
+       doubled-column truck at the nominal payload, ``H = ones((4, 1))``,
+       weights ``Q``, ``R``; the whole population is designed in one batched call;
+    3. the closed loop is simulated, for all designs and payload scenarios in
+       one array recursion (:func:`robustctl.simulate.simulate`): true truck at
+       each overload, steering ``alpha = sat_0.45(u1 + u2 + alpha_ff)``, the
+       nominal model's steady-cornering reference states and feedforward, the
+       truck starting 1 m off the path;
+    4. ``f_i = mean_s MSE_i(s)`` (``aggregate="mean"``) or ``max_s MSE_i(s)``
+       (``"max"``), ``MSE_i(s) = (1/T) sum_k e_i[k]^2`` with ``e = x - x_ref`` of the
+       objective's state, in the order ``rho, psidot, ydot, theta``.
+
+    **Penalties.** RLQR not computable / not converged (``ok`` False):
+    ``2 * penalty`` on every objective. Linear closed loop ``F_s + G_s (u1 + u2)``
+    not Schur-stable at some scenario payload (spectral radius ``rho >= 1``):
+    ``penalty * min(rho, 2)``; such designs are not simulated. A stable design
+    whose saturated run still drifts off is frozen by the simulator at the
+    divergence bound (``1e3``), so its MSE is at most ``1e6``, below the default
+    ``penalty = 1e7``: every penalised design ranks behind every simulated one.
+    Everything returned is finite.
+
+    Parameters
+    ----------
+    Q : (4, 4) array_like, optional
+        RLQR state weight (default identity).
+    R : (2, 2) array_like, optional
+        RLQR input weight of the two steering columns (default identity).
+    alpha : float
+        RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin.
+    path : ReferencePath, optional
+        Reference path (default :func:`robustctl.path.default_route`, 540 s).
+    overloads : sequence of float
+        Payload overloads of the scenarios in percent (>= 0, 0 = nominal payload,
+        100 = twice the payload). Default ``(0, 100)``: the nominal payload and
+        the 100 % overload that bounds the payload range of the paper's
+        uncertainty model (Appendix A); 200 % and 300 % are left for validation.
+    aggregate : {"mean", "max"}
+        How the scenarios are combined.
+    penalty : float
+        Base penalty (default ``1e7``).
+    hv_ref_point, molsp_ref_point : (4,) array_like, optional
+        Override the reference points.
+
+    Attributes
+    ----------
+    hv_ref_point : (4,) ndarray
+        Hypervolume reference point (see :data:`HV_REF_POINT` for how it was chosen).
+    molsp_ref_point : (4,) ndarray
+        MO-LSP reference point.
+    plant : robustctl.Plant
+        The design model (doubled column, nominal payload).
+    paper_optimum : (7,) ndarray
+        The paper's printed ``z*`` (Section 4.5.1).
+    """
+
+    paper_optimum = np.array(truck.RLQR_MOP_Z)
+
+    _HV_REF = np.array([0.05, 5e-5, 0.05, 2e-4])
+    _MOLSP_REF = np.array([0.2, 1e-4, 0.1, 5e-4])
+
+    def __init__(
+        self,
+        *,
+        Q=None,
+        R=None,
+        alpha: float = 0.1,
+        path: ReferencePath | None = None,
+        overloads=(0.0, 100.0),
+        aggregate: Literal["mean", "max"] = "mean",
+        penalty: float = 1e7,
+        hv_ref_point=None,
+        molsp_ref_point=None,
+    ):
+        self.plant = truck.truck_plant(0.0, doubled=True)
+        n, m = self.plant.n, self.plant.m
+        self.H = np.ones((n, 1))
+        self.Q, self.R = _weights(Q, R, n, m)
+        self.alpha = check_positive_scalar(alpha, "alpha")
+        if path is None:
+            path = default_route()
+        elif not isinstance(path, ReferencePath):
+            raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
+        self.path = path
+        if isinstance(overloads, (str, bytes)) or np.ndim(overloads) != 1 or len(overloads) == 0:
+            raise ValueError(f"overloads must be a non-empty 1-D sequence of percentages, got {overloads!r}")
+        self.overloads = np.asarray(truck.check_overload(list(overloads), "overloads"), dtype=float)
+        self.aggregate = _check_aggregate(aggregate)
+        self.penalty = _check_penalty(penalty)
+        if self.penalty <= DEFAULT_BOUND**2:
+            raise ValueError(f"penalty must exceed the largest simulated MSE ({DEFAULT_BOUND**2:g}), "
+                             f"got {self.penalty:g}")
+        self.hv_ref_point = _check_ref_point(hv_ref_point, "hv_ref_point", self._HV_REF)
+        self.molsp_ref_point = _check_ref_point(molsp_ref_point, "molsp_ref_point", self._MOLSP_REF)
+        # true plants of the scenarios, for the stability screen: F_s (S, 4, 4), G_s (S, 4, 1)
+        self._F_s, self._G_s, _ = truck.discretise(self.overloads)
+        super().__init__(n_var=n + m + 1, n_obj=4, xl=Z_LOWER, xu=Z_UPPER, vtype=float)
+
+    # -- public helpers -----------------------------------------------------
+    def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(EF (B, 1, 4), EG (B, 1, 2), mu (B,))`` of a population ``z`` (B, 7) or one ``z`` (7,)."""
+        z = _as_population(z, self.n_var)
+        if np.any(z[:, -1] < 0):
+            raise ValueError(f"z[:, 6] = (log10 mu)^2 must be >= 0, got {z[:, -1].min():g}")
+        return _decode(z, self.plant.n, self.plant.m)
+
+    def gains(self, z) -> "rc.RLQRBatch":
+        """The batched RLQR design of a population ``z`` (B, 7)."""
+        EF, EG, mu = self.decode(z)
+        return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha)
+
+    def closed_loop_radius(self, K: np.ndarray) -> np.ndarray:
+        """Spectral radius (B, S) of ``F_s + G_s [1 1] K`` at each scenario payload (NaN for non-finite K)."""
+        K = self._check_K(K)
+        finite = np.all(np.isfinite(K), axis=(1, 2))
+        Ksteer = np.where(finite[:, None, None], K, 0.0).sum(axis=1, keepdims=True)   # (B, 1, 4)
+        rho = _spectral_radius(self._F_s[None] + self._G_s[None] @ Ksteer[:, None])
+        rho[~finite] = np.nan
+        return rho
+
+    def mse(self, K: np.ndarray) -> np.ndarray:
+        """Per-scenario MSE (B, S, 4) of gains ``K`` (B, 2, 4), in the order f1..f4 (no penalties)."""
+        K = self._check_K(K)
+        return simulate(K, self.path, tuple(self.overloads), keep_trajectories=False).mse()
+
+    # -- pymoo hook -----------------------------------------------------------
+    def _evaluate(self, x, out, *args, **kwargs):
+        z = _as_population(x, self.n_var)
+        batch = self.gains(z)
+        ok = np.asarray(batch.ok, dtype=bool) & np.all(np.isfinite(batch.K), axis=(1, 2))
+        K = np.where(ok[:, None, None], batch.K, np.nan)
+        rho = np.max(self.closed_loop_radius(K), axis=1)
+        run = ok & (rho < 1.0)
+        J = np.full((z.shape[0], self.n_obj), np.inf)
+        if run.any():
+            e = self.mse(K[run])
+            J[run] = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
+        out["F"] = _penalise(J, ok, rho, self.penalty)
+
+    def _check_K(self, K) -> np.ndarray:
+        K = np.asarray(K, dtype=float)
+        n, m = self.plant.n, self.plant.m
+        if K.ndim != 3 or K.shape[1:] != (m, n):
+            raise ValueError(f"K must have shape (B, {m}, {n}), got shape {K.shape}")
+        return K
+
+    def __repr__(self) -> str:
+        return (f"AppliedRLQRProblem(n_var={self.n_var}, n_obj={self.n_obj}, "
+                f"overloads={tuple(self.overloads.tolist())}, T={self.path.T}, aggregate={self.aggregate!r})")
