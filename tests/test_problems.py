@@ -234,3 +234,160 @@ def test_generic_bad_population(generic):
         generic.decode(np.zeros((2, 4)))
     with pytest.raises(ValueError, match="finite"):
         generic.decode(np.full(5, np.nan))
+
+
+# ------------------------------------------------------------------ applied --
+from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
+from robustctl.models import truck  # noqa: E402
+from robustctl.path import default_route  # noqa: E402
+
+SHORT_PATH_S = 120.0      # a 2-minute stretch of the default route keeps the plain-loop reference quick
+APPLIED_Z = np.random.default_rng(0).uniform(1e-6, 500.0, (12, 7))   # seed 0: one unstable design
+
+
+def _zoh_truck(overload):
+    """Exact ZOH of x' = A x + B alpha + E kappa (scipy expm of the augmented matrix)."""
+    A, B, E = truck.continuous_model(overload)
+    dt = truck.PAPER_PARAMETERS.dt
+    M = np.zeros((6, 6))
+    M[:4, :4], M[:4, 4], M[:4, 5] = A * dt, B[:, 0] * dt, E * dt
+    Phi = scipy.linalg.expm(M)
+    return Phi[:4, :4], Phi[:4, 4], Phi[:4, 5]
+
+
+def _applied_reference(z, problem, *, aggregate="mean"):
+    """One individual, one payload, one time step at a time (no batching anywhere)."""
+    pen = problem.penalty
+    kappa = problem.path.kappa
+    T = kappa.size
+    x_ref, alpha_ff = truck.reference_states(kappa, 0.0)
+    plants = [_zoh_truck(ov) for ov in problem.overloads]
+    out = []
+    for zi in np.atleast_2d(z):
+        try:
+            K = rc.design("rlqr", truck.truck_plant(0.0, doubled=True), zi[None, :4], zi[None, 4:6],
+                          10.0 ** np.sqrt(zi[6]), Q=problem.Q, R=problem.R, H=np.ones((4, 1))).K
+        except (rc.ConvergenceError, rc.RankConditionError):
+            out.append(np.full(4, 2 * pen))
+            continue
+        k_steer = K[0] + K[1]                          # alpha = u1 + u2
+        rho = max(np.max(np.abs(np.linalg.eigvals(Fd + np.outer(Gd, k_steer)))) for Fd, Gd, _ in plants)
+        if rho >= 1.0:
+            out.append(np.full(4, pen * min(rho, 2.0)))
+            continue
+        per_payload = []
+        for Fd, Gd, Gk in plants:
+            x = x_ref[0] + np.array([0.0, 0.0, 1.0, 0.0])     # start 1 m left of the path
+            sq = np.zeros(4)
+            for k in range(T):
+                e = x - x_ref[k]
+                assert np.max(np.abs(e)) < 1e3                # no run of the chosen designs diverges
+                sq += e**2
+                alpha = np.clip(k_steer @ e + alpha_ff[k], -0.45, 0.45)
+                x = Fd @ x + Gd * alpha + Gk * kappa[k]
+            per_payload.append(sq[[2, 1, 0, 3]] / T)          # f1..f4 = rho, psidot, ydot, theta
+        per_payload = np.array(per_payload)
+        out.append(per_payload.mean(0) if aggregate == "mean" else per_payload.max(0))
+    return np.array(out)
+
+
+@pytest.fixture(scope="module")
+def applied_short():
+    return AppliedRLQRProblem(path=default_route(duration=SHORT_PATH_S))
+
+
+def test_applied_shape_and_bounds(applied_short):
+    p = applied_short
+    assert p.n_var == 7 and p.n_obj == 4
+    assert np.all(p.xl > 0) and np.all(p.xl <= 1e-6) and np.all(p.xu == 500.0)
+    assert p.plant.G.shape == (4, 2)
+    np.testing.assert_array_equal(p.plant.G[:, 0], p.plant.G[:, 1])    # doubled steering column
+    assert p.hv_ref_point.shape == (4,) and p.molsp_ref_point.shape == (4,)
+    np.testing.assert_array_equal(p.overloads, [0.0, 100.0])
+
+
+def test_applied_batched_equals_per_individual_loop(applied_short):
+    got = applied_short.evaluate(APPLIED_Z)
+    want = _applied_reference(APPLIED_Z, applied_short)
+    n_penalised = int(np.sum(want[:, 0] >= applied_short.penalty))
+    assert 1 <= n_penalised <= 6
+    np.testing.assert_allclose(got, want, rtol=1e-7)
+
+
+def test_applied_options_match_reference():
+    Q = np.diag([1.0, 10.0, 5.0, 50.0])
+    R = np.diag([20.0, 5.0])
+    p = AppliedRLQRProblem(Q=Q, R=R, path=default_route(duration=60.0), overloads=[0.0, 50.0, 300.0],
+                           aggregate="max")
+    z = APPLIED_Z[[0, 1, 3]]
+    np.testing.assert_allclose(p.evaluate(z), _applied_reference(z, p, aggregate="max"), rtol=1e-7)
+
+
+def test_applied_paper_optimum_is_finite_and_sensible():
+    p = AppliedRLQRProblem()                    # the full default route
+    f = p.evaluate(p.paper_optimum[None])[0]
+    assert np.all(np.isfinite(f)) and np.all(f > 0)
+    assert np.all(f < p.hv_ref_point) and np.all(f < p.molsp_ref_point)
+    # stable at every payload of the paper's comparison, 0 to 300 % overload
+    K = p.gains(p.paper_optimum[None]).K[0]
+    F_s, G_s, _ = truck.discretise([0.0, 100.0, 200.0, 300.0])
+    for Fd, Gd in zip(F_s, G_s):
+        assert np.max(np.abs(np.linalg.eigvals(Fd + Gd @ K.sum(axis=0, keepdims=True)))) < 1.0
+    # the truck ends up on the path: RMS lateral error well below the 1 m start offset
+    assert np.sqrt(f[0]) < 0.5
+
+
+def test_applied_not_computable_designs_get_finite_penalties(applied_short, monkeypatch):
+    z = APPLIED_Z[[0, 1, 3]]
+    real = rc.rlqr_gains
+
+    def failing(plant, EF, EG, mu, **kw):
+        b = real(plant, EF, EG, mu, **kw)
+        K = np.array(b.K, copy=True)
+        ok = np.array(b.ok, copy=True)
+        K[0] = np.nan
+        ok[0] = False
+        return type("Batch", (), {"K": K, "ok": ok, "P": b.P, "iterations": b.iterations})()
+
+    good = applied_short.evaluate(z)
+    monkeypatch.setattr(rc, "rlqr_gains", failing)
+    f = applied_short.evaluate(z)
+    np.testing.assert_array_equal(f[0], np.full(4, 2 * applied_short.penalty))
+    np.testing.assert_array_equal(f[1:], good[1:])
+
+
+def test_applied_extreme_population_is_finite(applied_short):
+    z = np.random.default_rng(3).uniform(1e-6, 500.0, (16, 7))
+    z[0] = 1e-6                 # the lower corner of the box
+    z[1] = 500.0                # the upper corner: mu = 10**sqrt(500) ~ 2.5e22
+    z[2, 4:6] = 1e-6            # EG ~ 0 with EF large
+    f = applied_short.evaluate(z)
+    assert f.shape == (16, 4) and np.all(np.isfinite(f)) and np.all(f > 0)
+    assert np.all(f <= 2 * applied_short.penalty)
+
+
+@pytest.mark.parametrize("kwargs, exc, words", [
+    (dict(Q=np.eye(3)), ValueError, "Q"),
+    (dict(R=np.eye(1)), ValueError, "R"),
+    (dict(R=np.diag([1.0, -1.0])), ValueError, "R"),
+    (dict(alpha=-0.1), ValueError, "alpha"),
+    (dict(path="default"), TypeError, "path"),
+    (dict(overloads=[]), ValueError, "overloads"),
+    (dict(overloads=[0.0, -10.0]), ValueError, "overloads"),
+    (dict(overloads=50.0), ValueError, "overloads"),
+    (dict(aggregate="min"), ValueError, "aggregate"),
+    (dict(penalty=1e5), ValueError, "penalty"),
+    (dict(hv_ref_point=[1.0, 1.0, 1.0]), ValueError, "hv_ref_point"),
+    (dict(molsp_ref_point=[0.0, 1.0, 1.0, 1.0]), ValueError, "molsp_ref_point"),
+])
+def test_applied_bad_arguments(kwargs, exc, words):
+    with pytest.raises(exc, match=words):
+        AppliedRLQRProblem(path=default_route(duration=10.0), **kwargs) if "path" not in kwargs \
+            else AppliedRLQRProblem(**kwargs)
+
+
+def test_applied_bad_population(applied_short):
+    with pytest.raises(ValueError, match=r"\(B, 7\)"):
+        applied_short.decode(np.ones((3, 5)))
+    with pytest.raises(ValueError, match="K must have shape"):
+        applied_short.mse(np.zeros((2, 1, 4)))
