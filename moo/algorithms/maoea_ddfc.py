@@ -1,0 +1,363 @@
+"""MaOEA-DDFC: directional diversity and favorable convergence.
+
+Cheng, Yen & Zhang, "A many-objective evolutionary algorithm with enhanced
+mating and environmental selections", IEEE Transactions on Evolutionary
+Computation 19(4), 592-605, 2015.
+
+What it implements
+------------------
+Objectives are normalised with the ideal point ``z*`` (best value seen so far)
+and the nadir estimate ``z^nad`` from the intercepts of the hyperplane through
+the extreme points (NSGA-III's procedure; pymoo's
+:class:`~pymoo.algorithms.moo.nsga3.HyperplaneNormalization`)::
+
+    f~_i(x) = (f_i(x) - z*_i) / (z^nad_i - z*_i).
+
+Favorable convergence (FC). The Chebyshev function ``g(x|w) = max_i w_i f~_i(x)``
+is smallest, over weights on the simplex, at the *favorable weight*
+``w^x_i = (1/f~_i(x)) / sum_j 1/f~_j(x)``, where all the terms ``w_i f~_i`` are
+equal. FC is that smallest value::
+
+    FC(x) = g(x | w^x) = 1 / sum_j (1 / f~_j(x)),
+
+and ``FC(x) = 0`` when some ``f~_j(x) = 0`` (all the weight on that objective).
+Smaller FC means better convergence along the solution's own direction.
+
+Directional diversity (DD). Normalised vectors are projected onto the unit
+simplex, ``p(x) = f~(x) / sum_i f~_i(x)``, so that the Euclidean distance
+between projections measures the difference of *directions*. The density of a
+candidate's direction relative to the already selected set ``S`` is::
+
+    DD(x) = sum_{k=1..K} 1 / d_k(x, S),
+
+with ``d_k`` the distance to its ``k``-th nearest member of ``S`` in the
+projected space (``K = 5``; fewer terms while ``|S| < K``). Smaller DD is a
+sparser, more diverse direction.
+
+Mating selection: binary tournament; a parent that Pareto-dominates the other
+wins, otherwise the one with the smaller FC (ties: the first drawn).
+
+Environmental selection on the merged population of parents and offspring:
+
+1. Non-dominated sorting; whole fronts enter while they fit.
+2. From the front that overflows, solutions are added one at a time: the
+   ``L = 3`` remaining candidates with the smallest DD with respect to the
+   solutions selected so far form a tournament, and the winner is chosen by
+   FC - by roulette wheel with probability proportional to ``1/FC``
+   (``candidate_choice="roulette"``, default) or deterministically the
+   smallest FC (``"best"``).
+3. If the first front alone overflows (nothing selected yet), DD of the first
+   pick is measured against the other candidates of that front.
+
+Readings where the paper leaves room
+------------------------------------
+* FC is computed on the same normalised objectives as DD, so that it does not
+  depend on the units of the objectives (the paper's control MOPs have
+  objectives of very different scales); PlatEMO translates by the ideal point
+  only.
+* The roulette probability ``1/FC`` uses ``max(FC, 1e-6)`` so that a solution
+  with ``FC = 0`` gets a large but finite weight; ``"best"`` breaks FC ties by
+  the smaller DD, then by population index.
+* A solution exactly at the ideal point (``sum f~ = 0``) is projected to the
+  simplex centre ``1/M``.
+* Coincident projections (distance 0) give ``DD = inf``: a duplicated
+  direction is taken last.
+* The survival tolerates any population size ``>= n_survive`` and repeated
+  calls in a generation (MO-LSP); its only state is the normalisation, which it
+  updates itself. It stores ``"FC"`` and ``"rank"`` (Pareto front index) on
+  the survivors.
+"""
+
+from __future__ import annotations
+
+import numbers
+from typing import Literal
+
+import numpy as np
+from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.algorithms.moo.nsga3 import HyperplaneNormalization
+from pymoo.core.selection import Selection
+from pymoo.core.survival import Survival
+from pymoo.operators.sampling.rnd import FloatRandomSampling
+from pymoo.util.display.multi import MultiObjectiveOutput
+from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+from scipy.spatial.distance import cdist
+
+from robustctl._validation import as_matrix
+
+from .operators import POP_SIZE, paper_crossover, paper_mutation
+
+__all__ = [
+    "MaOEADDFC",
+    "DDFCSurvival",
+    "DDFCMatingSelection",
+    "favorable_convergence",
+    "directional_projection",
+    "select_by_dd_fc",
+    "make_maoea_ddfc",
+]
+
+_FC_FLOOR = 1e-6
+_CHOICES = ("roulette", "best")
+
+
+def _check_int(value, name: str, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
+    if value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value}")
+    return int(value)
+
+
+def _check_choice(value, name: str, choices: tuple[str, ...]) -> str:
+    if not isinstance(value, str) or value.lower() not in choices:
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
+    return value.lower()
+
+
+def favorable_convergence(F: np.ndarray) -> np.ndarray:
+    """FC of each row of normalised objectives ``F`` (ideal point at the origin).
+
+    ``FC(x) = min_{w in simplex} max_i w_i F_i(x) = 1 / sum_i (1 / F_i(x))``,
+    and 0 if some ``F_i(x) = 0``. Negative entries (a point better than the
+    stored ideal) are clipped to 0.
+    """
+    F = np.maximum(as_matrix(F, "F"), 0.0)
+    with np.errstate(divide="ignore"):
+        inv = 1.0 / F
+    total = inv.sum(axis=1)
+    return np.where(np.isinf(total), 0.0, 1.0 / total)
+
+
+def directional_projection(F: np.ndarray) -> np.ndarray:
+    """Project normalised objective vectors on the unit simplex, ``F / sum(F)``."""
+    F = np.maximum(as_matrix(F, "F"), 0.0)
+    s = F.sum(axis=1, keepdims=True)
+    centre = np.full_like(F, 1.0 / F.shape[1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        P = F / s
+    return np.where(s > 0, P, centre)
+
+
+def _kth_sum_inverse(nearest: np.ndarray) -> np.ndarray:
+    with np.errstate(divide="ignore"):
+        return np.sum(1.0 / nearest, axis=1)
+
+
+def select_by_dd_fc(
+    P_selected: np.ndarray,
+    P_candidates: np.ndarray,
+    fc: np.ndarray,
+    n_select: int,
+    *,
+    n_neighbors: int = 5,
+    n_candidates: int = 3,
+    candidate_choice: Literal["roulette", "best"] = "roulette",
+    random_state: np.random.Generator | None = None,
+) -> np.ndarray:
+    """Pick ``n_select`` of the candidates one at a time by DD, then FC.
+
+    Parameters
+    ----------
+    P_selected : (s, M) array
+        Projected directions of the solutions already selected (may be empty).
+    P_candidates : (c, M) array
+        Projected directions of the candidates.
+    fc : (c,) array
+        FC of the candidates.
+    n_select : int
+        How many candidates to pick (``<= c``).
+    n_neighbors : int
+        ``K`` in ``DD = sum_{k<=K} 1/d_k``.
+    n_candidates : int
+        ``L``, the size of the tournament of the least crowded candidates.
+    candidate_choice : {"roulette", "best"}
+        Winner by roulette wheel on ``1/FC`` or the smallest FC.
+    random_state : numpy Generator
+        Needed for ``"roulette"``.
+
+    Returns
+    -------
+    (n_select,) int array
+        Candidate indices in the order they were picked.
+    """
+    P_c = np.asarray(P_candidates, dtype=float)
+    c = len(P_c)
+    P_s = np.asarray(P_selected, dtype=float).reshape(-1, P_c.shape[1])
+    fc = np.asarray(fc, dtype=float)
+    if fc.shape != (c,):
+        raise ValueError(f"fc must have shape ({c},) (one per candidate), got shape {fc.shape}")
+    n_select = _check_int(n_select, "n_select", 0)
+    if n_select > c:
+        raise ValueError(f"n_select must be <= the number of candidates ({c}), got {n_select}")
+    k = _check_int(n_neighbors, "n_neighbors", 1)
+    L = _check_int(n_candidates, "n_candidates", 1)
+    candidate_choice = _check_choice(candidate_choice, "candidate_choice", _CHOICES)
+    if candidate_choice == "roulette" and random_state is None:
+        raise ValueError("random_state is required with candidate_choice='roulette'")
+
+    D_cc = cdist(P_c, P_c)
+    remaining = np.ones(c, dtype=bool)
+    picked: list[int] = []
+    # nearest[i]: the (up to K) smallest distances from candidate i to the selected set,
+    # kept sorted and padded with inf; updated incrementally after every pick.
+    if len(P_s):
+        nearest = np.sort(cdist(P_c, P_s), axis=1)[:, :k]
+    else:
+        nearest = np.empty((c, 0))
+
+    for _ in range(n_select):
+        idx = np.flatnonzero(remaining)
+        if nearest.shape[1] == 0:
+            # nothing selected yet: density among the candidates themselves
+            d = D_cc[np.ix_(idx, idx)]
+            np.fill_diagonal(d, np.inf)
+            near = np.sort(d, axis=1)[:, : min(k, len(idx) - 1)]
+            dd = _kth_sum_inverse(near) if near.shape[1] else np.zeros(len(idx))
+        else:
+            dd = _kth_sum_inverse(nearest[idx])
+        order = np.lexsort((idx, dd))[:L]             # smallest DD, ties by index
+        tour = idx[order]
+        if candidate_choice == "best":
+            win = tour[np.lexsort((np.arange(len(tour)), dd[order], fc[tour]))[0]]
+        else:
+            weight = 1.0 / np.maximum(fc[tour], _FC_FLOOR)
+            win = tour[random_state.choice(len(tour), p=weight / weight.sum())]
+        picked.append(int(win))
+        remaining[win] = False
+        new = D_cc[:, win][:, None]
+        merged = np.concatenate([nearest, new], axis=1)
+        merged.sort(axis=1)
+        nearest = merged[:, :k]
+    return np.asarray(picked, dtype=np.int64)
+
+
+class DDFCSurvival(Survival):
+    """Environmental selection of MaOEA-DDFC (non-dominated fronts, then DD/FC tournaments)."""
+
+    def __init__(self, n_obj: int, *, n_neighbors: int = 5, n_candidates: int = 3,
+                 candidate_choice: str = "roulette"):
+        super().__init__(filter_infeasible=True)
+        self.n_neighbors = n_neighbors
+        self.n_candidates = n_candidates
+        self.candidate_choice = candidate_choice
+        self.norm = HyperplaneNormalization(n_obj)
+
+    @property
+    def ideal_point(self) -> np.ndarray:
+        return self.norm.ideal_point
+
+    @property
+    def nadir_point(self) -> np.ndarray | None:
+        return self.norm.nadir_point
+
+    def normalize(self, F: np.ndarray) -> np.ndarray:
+        """``(F - z*) / (z^nad - z*)`` with the current estimates."""
+        ideal, nadir = self.norm.ideal_point, self.norm.nadir_point
+        if nadir is None:                      # before the first update: the set itself
+            ideal, nadir = F.min(axis=0), F.max(axis=0)
+        denom = nadir - ideal
+        denom = np.where(denom > 1e-12, denom, 1e-12)
+        return (F - ideal) / denom
+
+    def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
+        F = pop.get("F").astype(float)
+        if n_survive is None:
+            n_survive = len(pop)
+        fronts, rank = NonDominatedSorting().do(F, return_rank=True, n_stop_if_ranked=n_survive)
+        self.norm.update(F, nds=fronts[0])
+        Fn = self.normalize(F)
+        fc = favorable_convergence(Fn)
+        pop.set("rank", rank, "FC", fc)
+
+        before = np.concatenate(fronts[:-1]) if len(fronts) > 1 else np.empty(0, dtype=int)
+        last = np.asarray(fronts[-1])
+        if len(before) + len(last) <= n_survive:
+            return pop[np.concatenate([before, last])]
+        P = directional_projection(Fn)
+        chosen = select_by_dd_fc(P[before], P[last], fc[last], n_survive - len(before),
+                                 n_neighbors=self.n_neighbors, n_candidates=self.n_candidates,
+                                 candidate_choice=self.candidate_choice, random_state=random_state)
+        return pop[np.concatenate([before, last[chosen]])]
+
+
+class DDFCMatingSelection(Selection):
+    """Binary tournament: Pareto dominance first, then the smaller FC (ties: first drawn).
+
+    FC is computed from the population's objectives with the normalisation held
+    by the algorithm's :class:`DDFCSurvival` (or the population's own range if
+    none is available).
+    """
+
+    def _do(self, problem, pop, n_select, n_parents, *args, random_state=None, algorithm=None,
+            **kwargs):
+        F = pop.get("F").astype(float)
+        survival = getattr(algorithm, "survival", None)
+        if isinstance(survival, DDFCSurvival) and survival.nadir_point is not None:
+            fc = favorable_convergence(survival.normalize(F))
+        else:
+            lo, hi = F.min(axis=0), F.max(axis=0)
+            fc = favorable_convergence((F - lo) / np.where(hi - lo > 1e-12, hi - lo, 1e-12))
+        n = n_select * n_parents
+        a = random_state.integers(0, len(pop), size=n)
+        b = random_state.integers(0, len(pop), size=n)
+        Fa, Fb = F[a], F[b]
+        a_better = np.any(Fa < Fb, axis=1)
+        b_better = np.any(Fa > Fb, axis=1)
+        a_dom = a_better & ~b_better
+        b_dom = b_better & ~a_better
+        a_wins = a_dom | (~b_dom & (fc[a] <= fc[b]))
+        return np.where(a_wins, a, b).reshape(n_select, n_parents)
+
+
+class MaOEADDFC(GeneticAlgorithm):
+    """MaOEA-DDFC as a pymoo genetic algorithm (see the module docstring).
+
+    Parameters
+    ----------
+    n_obj : int
+        Number of objectives (for the normalisation).
+    pop_size : int
+        Population size ``N``.
+    n_neighbors : int
+        ``K``, neighbours in the directional density DD (5).
+    n_candidates : int
+        ``L``, least crowded candidates entering each FC tournament (3).
+    candidate_choice : {"roulette", "best"}
+        How the FC tournament is decided.
+    sampling, crossover, mutation, eliminate_duplicates, output
+        As for any pymoo genetic algorithm.
+    """
+
+    def __init__(self, n_obj: int, *, pop_size: int = POP_SIZE, n_neighbors: int = 5,
+                 n_candidates: int = 3, candidate_choice: str = "roulette", sampling=None,
+                 crossover=None, mutation=None, eliminate_duplicates: bool = True, output=None):
+        self.n_obj = _check_int(n_obj, "n_obj", 2)
+        pop_size = _check_int(pop_size, "pop_size", 2)
+        n_neighbors = _check_int(n_neighbors, "n_neighbors", 1)
+        n_candidates = _check_int(n_candidates, "n_candidates", 1)
+        candidate_choice = _check_choice(candidate_choice, "candidate_choice", _CHOICES)
+        super().__init__(
+            pop_size=pop_size,
+            sampling=sampling if sampling is not None else FloatRandomSampling(),
+            selection=DDFCMatingSelection(),
+            crossover=crossover if crossover is not None else paper_crossover(),
+            mutation=mutation if mutation is not None else paper_mutation(),
+            survival=DDFCSurvival(self.n_obj, n_neighbors=n_neighbors, n_candidates=n_candidates,
+                                  candidate_choice=candidate_choice),
+            eliminate_duplicates=eliminate_duplicates,
+            output=output if output is not None else MultiObjectiveOutput(),
+            advance_after_initial_infill=True,
+        )
+
+    def _setup(self, problem, **kwargs):
+        if problem.n_obj != self.n_obj:
+            raise ValueError(f"n_obj is {self.n_obj} but the problem has {problem.n_obj} objectives")
+
+
+def make_maoea_ddfc(*, n_obj: int, pop_size: int = POP_SIZE, n_neighbors: int = 5,
+                    n_candidates: int = 3,
+                    candidate_choice: Literal["roulette", "best"] = "roulette") -> MaOEADDFC:
+    """MaOEA-DDFC with the paper's settings (``K = 5``, ``L = 3``, SBX and PM as in the paper)."""
+    return MaOEADDFC(n_obj, pop_size=pop_size, n_neighbors=n_neighbors, n_candidates=n_candidates,
+                     candidate_choice=candidate_choice)
