@@ -189,3 +189,18 @@ def test_bad_overload_type_and_params():
     with pytest.raises(ValueError, match="payload"):
         truck.TruckParameters(payload=-5.0)
     assert truck.TruckParameters(payload=0.0).total_mass(300) == pytest.approx(P.m)
+
+
+def test_lqr_weights_doubled_column_costs_the_same():
+    """The doubled-column LQR (R2 = 2 r I) gives the plain LQR's steering: K1 + K2 = K."""
+    import robustctl as rc
+
+    Q, R = truck.lqr_weights()
+    Q2, R2 = truck.lqr_weights(doubled=True)
+    np.testing.assert_array_equal(Q, Q2)
+    assert R.shape == (1, 1) and R2.shape == (2, 2)
+    K = -control.dlqr(truck.truck_plant(0.0).F, truck.truck_plant(0.0).G, Q, R)[0]
+    p2 = truck.truck_plant(0.0, doubled=True)
+    K2 = rc.design("lqr", p2, Q=Q2, R=R2).K
+    np.testing.assert_allclose(K2.sum(axis=0), K[0], rtol=1e-8)
+    np.testing.assert_allclose(K2[0], K2[1], rtol=1e-8)

@@ -58,7 +58,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 import scipy.linalg
 
-from .._validation import as_batch, as_matrix, check_positive_scalar
+from .._validation import as_batch, check_positive_scalar
 from ..plant import Plant, _frozen
 
 __all__ = [
@@ -66,6 +66,7 @@ __all__ = [
     "STEER_LIMIT", "continuous_model", "truck_plant", "discretise", "steady_state_cornering",
     "reference_states", "AlgebraicUncertainty", "algebraic_uncertainty", "uncertainty_from_z",
     "RLQR_MOP_Z", "PRINTED_EF", "PRINTED_EG", "PRINTED_LOG10_MU_SQ", "check_overload",
+    "MAX_ERRORS", "MAX_STEER", "lqr_weights",
 ]
 
 #: State names, in the model's order.
@@ -399,6 +400,33 @@ def algebraic_uncertainty(source: str = "printed", *, params: TruckParameters | 
     else:
         raise ValueError(f"source must be 'printed' or 'computed', got {source!r}")
     return AlgebraicUncertainty(_frozen(H), _frozen(EF), _frozen(EG), float(mu), source)
+
+
+#: Acceptable errors of Bryson's rule: ydot 0.5 m/s, psidot 0.1 rad/s (5.7 deg/s),
+#: rho 0.25 m (a quarter of the free space in a 3.5 m lane), theta 0.05 rad (2.9 deg).
+MAX_ERRORS = (0.5, 0.1, 0.25, 0.05)
+#: Acceptable steering angle of Bryson's rule [rad] (5.7 deg, well inside the 0.45 rad limit).
+MAX_STEER = 0.1
+
+
+def lqr_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Bryson's-rule weights used for every truck design (LQR, RLQR, H-infinity).
+
+    ``Q = diag(1 / MAX_ERRORS^2)``, ``R = 1 / MAX_STEER^2``: each state or the
+    steering costs 1 when it reaches its acceptable value (Bryson & Ho, *Applied
+    Optimal Control*, 1975, Sec. 5.4). With ``doubled=True`` (the doubled
+    steering column, ``alpha = u1 + u2``) ``R = 2 r I_2``: the cheapest split
+    of a steering angle ``alpha`` is ``u1 = u2 = alpha/2`` and costs
+    ``2 r (alpha^2/4 + alpha^2/4) = r alpha^2``, the same as on the plain plant.
+
+    Returns
+    -------
+    Q : (4, 4) ndarray
+    R : (1, 1) or (2, 2) ndarray
+    """
+    Q = np.diag(1.0 / np.square(MAX_ERRORS))
+    r = 1.0 / MAX_STEER**2
+    return Q, (2.0 * r * np.eye(2) if doubled else np.array([[r]]))
 
 
 def uncertainty_from_z(z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
