@@ -46,22 +46,17 @@ def dare(F, G, Q, R) -> tuple[np.ndarray, str]:
     Returns ``(P, backend)``; raises :class:`ConvergenceError` if neither
     backend gives a solution with relative residual below 1e-8.
     """
-    attempts = []
-    try:
-        import control
-
-        P, _, _ = control.dare(F, G, Q, R, method="slycot")
-        attempts.append(("slycot", np.asarray(P)))
-    except Exception as exc:  # slycot missing or failed: fall back to scipy
-        attempts.append(("slycot", exc))
-    try:
-        attempts.append(("scipy", scipy.linalg.solve_discrete_are(F, G, Q, R)))
-    except Exception as exc:
-        attempts.append(("scipy", exc))
     reasons = []
-    for backend, P in attempts:
-        if isinstance(P, Exception):
-            reasons.append(f"{backend}: {P}")
+    for backend in ("slycot", "scipy"):
+        try:
+            if backend == "slycot":
+                import control
+
+                P = np.asarray(control.dare(F, G, Q, R, method="slycot")[0])
+            else:
+                P = scipy.linalg.solve_discrete_are(F, G, Q, R)
+        except Exception as exc:  # slycot missing or failed, or scipy failed: try the next
+            reasons.append(f"{backend}: {exc}")
             continue
         P = 0.5 * (P + P.T)
         res = _residual(F, G, Q, R, P)
