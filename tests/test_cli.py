@@ -1,0 +1,142 @@
+"""``python -m moo run``: the JSON record, progress output, and argument errors (exit code 2)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from pymoo.problems import get_problem
+
+from moo.__main__ import main
+
+
+def run_cli(tmp_path, *args, name="out.json"):
+    out = tmp_path / name
+    code = main(["run", *args, "--out", str(out)])
+    return code, (json.loads(out.read_text()) if out.exists() else None)
+
+
+def hv_2d(F, r):
+    """2-D hypervolume by a sweep over the points sorted by the first objective."""
+    F = sorted(map(tuple, F))
+    total, best_f2 = 0.0, r[1]
+    for f1, f2 in F:
+        if f1 < r[0] and f2 < best_f2:
+            total += (r[0] - f1) * (best_f2 - f2)
+            best_f2 = f2
+    return total
+
+
+REQUIRED = {"problem", "algorithm", "molsp", "seed", "n_evals", "F", "X", "hv_history", "wall_time_s",
+            "versions"}
+
+
+def test_run_zdt1_nsga2_record(tmp_path):
+    code, rec = run_cli(tmp_path, "--problem", "zdt1", "--algorithm", "nsga2", "--seed", "3",
+                        "--evals", "500", "--pop-size", "20")
+    assert code == 0
+    assert REQUIRED <= rec.keys()
+    assert (rec["problem"], rec["algorithm"], rec["molsp"], rec["seed"]) == ("zdt1", "nsga2", False, 3)
+    assert 500 <= rec["n_evals"] < 500 + 20
+    F, X = np.array(rec["F"]), np.array(rec["X"])
+    assert F.shape[1] == 2 and X.shape == (len(F), 30)
+    assert np.all((X >= 0) & (X <= 1))
+    # the objectives are those of the decision vectors (pymoo's own ZDT1)
+    assert np.allclose(get_problem("zdt1").evaluate(X), F, rtol=1e-12, atol=0)
+    # the final set is non-dominated
+    for i in range(len(F)):
+        dominated = np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)
+        assert not dominated.any()
+    hist = rec["hv_history"]
+    evals, hv = hist["evaluations"], hist["hypervolume"]
+    assert evals[0] == 20 and evals[-1] == rec["n_evals"]
+    assert all(b > a for a, b in zip(evals, evals[1:]))
+    assert hv[-1] == pytest.approx(hv_2d(F, rec["hv_ref_point"]), rel=1e-12)
+    assert rec["hv_ref_point"] == [1.1, 1.1]
+    assert {"numpy", "pymoo", "moocore", "python"} <= rec["versions"].keys()
+
+
+def test_run_dtlz2_with_molsp_and_cap(tmp_path):
+    code, rec = run_cli(tmp_path, "--problem", "dtlz2", "--n-obj", "4", "--algorithm", "nsga2", "--molsp",
+                        "--max-leaders", "5", "--seed", "1", "--evals", "400", "--pop-size", "20")
+    assert code == 0
+    assert rec["molsp"] is True and rec["max_leaders"] == 5 and rec["n_obj"] == 4
+    assert 0 < rec["molsp_evals"] <= 5 * len(rec["hv_history"]["evaluations"])
+    assert 400 <= rec["n_evals"] < 420
+    F, X = np.array(rec["F"]), np.array(rec["X"])
+    assert F.shape[1] == 4
+    assert np.allclose(get_problem("dtlz2", n_var=13, n_obj=4).evaluate(X), F, rtol=1e-12, atol=0)
+
+
+def test_same_seed_same_record(tmp_path):
+    args = ["--problem", "zdt2", "--algorithm", "nsga2", "--molsp", "--seed", "9", "--evals", "300",
+            "--pop-size", "20"]
+    _, a = run_cli(tmp_path, *args, name="a.json")
+    _, b = run_cli(tmp_path, *args, name="b.json")
+    assert a["F"] == b["F"] and a["X"] == b["X"] and a["hv_history"] == b["hv_history"]
+
+
+def test_module_entry_point_is_quiet_without_tty(tmp_path):
+    out = tmp_path / "r.json"
+    proc = subprocess.run([sys.executable, "-m", "moo", "run", "--problem", "zdt1", "--algorithm", "nsga2",
+                           "--seed", "0", "--evals", "100", "--pop-size", "20", "--out", str(out)],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "" and proc.stderr == ""
+    assert json.loads(out.read_text())["n_evals"] >= 100
+
+
+def test_progress_bar_on_a_terminal(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    code, _ = run_cli(tmp_path, "--problem", "zdt1", "--algorithm", "nsga2", "--seed", "0", "--evals", "100",
+                      "--pop-size", "20")
+    err = capsys.readouterr().err
+    assert code == 0
+    assert "\r" in err and "/100 evals" in err and err.endswith("\n")
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--problem", "zdt9", "--algorithm", "nsga2"], "unknown problem 'zdt9'"),
+    (["--problem", "zdt1", "--algorithm", "nsga9"], "unknown algorithm 'nsga9'"),
+    (["--problem", "zdt1", "--algorithm", "nsga2", "--evals", "50"], "--evals must be at least"),
+    (["--problem", "zdt1", "--algorithm", "nsga2", "--pop-size", "2"], "--pop-size must be >= 4"),
+    (["--problem", "zdt1", "--algorithm", "nsga2", "--seed", "-1"], "--seed must be >= 0"),
+    (["--problem", "zdt1", "--n-obj", "3", "--algorithm", "nsga2"], "has 2 objectives"),
+    (["--problem", "dtlz2", "--n-obj", "1", "--algorithm", "nsga2"], "n_obj must be between 2"),
+    (["--problem", "zdt1", "--algorithm", "nsga2", "--max-leaders", "3"], "--max-leaders needs --molsp"),
+    (["--problem", "zdt1", "--algorithm", "nsga2", "--evals", "many"], "invalid int value"),
+    (["--problem", "zdt1"], "required"),
+])
+def test_bad_arguments_exit_2_with_one_line(tmp_path, capsys, args, message):
+    defaults = {"--seed": "0", "--evals": "200"}
+    argv = list(args)
+    for flag, value in defaults.items():
+        if flag not in argv and "--algorithm" in argv:
+            argv += [flag, value]
+    code = main(["run", *argv, "--out", str(tmp_path / "x.json")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and message in err
+    assert not (tmp_path / "x.json").exists()
+
+
+def test_missing_output_directory_is_a_usage_error(tmp_path, capsys):
+    code = main(["run", "--problem", "zdt1", "--algorithm", "nsga2", "--seed", "0", "--evals", "200",
+                 "--out", str(tmp_path / "nowhere" / "x.json")])
+    assert code == 2 and "does not exist" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name, module, n_obj, evals", [("generic", "moo.problems.generic", 3, 60),
+                                                        ("applied", "moo.problems.applied", 4, 40)])
+def test_control_design_problems(tmp_path, name, module, n_obj, evals):
+    pytest.importorskip(module)
+    code, rec = run_cli(tmp_path, "--problem", name, "--algorithm", "nsga2", "--molsp", "--seed", "0",
+                        "--evals", str(evals), "--pop-size", "20")
+    assert code == 0
+    F = np.array(rec["F"])
+    assert F.shape[1] == n_obj and rec["n_obj"] == n_obj
+    assert evals <= rec["n_evals"] < evals + 20
+    assert len(rec["hv_ref_point"]) == n_obj and len(rec["molsp_ref_point"]) == n_obj
