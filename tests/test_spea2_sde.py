@@ -1,0 +1,329 @@
+"""Tests of SPEA2+SDE (moo.algorithms.spea2_sde).
+
+Expected values are worked out by hand in the comments, or come from a
+per-pair reference written straight from the definitions (Li, Yang & Liu
+2014, Sec. III; Zitzler, Laumanns & Thiele 2001, Sec. 3), independent of the
+vectorised code under test.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from pymoo.core.population import Population
+from pymoo.core.problem import Problem
+from pymoo.indicators.igd import IGD
+from pymoo.optimize import minimize
+from pymoo.problems import get_problem
+from pymoo.util.ref_dirs import get_reference_directions
+from scipy.spatial.distance import cdist
+
+from moo.algorithms import make_algorithm
+from moo.algorithms.spea2_sde import (
+    SPEA2SDE,
+    SPEA2SDESurvival,
+    _sde_tournament,
+    make_spea2_sde,
+    sde_fitness,
+    sde_truncation,
+    shifted_distances,
+)
+
+# Three mutually non-dominated points (2 objectives) used throughout:
+#   p0 = (1, 4), p1 = (2, 2), p2 = (4.5, 1)
+# Shifted distance seen from i: move j to max(f(j), f(i)), then Euclidean.
+#   sd(0,1): max((2,2),(1,4)) = (2,4) - (1,4) = (1,0)   -> 1
+#   sd(0,2): max((4.5,1),(1,4)) = (4.5,4) - (1,4)       -> 3.5
+#   sd(1,0): max((1,4),(2,2)) = (2,4) - (2,2) = (0,2)   -> 2
+#   sd(1,2): (4.5,2) - (2,2) = (2.5,0)                  -> 2.5
+#   sd(2,0): (4.5,4) - (4.5,1) = (0,3)                  -> 3
+#   sd(2,1): (4.5,2) - (4.5,1) = (0,1)                  -> 1
+THREE = np.array([[1.0, 4.0], [2.0, 2.0], [4.5, 1.0]])
+THREE_SD = np.array([[np.inf, 1.0, 3.5], [2.0, np.inf, 2.5], [3.0, 1.0, np.inf]])
+
+
+class _Dummy(Problem):
+    def __init__(self, n_obj=2):
+        super().__init__(n_var=1, n_obj=n_obj, xl=0.0, xu=1.0)
+
+
+def _pop(F, cv=None):
+    F = np.asarray(F, dtype=float)
+    pop = Population.new("X", np.zeros((len(F), 1)), "F", F)
+    pop.set("CV", np.zeros((len(F), 1)) if cv is None else np.asarray(cv, dtype=float)[:, None])
+    return pop
+
+
+def _reference_sd(F):
+    """Shifted distance by the case definition of Eq. 5: f_k(q') = f_k(p) if f_k(q) < f_k(p) else f_k(q)."""
+    n = len(F)
+    D = np.full((n, n), np.inf)
+    for p, q in itertools.permutations(range(n), 2):
+        shifted = np.array([F[p, k] if F[q, k] < F[p, k] else F[q, k] for k in range(F.shape[1])])
+        D[p, q] = cdist(F[p][None], shifted[None])[0, 0]
+    return D
+
+
+def _reference_fitness(F, G):
+    """SPEA2 fitness by per-individual loops: dominance on F, shifted distances on G."""
+    n = len(F)
+    dom = lambda a, b: np.all(F[a] <= F[b]) and np.any(F[a] < F[b])  # noqa: E731
+    S = [sum(dom(i, j) for j in range(n)) for i in range(n)]
+    R = [sum(S[j] for j in range(n) if dom(j, i)) for i in range(n)]
+    D = _reference_sd(G)
+    k = int(np.floor(np.sqrt(n)))
+    dens = [1.0 / (sorted(D[i, j] for j in range(n) if j != i)[k - 1] + 2.0) for i in range(n)]
+    return np.array(R, float) + np.array(dens), np.array(R, float), np.array(dens)
+
+
+def _naive_truncation(D, n_keep):
+    """Zitzler's truncation by brute force: re-sort every row after each removal."""
+    alive = list(range(len(D)))
+    while len(alive) > n_keep:
+        rows = [tuple(sorted(D[i, j] for j in alive if j != i)) for i in alive]
+        alive.pop(min(range(len(alive)), key=lambda a: (rows[a], a)))
+    return np.array(alive)
+
+
+# ----------------------------------------------------------------------------- shifted distances
+
+def test_shifted_distances_hand_example():
+    np.testing.assert_array_equal(shifted_distances(THREE), THREE_SD)
+
+
+def test_shifted_distance_is_zero_to_a_dominating_point_and_euclidean_when_worse_everywhere():
+    # q = (1,1) dominates p = (2,3): q shifted to p itself, sd(p,q) = 0.
+    # seen from q, p is worse in every objective: no shift, sd(q,p) = |(1,2)| = sqrt(5).
+    D = shifted_distances([[2.0, 3.0], [1.0, 1.0]])
+    assert D[0, 1] == 0.0
+    assert D[1, 0] == pytest.approx(np.sqrt(5.0), rel=1e-15)
+
+
+def test_shifted_distances_match_the_definition_on_random_sets():
+    rng = np.random.default_rng(3)
+    for n, m in [(2, 2), (7, 3), (15, 5)]:
+        F = rng.random((n, m))
+        np.testing.assert_allclose(shifted_distances(F), _reference_sd(F), rtol=1e-14, atol=0)
+
+
+def test_shifted_distances_reject_bad_input():
+    with pytest.raises(ValueError, match=r"F must be a non-empty 2-D array.*shape \(3,\)"):
+        shifted_distances([1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match="F must have finite entries"):
+        shifted_distances([[1.0, np.nan], [0.0, 1.0]])
+    with pytest.raises(TypeError, match="F must be"):
+        shifted_distances("abc")
+
+
+# ----------------------------------------------------------------------------- fitness
+
+def test_fitness_hand_example_raw_objectives():
+    # F = p0 (1,4), p1 (2,2), p2 (4.5,1), p3 (3,3), p4 (5,5).
+    # Dominance: p1 > p3, p4; p3 > p4; p0 > p4; p2 > p4.
+    # Strength S = [1, 2, 1, 1, 0]; raw R = [0, 0, 0, S(p1) = 2, 1+2+1+1 = 5].
+    # n = 5 -> k = floor(sqrt 5) = 2: second smallest shifted distance seen from each:
+    #   p0: to p1 1, p3 (3,4)-(1,4) = 2, p2 3.5, p4 |(4,1)| -> sigma = 2
+    #   p1: to p0 2, p2 2.5, p3 |(1,1)| = 1.414, p4 |(3,3)| -> sigma = 2
+    #   p2: to p1 1, p3 (4.5,3)-(4.5,1) = 2, p0 3, p4 |(0.5,4)| -> sigma = 2
+    #   p3: to p1 0 (p1 dominates p3), p0 (3,4)-(3,3) = 1, p2 (4.5,3)-(3,3) = 1.5, p4 -> sigma = 1
+    #   p4: dominated by all -> every sd is 0 -> sigma = 0
+    # D = 1/(sigma + 2) = [1/4, 1/4, 1/4, 1/3, 1/2]
+    F = np.vstack([THREE, [[3.0, 3.0], [5.0, 5.0]]])
+    fit, raw, dens = sde_fitness(F, normalize=False)
+    np.testing.assert_array_equal(raw, [0, 0, 0, 2, 5])
+    np.testing.assert_allclose(dens, [0.25, 0.25, 0.25, 1 / 3, 0.5], rtol=1e-15)
+    np.testing.assert_allclose(fit, [0.25, 0.25, 0.25, 2 + 1 / 3, 5.5], rtol=1e-15)
+    # normalised: min (1,1), max (5,5) -> every distance / 4 -> sigma = [.5,.5,.5,.25,0]
+    fit_n, raw_n, dens_n = sde_fitness(F)
+    np.testing.assert_array_equal(raw_n, raw)
+    np.testing.assert_allclose(dens_n, [1 / 2.5, 1 / 2.5, 1 / 2.5, 1 / 2.25, 0.5], rtol=1e-15)
+
+
+def test_fitness_matches_per_individual_reference():
+    rng = np.random.default_rng(11)
+    for n, m in [(9, 2), (16, 3), (30, 4)]:
+        F = rng.random((n, m)) * np.array([1.0, 100.0, 0.01, 5.0])[:m]
+        F[n // 2] = F[0] + 0.1                 # make sure some dominance exists
+        lo, hi = F.min(0), F.max(0)
+        for normalize, G in [(False, F), (True, (F - lo) / (hi - lo))]:
+            got = sde_fitness(F, normalize=normalize)
+            want = _reference_fitness(F, G)
+            for g, w in zip(got, want):
+                np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-15)
+
+
+def test_fitness_below_one_iff_nondominated():
+    rng = np.random.default_rng(5)
+    F = rng.random((40, 3))
+    fit, raw, _ = sde_fitness(F)
+    dominated = np.array([np.any(np.all(F <= f, axis=1) & np.any(F < f, axis=1)) for f in F])
+    np.testing.assert_array_equal(fit < 1.0, ~dominated)
+    np.testing.assert_array_equal(raw == 0, ~dominated)
+
+
+def test_fitness_single_individual():
+    fit, raw, dens = sde_fitness([[1.0, 2.0]])
+    assert fit.tolist() == [0.5] and raw.tolist() == [0.0] and dens.tolist() == [0.5]
+
+
+# ----------------------------------------------------------------------------- truncation
+
+def test_truncation_hand_example_keeps_the_knee_unlike_euclidean():
+    # Sorted shifted rows: p0 (1, 3.5), p1 (2, 2.5), p2 (1, 3): p0 and p2 tie on the
+    # nearest distance, p2's second (3) < p0's (3.5) -> p2 removed.
+    # Then among {p0, p1}: sd(0,1) = 1 < sd(1,0) = 2 -> p0 removed.
+    np.testing.assert_array_equal(sde_truncation(THREE_SD, 2), [0, 1])
+    np.testing.assert_array_equal(sde_truncation(THREE_SD, 1), [1])
+    # Plain Euclidean SPEA2 truncation removes the middle point instead:
+    # d01 = sqrt 5 = 2.236, d12 = sqrt 7.25 = 2.693, d02 = sqrt 21.25 = 4.610:
+    # rows p0 (2.236, 4.610), p1 (2.236, 2.693), p2 (2.693, 4.610) -> p1 removed.
+    np.testing.assert_array_equal(sde_truncation(cdist(THREE, THREE), 2), [0, 2])
+
+
+def test_truncation_exact_tie_removes_lowest_index():
+    # (1,4), (2,2), (4,1): rows (1,3), (2,2), (1,3) -> exact tie of p0 and p2 -> p0 goes.
+    D = shifted_distances([[1.0, 4.0], [2.0, 2.0], [4.0, 1.0]])
+    np.testing.assert_array_equal(sde_truncation(D, 2), [1, 2])
+
+
+def test_truncation_matches_brute_force():
+    rng = np.random.default_rng(7)
+    for trial in range(60):
+        n, m = int(rng.integers(2, 25)), int(rng.integers(2, 5))
+        F = rng.random((n, m))
+        if trial % 3 == 0:
+            F = np.round(F, 1)                  # ties and duplicates
+        D = shifted_distances(F)
+        n_keep = int(rng.integers(1, n + 1))
+        np.testing.assert_array_equal(sde_truncation(D, n_keep), _naive_truncation(D, n_keep))
+
+
+def test_truncation_rejects_bad_input():
+    with pytest.raises(ValueError, match=r"dist must be a square.*shape \(2, 3\)"):
+        sde_truncation(np.zeros((2, 3)), 1)
+    with pytest.raises(ValueError, match=r"n_keep must be in \[1, 3\].*got 4"):
+        sde_truncation(THREE_SD, 4)
+    with pytest.raises(ValueError, match="n_keep"):
+        sde_truncation(THREE_SD, 0)
+    with pytest.raises(TypeError, match="n_keep must be an integer"):
+        sde_truncation(THREE_SD, 1.5)
+    with pytest.raises(ValueError, match="NaN"):
+        sde_truncation(np.array([[0.0, np.nan], [1.0, 0.0]]), 1)
+
+
+# ----------------------------------------------------------------------------- survival and mating
+
+def test_survival_fills_by_fitness_then_truncates():
+    # Same five points as the fitness example (fitness [.4,.4,.4,2.44,5.5] normalised).
+    F = np.vstack([THREE, [[3.0, 3.0], [5.0, 5.0]]])
+    surv = SPEA2SDESurvival()
+    problem = _Dummy()
+    # 4 survivors: the 3 non-dominated + the best dominated one (p3, fitness 2.44 < 5.5)
+    out = surv.do(problem, _pop(F), n_survive=4, random_state=np.random.default_rng(0))
+    np.testing.assert_array_equal(out.get("F"), F[[0, 1, 2, 3]])
+    np.testing.assert_allclose(out.get("sde_fitness"), [0.4, 0.4, 0.4, 2 + 1 / 2.25])
+    # 2 survivors: truncation of {p0, p1, p2}; normalisation by the 5-point set divides every
+    # distance by 4, so the order is the hand example's: p2 goes -> {p0, p1}
+    out = surv.do(problem, _pop(F), n_survive=2, random_state=np.random.default_rng(0))
+    np.testing.assert_array_equal(out.get("F"), F[[0, 1]])
+    out = surv.do(problem, _pop(F), n_survive=1, random_state=np.random.default_rng(0))
+    np.testing.assert_array_equal(out.get("F"), F[[1]])
+
+
+def test_survival_puts_feasible_first():
+    F = np.array([[0.0, 0.0], [1.0, 2.0], [2.0, 1.0], [3.0, 3.0]])
+    problem = Problem(n_var=1, n_obj=2, n_ieq_constr=1, xl=0.0, xu=1.0)
+    pop = _pop(F, cv=[1.0, 0.0, 0.0, 0.0])
+    out = SPEA2SDESurvival().do(problem, pop, n_survive=3, random_state=np.random.default_rng(0))
+    # (0,0) dominates everything but is infeasible: the three feasible ones survive
+    np.testing.assert_array_equal(out.get("F"), F[[1, 2, 3]])
+
+
+def test_survival_tolerates_repeated_calls_on_merged_populations():
+    rng = np.random.default_rng(2)
+    surv = SPEA2SDESurvival()
+    problem = _Dummy(3)
+    pop = surv.do(problem, _pop(rng.random((92 + 92, 3))), n_survive=92, random_state=rng)
+    assert len(pop) == 92
+    merged = Population.merge(pop, _pop(rng.random((57, 3))))
+    again = surv.do(problem, merged, n_survive=92, random_state=rng)
+    assert len(again) == 92
+    fit, _, _ = sde_fitness(merged.get("F"))
+    # the stored fitness is the one of the merged set, recomputed on the second call
+    ids = {id(ind): i for i, ind in enumerate(merged)}
+    np.testing.assert_array_equal(again.get("sde_fitness"), fit[[ids[id(ind)] for ind in again]])
+
+
+def test_tournament_prefers_lower_fitness_cv_first_and_breaks_ties_at_random():
+    pop = _pop(np.zeros((4, 2)), cv=[0.0, 0.0, 0.0, 2.0])
+    pop.set("sde_fitness", np.array([0.3, 0.7, 0.3, 0.1]))
+    P = np.array([[0, 1], [1, 0], [1, 3], [3, 1]])
+    S = _sde_tournament(pop, P, random_state=np.random.default_rng(0))
+    # lower fitness wins; 3 has the best fitness but violates a constraint
+    np.testing.assert_array_equal(S[:, 0], [0, 0, 1, 1])
+    ties = np.tile([[0, 2]], (200, 1))
+    won = _sde_tournament(pop, ties, random_state=np.random.default_rng(1))[:, 0]
+    assert set(won) == {0, 2} and 60 < np.sum(won == 0) < 140
+
+
+# ----------------------------------------------------------------------------- whole runs
+
+def _dtlz2_igd(alg, n_eval, seed, n_obj=3):
+    problem = get_problem("dtlz2", n_obj=n_obj)
+    res = minimize(problem, alg, ("n_eval", n_eval), seed=seed)
+    pf = problem.pareto_front(get_reference_directions("das-dennis", n_obj, n_partitions=30))
+    return IGD(pf)(res.F), res
+
+
+def test_registry_and_factory():
+    alg = make_algorithm("spea2-sde", n_obj=3)
+    assert isinstance(alg, SPEA2SDE) and alg.pop_size == 92
+    assert make_spea2_sde(n_obj=4, pop_size=40, normalize=False).survival.normalize is False
+    with pytest.raises(ValueError, match="n_obj"):
+        make_spea2_sde(n_obj=1)
+    with pytest.raises(ValueError, match="pop_size"):
+        make_spea2_sde(n_obj=3, pop_size=0)
+    with pytest.raises(TypeError, match="normalize"):
+        make_spea2_sde(n_obj=3, normalize="yes")
+
+
+def test_same_seed_same_result_different_seed_differs():
+    problem = get_problem("dtlz2", n_obj=3)
+    runs = [minimize(problem, make_spea2_sde(n_obj=3), ("n_eval", 600), seed=s).pop.get("F") for s in (4, 4, 5)]
+    np.testing.assert_array_equal(runs[0], runs[1])
+    assert runs[0].shape == runs[2].shape and not np.array_equal(runs[0], runs[2])
+
+
+def test_dtlz2_igd_comparable_to_nsga3():
+    # 2000 evaluations, 3 objectives: measured IGD ~0.08 for both (NSGA-III 0.086 +- 0.006)
+    ours, res = _dtlz2_igd(make_spea2_sde(n_obj=3), 2000, seed=1)
+    ref, _ = _dtlz2_igd(make_algorithm("nsga3", n_obj=3), 2000, seed=1)
+    assert ours < 1.5 * ref, (ours, ref)
+    assert len(res.pop) == 92
+    # near the unit sphere already
+    assert np.median(np.abs(np.linalg.norm(res.F, axis=1) - 1.0)) < 0.05
+
+
+def test_dtlz1_converges_to_the_linear_front():
+    # DTLZ1 (3 objectives, n_var 7): the front is sum f = 0.5. 20000 evaluations (~2.5 s).
+    problem = get_problem("dtlz1", n_obj=3)
+    res = minimize(problem, make_spea2_sde(n_obj=3), ("n_eval", 20000), seed=0)
+    s = res.F.sum(axis=1)
+    assert abs(np.median(s) - 0.5) < 0.01, np.median(s)
+    assert np.mean(np.abs(s - 0.5) < 0.05) > 0.9
+    # spread over the front, not collapsed
+    assert np.all(res.F.max(axis=0) - res.F.min(axis=0) > 0.4)
+
+
+def test_runs_wrapped_with_molsp():
+    molsp = pytest.importorskip("moo.molsp").molsp
+    problem = get_problem("dtlz2", n_obj=3)
+    res = minimize(problem, molsp(make_spea2_sde(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
+    assert len(res.pop) == 92 and 1500 <= res.algorithm.evaluator.n_eval < 1500 + 92
+    assert res.algorithm.data["molsp_n_eval"] > 0
+    # the fitness stored on the population is set by the last (MO-LSP) survival call
+    assert np.all(np.isfinite(res.pop.get("sde_fitness").astype(float)))
+    again = minimize(problem, molsp(make_spea2_sde(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
+    np.testing.assert_array_equal(res.pop.get("F"), again.pop.get("F"))
