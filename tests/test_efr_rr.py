@@ -219,3 +219,23 @@ def test_dtlz1_converges_to_linear_front():
     res = minimize(problem, make_efr_rr(n_obj=3), ("n_eval", 20000), seed=1)
     sums = res.F.sum(axis=1)
     assert np.median(sums) < 0.55 and np.quantile(sums, 0.75) < 0.75, np.quantile(sums, [0.5, 0.75])
+
+
+def test_reused_algorithm_starts_fresh():
+    # The normalisation state is reset at setup, so a reused object repeats its run.
+    problem = get_problem("dtlz2", n_obj=3, n_var=12)
+    alg = make_efr_rr(n_obj=3)
+    a = minimize(problem, alg, ("n_eval", 400), seed=0, copy_algorithm=False).pop.get("F")
+    b = minimize(problem, alg, ("n_eval", 400), seed=0, copy_algorithm=False).pop.get("F")
+    np.testing.assert_array_equal(a, b)
+
+
+def test_runs_wrapped_with_molsp():
+    from moo.molsp import molsp
+
+    problem = get_problem("dtlz2", n_obj=3, n_var=12)
+    res = minimize(problem, molsp(make_efr_rr(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
+    assert len(res.pop) == 92 and 1500 <= res.algorithm.evaluator.n_eval < 1500 + 92
+    assert res.algorithm.data["molsp_n_eval"] > 0
+    again = minimize(problem, molsp(make_efr_rr(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
+    np.testing.assert_array_equal(res.pop.get("F"), again.pop.get("F"))

@@ -12,10 +12,11 @@ into ``S`` and ``N`` survivors are chosen from ``S`` as follows.
 
 1. Normalisation. With the ideal point ``z*`` (best value seen so far in each
    objective) and the nadir estimate ``z^nad`` from the intercepts of the
-   hyperplane through the ``M`` extreme points (NSGA-III's procedure, as in the
-   paper; pymoo's :class:`~pymoo.algorithms.moo.nsga3.HyperplaneNormalization`,
-   extreme points kept across generations, with its fall-backs when the
-   hyperplane is degenerate)::
+   hyperplane through the ``M`` extreme points (NSGA-III's procedure as the
+   same authors use it in theta-DEA; the project's
+   :class:`moo.algorithms._normalize.HyperplaneNormalization`, extreme points
+   kept across generations, with its fall-backs when the hyperplane is
+   degenerate)::
 
        f~_i(x) = (f_i(x) - z*_i) / (z^nad_i - z*_i).
 
@@ -73,7 +74,6 @@ from typing import Literal
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
-from pymoo.algorithms.moo.nsga3 import HyperplaneNormalization
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
@@ -82,6 +82,7 @@ from pymoo.util.display.multi import MultiObjectiveOutput
 
 from robustctl._validation import as_matrix, check_positive_scalar
 
+from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
 
 __all__ = ["EFRRR", "EFRRRSurvival", "maximum_ranking", "make_efr_rr"]
@@ -206,10 +207,11 @@ class EFRRRSurvival(Survival):
 
     def normalize(self, F: np.ndarray) -> np.ndarray:
         """``(F - z*) / (z^nad - z*)`` with the current estimates (update first)."""
-        ideal, nadir = self.norm.ideal_point, self.norm.nadir_point
-        denom = nadir - ideal
-        denom = np.where(denom > 1e-12, denom, 1e-12)
-        return (F - ideal) / denom
+        return self.norm.normalize(F)
+
+    def reset(self) -> None:
+        """Forget the normalisation state (a new run starts)."""
+        self.norm.reset()
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
         F = pop.get("F").astype(float)
@@ -303,6 +305,7 @@ class EFRRR(GeneticAlgorithm):
         if self.ref_dirs.shape[1] != problem.n_obj:
             raise ValueError(f"ref_dirs must have {problem.n_obj} columns (the problem's objectives), "
                              f"got shape {self.ref_dirs.shape}")
+        self.survival.reset()
 
 
 def make_efr_rr(*, n_obj: int, pop_size: int = POP_SIZE, n_neighbors: int = 2,

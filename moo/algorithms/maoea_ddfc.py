@@ -8,8 +8,9 @@ What it implements
 ------------------
 Objectives are normalised with the ideal point ``z*`` (best value seen so far)
 and the nadir estimate ``z^nad`` from the intercepts of the hyperplane through
-the extreme points (NSGA-III's procedure; pymoo's
-:class:`~pymoo.algorithms.moo.nsga3.HyperplaneNormalization`)::
+the extreme points found among the non-dominated solutions (NSGA-III's
+procedure; the project's
+:class:`moo.algorithms._normalize.HyperplaneNormalization`)::
 
     f~_i(x) = (f_i(x) - z*_i) / (z^nad_i - z*_i).
 
@@ -75,7 +76,6 @@ from typing import Literal
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
-from pymoo.algorithms.moo.nsga3 import HyperplaneNormalization
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
@@ -85,6 +85,7 @@ from scipy.spatial.distance import cdist
 
 from robustctl._validation import as_matrix
 
+from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, paper_crossover, paper_mutation
 
 __all__ = [
@@ -253,19 +254,18 @@ class DDFCSurvival(Survival):
 
     def normalize(self, F: np.ndarray) -> np.ndarray:
         """``(F - z*) / (z^nad - z*)`` with the current estimates."""
-        ideal, nadir = self.norm.ideal_point, self.norm.nadir_point
-        if nadir is None:                      # before the first update: the set itself
-            ideal, nadir = F.min(axis=0), F.max(axis=0)
-        denom = nadir - ideal
-        denom = np.where(denom > 1e-12, denom, 1e-12)
-        return (F - ideal) / denom
+        return self.norm.normalize(F)
+
+    def reset(self) -> None:
+        """Forget the normalisation state (a new run starts)."""
+        self.norm.reset()
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
         F = pop.get("F").astype(float)
         if n_survive is None:
             n_survive = len(pop)
         fronts, rank = NonDominatedSorting().do(F, return_rank=True, n_stop_if_ranked=n_survive)
-        self.norm.update(F, nds=fronts[0])
+        self.norm.update(F, nondominated=fronts[0])
         Fn = self.normalize(F)
         fc = favorable_convergence(Fn)
         pop.set("rank", rank, "FC", fc)
@@ -353,6 +353,7 @@ class MaOEADDFC(GeneticAlgorithm):
     def _setup(self, problem, **kwargs):
         if problem.n_obj != self.n_obj:
             raise ValueError(f"n_obj is {self.n_obj} but the problem has {problem.n_obj} objectives")
+        self.survival.reset()
 
 
 def make_maoea_ddfc(*, n_obj: int, pop_size: int = POP_SIZE, n_neighbors: int = 5,
