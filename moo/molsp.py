@@ -166,7 +166,9 @@ def build_mutants(d: ArrayLike, Z: ArrayLike, kappa: ArrayLike, phi: ArrayLike) 
 
     Row 0 is :math:`m_1 = d + d\,\kappa_0\,(-1)^{\phi_0}`; row ``h`` (``h >= 1``) is
     :math:`z_h + \Lambda_h\,\kappa_h\,(-1)^{\phi_h}` with :math:`\Lambda_h` from
-    :func:`mutation_steps`. All products are entry-wise.
+    :func:`mutation_steps`. All products are entry-wise. As Eq. (bestM1) scales
+    the leader's step with ``d`` itself, zero entries of ``d`` stay zero in
+    :math:`m_1` (the paper's rule, kept as printed).
 
     Parameters
     ----------

@@ -140,3 +140,60 @@ def test_control_design_problems(tmp_path, name, module, n_obj, evals):
     assert F.shape[1] == n_obj and rec["n_obj"] == n_obj
     assert evals <= rec["n_evals"] < evals + 20
     assert len(rec["hv_ref_point"]) == n_obj and len(rec["molsp_ref_point"]) == n_obj
+
+
+# ----------------------------------------------------------------------------- the problems behind --problem
+
+
+def _nondominated(F):
+    import moocore
+    return F[moocore.is_nondominated(F)]
+
+
+@pytest.mark.parametrize("name, n_obj", [("zdt1", None), ("zdt2", None), ("zdt3", None), ("zdt4", None),
+                                         ("zdt6", None), ("dtlz1", 2), ("dtlz1", 3), ("dtlz2", 3),
+                                         ("dtlz3", 2), ("dtlz4", 3), ("dtlz5", 4), ("dtlz6", 5)])
+def test_front_bounds_match_pymoo_fronts(name, n_obj):
+    from moo.problems import make_problem, true_front_bounds
+    ideal, nadir = true_front_bounds(name, n_obj)
+    kwargs = {} if n_obj is None else {"n_obj": n_obj}
+    pf = get_problem(name, **kwargs).pareto_front()
+    tol = 2e-3 if name == "zdt3" else 1e-6          # pymoo samples ZDT3's front on a grid
+    assert np.allclose(ideal, pf.min(axis=0), atol=tol) and np.allclose(nadir, pf.max(axis=0), atol=tol)
+    problem = make_problem(name, n_obj)
+    assert np.allclose(problem.hv_ref_point, nadir + 0.1 * (nadir - ideal))
+    assert np.array_equal(problem.molsp_ref_point, problem.hv_ref_point)
+
+
+@pytest.mark.parametrize("n_obj", [2, 3])
+def test_dtlz7_front_bounds_by_sampling(n_obj):
+    """DTLZ7's front (g = 1): f_M = 2 (M - sum_i f_i/2 (1 + sin 3 pi f_i)); filter a grid to its non-dominated part."""
+    from moo.problems import true_front_bounds
+    axis = np.linspace(0, 1, 20001 if n_obj == 2 else 301)
+    grid = np.stack(np.meshgrid(*[axis] * (n_obj - 1), indexing="ij"), -1).reshape(-1, n_obj - 1)
+    fM = 2 * (n_obj - np.sum(grid / 2 * (1 + np.sin(3 * np.pi * grid)), axis=1))
+    front = _nondominated(np.column_stack([grid, fM]))
+    ideal, nadir = true_front_bounds("dtlz7", n_obj)
+    tol = 1e-3 if n_obj == 2 else 1e-2
+    assert np.allclose(ideal, front.min(axis=0), atol=tol)
+    assert np.allclose(nadir, front.max(axis=0), atol=tol)
+
+
+def test_zdt5_real_coding_reads_bits():
+    from moo.problems import make_problem
+    rng = np.random.default_rng(0)
+    X = rng.random((6, 80))
+    bits = (X >= 0.5).astype(float)
+    assert np.array_equal(make_problem("zdt5").evaluate(X), get_problem("zdt5").evaluate(bits))
+
+
+def test_make_problem_names_and_objectives():
+    from moo.problems import PROBLEMS, make_problem
+    assert make_problem("DTLZ2").n_obj == 3
+    assert make_problem("dtlz1", 5).n_var == 5 + 5 - 1
+    assert make_problem("dtlz7", 3).n_var == 3 + 20 - 1
+    assert len(PROBLEMS) == 15
+    with pytest.raises(ValueError, match="unknown problem 'foo'"):
+        make_problem("foo")
+    with pytest.raises(TypeError, match="n_obj must be an integer"):
+        make_problem("dtlz2", 2.5)
