@@ -95,6 +95,7 @@ __all__ = [
     "favorable_convergence",
     "directional_projection",
     "select_by_dd_fc",
+    "tournament_winners",
     "make_maoea_ddfc",
 ]
 
@@ -281,6 +282,23 @@ class DDFCSurvival(Survival):
         return pop[np.concatenate([before, last[chosen]])]
 
 
+def tournament_winners(F: np.ndarray, fc: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Winners of the binary tournaments ``a[t]`` vs ``b[t]`` (MaOEA-DDFC mating rule).
+
+    ``a[t]`` wins if it Pareto-dominates ``b[t]``, or if neither dominates and
+    ``fc[a[t]] <= fc[b[t]]``; otherwise ``b[t]`` wins.
+    """
+    F = np.asarray(F, dtype=float)
+    fc = np.asarray(fc, dtype=float)
+    a = np.asarray(a, dtype=np.int64)
+    b = np.asarray(b, dtype=np.int64)
+    a_better = np.any(F[a] < F[b], axis=1)
+    b_better = np.any(F[a] > F[b], axis=1)
+    a_dom = a_better & ~b_better
+    b_dom = b_better & ~a_better
+    return np.where(a_dom | (~b_dom & (fc[a] <= fc[b])), a, b)
+
+
 class DDFCMatingSelection(Selection):
     """Binary tournament: Pareto dominance first, then the smaller FC (ties: first drawn).
 
@@ -301,13 +319,7 @@ class DDFCMatingSelection(Selection):
         n = n_select * n_parents
         a = random_state.integers(0, len(pop), size=n)
         b = random_state.integers(0, len(pop), size=n)
-        Fa, Fb = F[a], F[b]
-        a_better = np.any(Fa < Fb, axis=1)
-        b_better = np.any(Fa > Fb, axis=1)
-        a_dom = a_better & ~b_better
-        b_dom = b_better & ~a_better
-        a_wins = a_dom | (~b_dom & (fc[a] <= fc[b]))
-        return np.where(a_wins, a, b).reshape(n_select, n_parents)
+        return tournament_winners(F, fc, a, b).reshape(n_select, n_parents)
 
 
 class MaOEADDFC(GeneticAlgorithm):
