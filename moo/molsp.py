@@ -7,7 +7,8 @@ NSGA3, SPEA2, AGEMOEA, SMSEMOA, ...). Each generation, after the host's own
 step (mating, evaluation, survival), MO-LSP
 
 1. takes the ``K`` individuals of the first two non-dominated fronts of the
-   population (among feasible individuals when the problem has constraints);
+   population (among the individuals with finite objectives, and feasible
+   ones when the problem has constraints);
 2. picks the leader :math:`\hat d`: the one whose box :math:`[y_j, r]` against
    the fixed reference point ``r`` has the largest volume
    :math:`\Gamma_j = \prod_k (r_k - y_{jk})` (:func:`leader_scores`);
@@ -284,10 +285,10 @@ class MOLSP:
         pop, problem = self.pop, self.problem
         stats = {"n_candidates": 0, "n_mutants": 0, "n_survived": 0}
         self.data["molsp"] = stats
+        keep = np.all(np.isfinite(np.asarray(pop.get("F"), dtype=float)), axis=1)
         if problem.has_constraints():
-            pool = pop[np.flatnonzero(pop.get("FEAS").ravel())]
-        else:
-            pool = pop
+            keep &= np.asarray(pop.get("FEAS"), dtype=bool).ravel()
+        pool = pop[np.flatnonzero(keep)]
         if len(pool) == 0:
             return
         budget = _eval_budget(self.termination)

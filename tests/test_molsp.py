@@ -309,3 +309,20 @@ def test_molsp_improves_hypervolume_on_zdt1():
     gain = local - plain
     assert gain.mean() > 0
     assert stats.ttest_rel(local, plain, alternative="greater").pvalue < 0.01
+
+
+@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")  # pymoo crowding on inf
+def test_individuals_with_infinite_objectives_are_not_candidates():
+    """A problem that returns inf for some designs (e.g. an unstable loop) still runs with MO-LSP."""
+    from pymoo.problems.multi.zdt import ZDT1
+
+    class HalfInfinite(ZDT1):
+        def _evaluate(self, x, out, *args, **kwargs):
+            super()._evaluate(x, out, *args, **kwargs)
+            out["F"][x[:, 1] > 0.5] = np.inf
+
+    ledger = Ledger()
+    res = minimize(HalfInfinite(), molsp(NSGA2(pop_size=12), ref_point=[1.1, 1.1]), ("n_eval", 300),
+                   seed=0, callback=ledger)
+    assert res.algorithm.data["molsp_n_eval"] > 0
+    assert np.all(np.isfinite(res.F))
