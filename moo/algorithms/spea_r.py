@@ -69,6 +69,7 @@ Readings where the paper leaves room (all deliberate):
 from __future__ import annotations
 
 import numpy as np
+from moocore import is_nondominated
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
@@ -95,8 +96,14 @@ __all__ = [
 def dominance_matrix(F: np.ndarray) -> np.ndarray:
     """Boolean ``(n, n)`` matrix, ``[i, j]`` true iff row ``i`` Pareto-dominates row ``j`` (minimisation)."""
     F = np.asarray(F, dtype=float)
-    A, B = F[:, None, :], F[None, :, :]
-    return np.all(A <= B, axis=2) & np.any(A < B, axis=2)
+    n = len(F)
+    weakly = np.ones((n, n), dtype=bool)
+    strictly = np.zeros((n, n), dtype=bool)
+    for col in F.T:                      # a loop over the M objectives, each step one (n, n) comparison
+        a, b = col[:, None], col[None, :]
+        weakly &= a <= b
+        strictly |= a < b
+    return weakly & strictly
 
 
 def largest_neighbour_angle(ref_dirs: np.ndarray) -> float:
@@ -122,9 +129,12 @@ def associate_by_angle(Fn: np.ndarray, ref_dirs: np.ndarray) -> tuple[np.ndarray
     with np.errstate(invalid="ignore", divide="ignore"):
         C = (Fn @ U.T) / norms[:, None]
     C[norms == 0] = 1.0
-    C = np.clip(C, -1.0, 1.0)
     niche = np.argmax(C, axis=1)
-    return niche, np.arccos(C[np.arange(len(Fn)), niche])
+    # the angle itself from atan2(perpendicular, parallel): accurate also near 0, where arccos is not
+    u = U[niche]
+    along = np.sum(Fn * u, axis=1)
+    perp = np.linalg.norm(Fn - along[:, None] * u, axis=1)
+    return niche, np.arctan2(perp, along)
 
 
 def spea_r_fitness(F: np.ndarray, niche: np.ndarray, angle: np.ndarray, theta_bar: float,
@@ -209,7 +219,7 @@ class NeighbourMatingSelection(Selection):
         if n == 1:
             return np.stack([first, first], axis=1)
         F = pop.get("F").astype(float)
-        z_min, rng = front_bounds(F, ~dominance_matrix(F).any(axis=0))
+        z_min, rng = front_bounds(F, is_nondominated(F))
         Fn = (F - z_min) / rng
         k = min(self.k, n - 1)
         keys = random_state.random((n_select, n))
