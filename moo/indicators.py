@@ -210,14 +210,15 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
         times, among the points not yet withdrawn, the one whose dissimilarity to
         its nearest point *in another component* (withdrawn points included) is
         the largest is withdrawn, that dissimilarity is added to PD, and the two
-        components are joined (so no link closes a cycle). This is the computation
-        used in practice for PD (e.g. by PlatEMO, in which the paper's PD values
-        were computed), O(n^3). Ties, common since two mutual nearest neighbours
-        share their distance, go to the lexicographically smallest objective
-        vector, so the value does not depend on the order of the rows (PlatEMO
-        breaks them by row order). It is not always equal to the recursion (points
-        0, 1, 3 on a line: greedy 3, exact 4); prefer ``"greedy"`` to compare with
-        published values.
+        components are joined (so no link closes a cycle), O(n^3). This is the
+        graph-based computation used in practice for PD; PlatEMO, in which the
+        paper's PD values were computed, checks the cycle condition lazily (only
+        for the point it is about to withdraw) and breaks ties by row order, so
+        its values can differ from ours in rare cases. Ties, common since two
+        mutual nearest neighbours share their distance, go here to the
+        lexicographically smallest objective vector, so the value does not
+        depend on the order of the rows. The greedy value is not always equal
+        to the recursion (points 0, 1, 3 on a line: greedy 3, exact 4).
 
     Returns
     -------
@@ -266,7 +267,9 @@ def spread(F: ArrayLike, ref_set: ArrayLike) -> float:
     The paper's Eq. (dm) averages :math:`d(\chi, P)` over :math:`P^*`; that
     contradicts its own numerator (deviations of the points of ``P`` from the
     mean) and the definition it cites, so the mean is taken over ``P`` as in
-    Zhou et al. (2006). Zero for evenly spaced points that reach the reference
+    Zhou et al. (2006). (PlatEMO, where the paper's values were computed,
+    puts :math:`(|P| - m)\,\bar d` in the denominator instead.) Zero for
+    evenly spaced points that reach the reference
     extremes; if every point of ``P`` coincides with the extremes and all
     nearest-neighbour distances are zero the ratio is 0/0 and 0.0 is returned.
 

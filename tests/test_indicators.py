@@ -231,3 +231,20 @@ def test_non_finite_objectives_rejected(func):
         func([[0, np.nan], [1, 0]])
     with pytest.raises(TypeError, match="F must be an array"):
         func("abc")
+
+
+# ----------------------------------------------------------------------------- other implementations
+
+
+def test_against_pymoo_indicators():
+    """pymoo's IGD, HV and spacing (the last with the population std, 1/n instead of 1/(n-1))."""
+    from pymoo.indicators.hv import HV
+    from pymoo.indicators.igd import IGD
+    from pymoo.indicators.spacing import SpacingIndicator
+
+    rng = np.random.default_rng(11)
+    A, R = rng.random((30, 3)), rng.random((50, 3))
+    assert igd(A, R) == pytest.approx(IGD(R)(A), rel=1e-12)
+    assert hypervolume(A, [1.2, 1.1, 1.0]) == pytest.approx(HV(ref_point=np.array([1.2, 1.1, 1.0]))(A), rel=1e-12)
+    n = len(A)
+    assert spacing(A) == pytest.approx(SpacingIndicator()(A) * math.sqrt(n / (n - 1)), rel=1e-12)
