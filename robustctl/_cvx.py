@@ -69,6 +69,7 @@ class SolveReport:
     status: str
     value: float
     solver: str
+    tol: float
     solve_time: float
     setup_time: float | None
     iterations: int | None
@@ -76,13 +77,17 @@ class SolveReport:
 
     def as_dict(self, prefix: str = "") -> dict:
         return {f"{prefix}status": self.status, f"{prefix}value": self.value,
-                f"{prefix}solver": self.solver, f"{prefix}solve_time": self.solve_time,
+                f"{prefix}solver": self.solver, f"{prefix}tol": self.tol, f"{prefix}solve_time": self.solve_time,
                 f"{prefix}iterations": self.iterations,
                 f"{prefix}certificate": dict(self.certificate)}
 
 
-def _settings(solver: str) -> dict:
-    return dict(_CLARABEL) if solver == "CLARABEL" else {}
+def _settings(solver: str, tol: float) -> dict:
+    if solver != "CLARABEL":
+        return {}
+    out = dict(_CLARABEL)
+    out.update(tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol)
+    return out
 
 
 def check_solver(solver) -> str:
@@ -99,7 +104,7 @@ def check_solver(solver) -> str:
 
 
 def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, solver: str = "CLARABEL",
-              infeasible_msg: str = "the LMI problem is infeasible") -> SolveReport:
+              tol: float = SOLVER_TOL, infeasible_msg: str = "the LMI problem is infeasible") -> SolveReport:
     """Solve ``objective`` subject to the LMI blocks and the other constraints.
 
     Parameters
@@ -111,6 +116,8 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
         Anything else (equalities, scalar bounds).
     solver : str
         A cvxpy solver name; Clarabel gets tight explicit tolerances.
+    tol : float
+        Clarabel's ``tol_gap_abs``, ``tol_gap_rel`` and ``tol_feas``.
     infeasible_msg : str
         Message of the :class:`InfeasibleError` raised if the problem is
         infeasible or the certificate fails.
@@ -131,19 +138,34 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
         syms.append(S)
         cons.append(S - lmi.margin * np.eye(k) >> 0)
     prob = cp.Problem(objective, cons)
-    try:
-        with warnings.catch_warnings():
-            # cvxpy warns on 'optimal_inaccurate'; the status is checked below instead.
-            warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver=solver, **_settings(solver))
-    except cp.error.SolverError as exc:
-        raise ConvergenceError(f"{solver} failed on the LMI problem: {exc}") from None
+    # Interior-point solvers occasionally stop short ("insufficient progress")
+    # at tight tolerances on nearly degenerate problems: retry twice with
+    # 100x looser tolerances before giving up; the tolerance used is reported.
+    attempt_tol, failure = tol, None
+    for _ in range(3):
+        try:
+            with warnings.catch_warnings():
+                # cvxpy warns on 'optimal_inaccurate'; the status is checked below instead.
+                warnings.simplefilter("ignore", UserWarning)
+                prob.solve(solver=solver, **_settings(solver, attempt_tol))
+        except cp.error.SolverError as exc:
+            failure = f"{solver} failed ({exc})"
+        else:
+            if prob.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE, cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
+                break
+            failure = f"{solver} returned status {prob.status!r}"
+        if solver != "CLARABEL":
+            break
+        attempt_tol *= 100.0
+    else:
+        pass
     status = prob.status
+    if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE, cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
+        raise ConvergenceError(f"{failure or 'the solver failed'} on the LMI problem, also with relaxed "
+                               f"tolerances; the problem is probably infeasible or nearly so: {infeasible_msg}")
     stats = prob.solver_stats
     if status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
         raise InfeasibleError(f"{infeasible_msg} (solver status: {status})")
-    if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-        raise ConvergenceError(f"{solver} returned status {status!r} on the LMI problem; {infeasible_msg}?")
     cert = {}
     bad = []
     for lmi, S in zip(lmis, syms):
@@ -161,6 +183,6 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
     if bad:
         raise InfeasibleError(f"{infeasible_msg}: {solver} reported {status!r} but the certificate "
                               f"fails ({'; '.join(bad)})")
-    return SolveReport(status=status, value=float(prob.value), solver=solver,
+    return SolveReport(status=status, value=float(prob.value), solver=solver, tol=attempt_tol,
                        solve_time=float(stats.solve_time) if stats.solve_time is not None else float("nan"),
                        setup_time=stats.setup_time, iterations=stats.num_iters, certificate=cert)

@@ -92,13 +92,15 @@ from .plant import Plant
 
 __all__ = ["hinf", "HinfController"]
 
-# Strictness margin (relative to the largest data entry, after balancing) of
-# the LMI blocks when minimising gamma; small so that gamma_opt is not biased.
-_MIN_MARGIN = 1e-9
-# Smallest acceptable centring margin t of the gain-extraction problem.
-_STRICT = 1e-9
-# u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that rounding cannot exceed u_max.
-_U_SLACK = 1e-6
+# Smallest acceptable strictness (centring) margin t of the gain-extraction
+# problem, whose data are normalised (||Bw~|| = 1, level 1, unit energy).
+# The gamma minimisation uses the non-strict LMIs: it computes an infimum.
+_STRICT = 1e-8
+# Solver tolerance of the centring problem (its optimum need not be exact).
+_CENTRE_TOL = 1e-8
+# u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that solver rounding cannot
+# exceed u_max (the bound is conservative by 0.005 %).
+_U_SLACK = 1e-4
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -212,29 +214,66 @@ def _balance(F, Bw, G, Cz) -> np.ndarray:
 
 # ---------------------------------------------------------------- LMIs
 class _Problem:
-    """The scaled data and the LMI builders for one synthesis."""
+    """The scaled data and the LMI builders for one synthesis.
+
+    Scaling (the H-infinity level and the input bound are unchanged up to the
+    recorded factors): ``x = diag(d) x~`` (balancing, then one scalar so that
+    ``||Bw~||_2 = 1``), ``w = a w~`` with ``a = sqrt(w_energy)`` when an input
+    bound is given (the bound then reads for unit energy), and ``z~ = b z``
+    with ``b`` chosen per solve (``b = 1 / (a gamma)`` at a fixed level, so
+    that the scaled level is 1). The scaled level is ``a b gamma``.
+    """
 
     def __init__(self, plants, Bw, Cz, Dzu, Dzw, extended, u_max, w_energy):
         import cvxpy as cp
 
         self.cp = cp
         self.discrete = plants[0].is_discrete
-        F0 = plants[0].F
-        d = _balance(F0, Bw, plants[0].G, Cz)
+        d = _balance(plants[0].F, Bw, plants[0].G, Cz)
+        self.a = float(np.sqrt(w_energy)) if u_max is not None else 1.0
+        bw = np.linalg.norm(Bw / d[:, None] * self.a, 2)
+        if bw > 0 and np.isfinite(bw):
+            d = d * bw
         self.d = d
-        Ti = 1.0 / d
-        self.F = [Ti[:, None] * p.F * d[None, :] for p in plants]
-        self.G = [Ti[:, None] * p.G for p in plants]
-        self.Bw = Ti[:, None] * Bw
-        self.Cz = Cz * d[None, :]
-        self.Dzu, self.Dzw = Dzu, Dzw
+        self._orig = ([p.F for p in plants], [p.G for p in plants], Bw * self.a, Cz)
+        self.Dzu, self.Dzw = Dzu, Dzw * self.a
+        self._transform(np.diag(d))
         self.n, self.m = plants[0].n, plants[0].m
         self.p, self.q = Cz.shape[0], Bw.shape[1]
         self.extended = extended
-        self.u_max, self.w_energy = u_max, w_energy
-        self.scale = max(1.0, max(np.max(np.abs(f)) for f in self.F), max(np.max(np.abs(g)) for g in self.G),
-                         np.max(np.abs(self.Bw)), np.max(np.abs(self.Cz)), np.max(np.abs(Dzu)),
-                         np.max(np.abs(Dzw)) if Dzw.size else 0.0)
+        self.u_max = u_max
+
+    def _transform(self, T: np.ndarray) -> None:
+        """Use the state coordinates ``x = T x^`` for the LMI data."""
+        Fs, Gs, Bw, Cz = self._orig
+        self.T = T
+        self.F = [np.linalg.solve(T, F @ T) for F in Fs]
+        self.G = [np.linalg.solve(T, G) for G in Gs]
+        self.Bw = np.linalg.solve(T, Bw)
+        self.Cz = Cz @ T
+
+    def recentre(self, V) -> None:
+        """Change coordinates so that the Lyapunov matrix of a previous solution becomes ~ I.
+
+        ``X = R R'`` (Cholesky of the solution, slightly regularised) and
+        ``x = T R x^``: a similarity, so the level and the input bound are
+        unchanged, but the centring margin ``t`` of the next solve is then
+        measured relative to the solution's own scale.
+        """
+        if self.extended:
+            Sv = V["S"].value
+            X = 0.5 * (Sv + Sv.T)
+        else:
+            X = 0.5 * (V["X"].value + V["X"].value.T)
+        lam = np.linalg.eigvalsh(X)
+        if not (np.all(np.isfinite(lam)) and lam[-1] > 0):
+            return
+        X = X + max(0.0, 1e-6 * lam[-1] - lam[0]) * np.eye(self.n)
+        try:
+            R = np.linalg.cholesky(X)
+        except np.linalg.LinAlgError:
+            return
+        self._transform(self.T @ (R / np.sqrt(lam[-1])))
 
     def variables(self):
         cp = self.cp
@@ -246,45 +285,60 @@ class _Problem:
             V = {"X": cp.Variable((n, n), symmetric=True, name="X"), "Y": cp.Variable((m, n), name="Y")}
         return V
 
-    def lmis(self, V, mu, margin) -> list:
+    def lmis(self, V, mu, margin, b: float = 1.0, x_margin=None, x_upper: float | None = None) -> list:
+        """LMI blocks at scaled level ``mu`` (``= (a b gamma)^2``), output scaling ``b``.
+
+        ``margin`` applies to the H-infinity blocks. With ``x_margin`` the
+        Lyapunov (or slack) matrix must also satisfy ``X >= x_margin I`` and
+        ``X <= x_upper I``.
+        """
         cp = self.cp
         n, p, q = self.n, self.p, self.q
         Iq, Ip = np.eye(q), np.eye(p)
+        Cz, Dzu, Dzw = b * self.Cz, b * self.Dzu, b * self.Dzw
         out = []
         for i, (F, G) in enumerate(zip(self.F, self.G)):
             if self.extended:
                 P, S, L = V["P"][i], V["S"], V["L"]
                 AS = F @ S + G @ L
-                CS = self.Cz @ S + self.Dzu @ L
+                CS = Cz @ S + Dzu @ L
                 M = cp.bmat([
                     [P, AS, self.Bw, np.zeros((n, p))],
                     [AS.T, S + S.T - P, np.zeros((n, q)), CS.T],
-                    [self.Bw.T, np.zeros((q, n)), Iq, self.Dzw.T],
-                    [np.zeros((p, n)), CS, self.Dzw, mu * Ip]])
+                    [self.Bw.T, np.zeros((q, n)), Iq, Dzw.T],
+                    [np.zeros((p, n)), CS, Dzw, mu * Ip]])
             elif self.discrete:
                 X, Y = V["X"], V["Y"]
                 AX = F @ X + G @ Y
-                CX = self.Cz @ X + self.Dzu @ Y
+                CX = Cz @ X + Dzu @ Y
                 M = cp.bmat([
                     [X, AX, self.Bw, np.zeros((n, p))],
                     [AX.T, X, np.zeros((n, q)), CX.T],
-                    [self.Bw.T, np.zeros((q, n)), Iq, self.Dzw.T],
-                    [np.zeros((p, n)), CX, self.Dzw, mu * Ip]])
+                    [self.Bw.T, np.zeros((q, n)), Iq, Dzw.T],
+                    [np.zeros((p, n)), CX, Dzw, mu * Ip]])
             else:
                 X, Y = V["X"], V["Y"]
                 AX = F @ X + G @ Y
-                CX = self.Cz @ X + self.Dzu @ Y
+                CX = Cz @ X + Dzu @ Y
                 # -(continuous BRL) >= 0
                 M = cp.bmat([
                     [-(AX + AX.T), -self.Bw, -CX.T],
-                    [-self.Bw.T, Iq, -self.Dzw.T],
-                    [-CX, -self.Dzw, mu * Ip]])
+                    [-self.Bw.T, Iq, -Dzw.T],
+                    [-CX, -Dzw, mu * Ip]])
             out.append(_cvx.LMI(f"hinf[{i}]", M, margin))
-        if not self.discrete:
+        if x_margin is not None:
+            n_eye = np.eye(self.n)
+            if self.extended:
+                out.append(_cvx.LMI("S", 0.5 * (V["S"] + V["S"].T), x_margin))
+                out += [_cvx.LMI(f"P_upper[{i}]", x_upper * n_eye - P) for i, P in enumerate(V["P"])]
+            else:
+                out.append(_cvx.LMI("X", V["X"], x_margin))
+                out.append(_cvx.LMI("X_upper", x_upper * n_eye - V["X"]))
+        elif not self.discrete:
             out.append(_cvx.LMI("X", V["X"], margin))
         if self.u_max is not None:
             for j, umax in enumerate(self.u_max):
-                c = np.array([[umax**2 * (1.0 - _U_SLACK) / self.w_energy]])
+                c = np.array([[umax**2 * (1.0 - _U_SLACK)]])  # unit energy after scaling w
                 if self.extended:
                     for i, P in enumerate(V["P"]):
                         S, L = V["S"], V["L"]
@@ -305,8 +359,8 @@ class _Problem:
             Xs, Y = V["X"].value, V["Y"].value
             Xs = 0.5 * (Xs + Xs.T)
             Ks = np.linalg.solve(Xs, Y.T).T
-        d = self.d
-        return Ks / d[None, :], d[:, None] * Xs * d[None, :]
+        T = self.T
+        return np.linalg.solve(T.T, Ks.T).T, T @ Xs @ T.T
 
 
 # ---------------------------------------------------------------- public
@@ -409,10 +463,14 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
     import cvxpy as cp
 
     prob = _Problem(plants, Bw, Cz, Dzu, Dzw, bool(extended), u_max, w_energy)
-    margin = _MIN_MARGIN * prob.scale
-    what = "a common Lyapunov matrix for all vertices" if len(plants) > 1 else "a stabilising gain"
+    if len(plants) == 1:
+        what = "no stabilising gain satisfies the H-infinity LMI"
+    else:
+        what = (f"no common {'slack matrix' if extended else 'Lyapunov matrix'} and gain satisfy the "
+                f"H-infinity LMI at all {len(plants)} vertices" + ("" if extended else " (try extended=True)"))
     if u_max is not None:
-        what += f" with |u_j| <= u_max for disturbance energy {w_energy:g}"
+        what += (f" together with |u_j| <= u_max = {u_max.tolist()} for every disturbance of energy "
+                 f"{w_energy:g} (the input bound may be too tight for this disturbance energy)")
     solves = []
 
     # 1. minimise mu = gamma^2
@@ -420,27 +478,41 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
     if gamma is None:
         V = prob.variables()
         mu = cp.Variable(name="mu")
-        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, margin), solver=solver,
-                             infeasible_msg=f"no H-infinity state feedback exists: the LMIs admit no {what}"
-                             + ("" if len(plants) == 1 or extended else " (try extended=True)"))
+        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0), solver=solver,
+                             infeasible_msg=f"no H-infinity state feedback: {what}")
         solves.append(rep.as_dict())
-        gamma_opt = float(np.sqrt(max(mu.value, 0.0)))
+        gamma_opt = float(np.sqrt(max(mu.value, 0.0))) / prob.a
         gamma_fix = gamma_opt * (1.0 + backoff)
     else:
         gamma_fix = gamma
 
     # 2. well-centred gain at the fixed level
     if gamma is None and backoff == 0:
-        final_margin = margin
+        final_margin = 0.0
+    elif gamma is None:
+        # Maximise the smallest eigenvalue of X (S for the extended LMI) below
+        # x_upper = 2 lambda_max of the optimal point: the best-conditioned
+        # X, hence a moderate K = Y X^-1, at the backed-off level.
+        Xopt = V["S"].value if extended else V["X"].value
+        x_upper = 2.0 * float(np.max(np.abs(np.linalg.eigvalsh(0.5 * (Xopt + Xopt.T)))))
+        V = prob.variables()
+        t = cp.Variable(name="t")
+        # H-infinity blocks strictly feasible by a margin that scales with the backoff
+        eps = max(_STRICT, 1e-2 * backoff)
+        rep = _cvx.solve_sdp(
+            cp.Maximize(t), prob.lmis(V, 1.0, eps, b=1.0 / (prob.a * gamma_fix), x_margin=t, x_upper=x_upper),
+            [t >= _STRICT * x_upper], solver=solver, tol=_CENTRE_TOL,
+            infeasible_msg=f"could not find a strictly feasible gain at gamma={gamma_fix:.6g} = "
+                           "(1 + backoff) gamma_opt; increase backoff")
+        solves.append(rep.as_dict())
+        final_margin = float(t.value) / x_upper
     else:
         V = prob.variables()
         t = cp.Variable(name="t")
-        msg = (f"no gain achieves gamma={gamma_fix:.6g}" if gamma is not None else
-               f"could not find a strictly feasible gain at gamma={gamma_fix:.6g} = (1 + backoff) gamma_opt; "
-               "increase backoff")
-        rep = _cvx.solve_sdp(cp.Maximize(t), prob.lmis(V, gamma_fix**2, t),
-                             [t <= 1.0, t >= _STRICT * prob.scale], solver=solver,
-                             infeasible_msg=msg + (f" ({what} needed)" if gamma is not None else ""))
+        # scaled level a * b * gamma_fix = 1
+        rep = _cvx.solve_sdp(cp.Maximize(t), prob.lmis(V, 1.0, t, b=1.0 / (prob.a * gamma_fix)),
+                             [t <= 1.0, t >= _STRICT], solver=solver, tol=_CENTRE_TOL,
+                             infeasible_msg=f"no gain achieves gamma={gamma_fix:.6g}: {what} at this level")
         solves.append(rep.as_dict())
         final_margin = float(t.value)
 
@@ -466,15 +538,13 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
         "margin": final_margin, "solves": solves, "X": Xs, "scaling": prob.d, "solver": solver,
     }
     if u_max is not None:
-        Xb = Xs if not extended else None
-        if extended:
-            Pmats = [np.asarray(P.value) for P in V["P"]]
-            d = prob.d
-            bounds = [np.sqrt(w_energy * np.einsum("ij,jk,ik->i", K * d[None, :], Pk, K * d[None, :]))
-                      for Pk in Pmats]
-            info["u_bound"] = np.max(bounds, axis=0)
-        else:
-            info["u_bound"] = np.sqrt(w_energy * np.einsum("ij,jk,ik->i", K, Xb, K))
+        T = prob.T
+        Ks = K @ T  # gain in the solver's coordinates (unit energy)
+        mats = [np.asarray(P.value) for P in V["P"]] if extended else [np.linalg.solve(T, np.linalg.solve(T, Xs).T)]
+        info["u_bound"] = np.max([np.sqrt(np.einsum("ij,jk,ik->i", Ks, Pk, Ks)) for Pk in mats], axis=0)
         info["u_max"], info["w_energy"] = u_max, w_energy
+        if np.any(info["u_bound"] > u_max * (1.0 + 1e-6)):
+            raise ConvergenceError(f"internal check failed: the guaranteed input bound {info['u_bound'].tolist()} "
+                                   f"exceeds u_max = {u_max.tolist()} (solver inaccuracy); increase backoff")
     return HinfController(K=K, method="hinf", plant=plant, info=info, gamma=float(gamma_fix),
                           gamma_opt=gamma_opt)
