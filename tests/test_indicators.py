@@ -158,6 +158,16 @@ def test_pure_diversity_hand_cases_on_a_line():
     assert pure_diversity(line([0, 1, 2, 10]), method="exact") == pytest.approx(13.0, rel=1e-12)
 
 
+def test_pure_diversity_hand_case_minkowski():
+    # d((0,0),(1,0)) = d((0,0),(0,1)) = 1, d((1,0),(0,1)) = (1 + 1)^10 = 1024.
+    # Best removal order: (0,0) first (1), then the pair (1024): 1025. Greedy: all nearest
+    # distances tie at 1, (0,0) goes first and links to (0,1); then (0,1) reaches (1,0) at 1024.
+    F = [[1, 0], [0, 0], [0, 1]]
+    assert pure_diversity(F) == pytest.approx(1025.0, rel=1e-12)
+    assert pure_diversity(F, method="exact") == pytest.approx(1025.0, rel=1e-12)
+    assert pure_diversity(F, p=2.0, method="exact") == pytest.approx(1 + math.sqrt(2), rel=1e-12)
+
+
 def test_pure_diversity_exact_matches_permutation_brute_force():
     rng = np.random.default_rng(7)
     for n in (3, 5, 6):
