@@ -165,6 +165,20 @@ def test_mating_with_one_candidate_is_uniform_over_others():
         np.testing.assert_allclose(np.delete(freq, i), 0.25, atol=0.05)
 
 
+def test_non_finite_objectives_rank_last_and_mate_far():
+    F = np.vstack([HAND[:3], [[np.inf, 0.0]], HAND[3:], [[np.nan, np.nan]]])
+    surv = SPEARSurvival(DIRS5)
+    out = surv.do(_Dummy(), _pop(F), n_survive=4, random_state=np.random.default_rng(0))
+    np.testing.assert_array_equal(np.sort(out.get("F"), axis=0), np.sort(HAND[[P1, P2, P3, Q]], axis=0))
+    out = surv.do(_Dummy(), _pop(F), n_survive=7, random_state=np.random.default_rng(0))
+    assert len(out) == 7 and np.sum(~np.all(np.isfinite(out.get("F")), axis=1)) == 1
+    # mating with every candidate visible: a finite parent never picks a non-finite mate
+    P = NeighbourMatingSelection(k=7).do(_Dummy(), _pop(F), 40, 2, to_pop=False,
+                                         random_state=np.random.default_rng(0))
+    bad = {3, 7}
+    assert all(m not in bad for f, m in P if f not in bad)
+
+
 def test_survival_tolerates_repeated_calls_on_any_size():
     rng = np.random.default_rng(5)
     surv = SPEARSurvival(get_reference_directions("das-dennis", 3, n_partitions=5))

@@ -206,6 +206,20 @@ def test_survival_tolerates_repeated_calls_on_any_size():
         assert np.all(np.isfinite(out.get("theta_fitness")))
 
 
+def test_non_finite_objectives_rank_last():
+    # HAND plus a NaN row and an inf row: with 7 places the 7 finite rows survive; with 8, the first bad one too
+    F = np.vstack([HAND[:3], [[np.nan, 0.0]], HAND[3:], [[0.0, np.inf]]])
+    surv = ThetaSurvival(DIRS2)
+    out = surv.do(_Dummy(), _pop(F), n_survive=3, random_state=np.random.default_rng(0))
+    np.testing.assert_array_equal(np.sort(out.get("F"), axis=0), np.sort(HAND[[A_, B_, C_]], axis=0))
+    out = surv.do(_Dummy(), _pop(F), n_survive=7, random_state=np.random.default_rng(0))
+    assert np.all(np.isfinite(out.get("F")))
+    out = surv.do(_Dummy(), _pop(F), n_survive=8, random_state=np.random.default_rng(0))
+    assert len(out) == 8 and np.isnan(out.get("F")).sum() == 1
+    out = surv.do(_Dummy(), _pop(np.full((3, 2), np.inf)), n_survive=2, random_state=np.random.default_rng(0))
+    assert len(out) == 2
+
+
 def test_random_feasible_selection_prefers_smaller_violation():
     # one feasible (index 0) among four with CV 0, 1, 2, 3. Each parent is the better of two random draws;
     # with (nearly) independent uniform draws P(winner = 0) = 1 - (3/4)^2 = 7/16, P(winner = 3) = 1/16.

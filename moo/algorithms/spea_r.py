@@ -64,6 +64,9 @@ Readings where the paper leaves room (all deliberate):
   of the final population as the result.
 * A point at ``z_min`` (zero normalised vector) has angle 0 to every
   direction and joins direction 0; ties of ``F`` are broken by position.
+* Individuals with a NaN or infinite objective rank behind all others in
+  the survival (:func:`~moo.algorithms.theta_dea.finite_first`) and count
+  as infinitely far in the mating; the paper assumes finite objectives.
 """
 
 from __future__ import annotations
@@ -79,7 +82,7 @@ from pymoo.util.misc import random_permutations
 
 from ._normalize import front_bounds
 from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
-from .theta_dea import _check_reference_directions, select_by_fronts, theta_nondominated_ranks
+from .theta_dea import _check_reference_directions, finite_first, select_by_fronts, theta_nondominated_ranks
 
 __all__ = [
     "SPEAR",
@@ -171,7 +174,8 @@ class SPEARSurvival(Survival):
     """SPEA/R environmental selection (steps 1-5 of the module docstring).
 
     Stateless: a function of the population it is given, so it may be called
-    any number of times per generation on populations of any size. The
+    any number of times per generation on populations of any size.
+    Individuals with non-finite objectives are ranked last. The
     survivors carry ``niche``, ``angle``, ``fitness`` and ``round`` (the
     selection round, 0-based).
     """
@@ -185,6 +189,8 @@ class SPEARSurvival(Survival):
         F = pop.get("F").astype(float)
         if F.shape[1] != self.ref_dirs.shape[1]:
             raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has {self.ref_dirs.shape[1]} columns")
+        if not np.all(np.isfinite(F)):
+            return finite_first(self._do, problem, pop, n_survive, random_state)
         dom = dominance_matrix(F)
         z_min, rng = front_bounds(F, ~dom.any(axis=0))
         niche, angle = associate_by_angle((F - z_min) / rng, self.ref_dirs)
@@ -219,13 +225,18 @@ class NeighbourMatingSelection(Selection):
         if n == 1:
             return np.stack([first, first], axis=1)
         F = pop.get("F").astype(float)
-        z_min, rng = front_bounds(F, is_nondominated(F))
-        Fn = (F - z_min) / rng
+        finite = np.all(np.isfinite(F), axis=1)
+        Fn = np.full_like(F, np.inf)                                 # non-finite rows: infinitely far
+        if finite.any():
+            z_min, rng = front_bounds(F[finite], is_nondominated(F[finite]))
+            Fn[finite] = (F[finite] - z_min) / rng
         k = min(self.k, n - 1)
         keys = random_state.random((n_select, n))
         keys[np.arange(n_select), first] = np.inf                    # never the parent itself
         cand = np.argpartition(keys, k - 1, axis=1)[:, :k]           # k distinct random others
-        dist = np.linalg.norm(Fn[cand] - Fn[first][:, None, :], axis=2)
+        with np.errstate(invalid="ignore"):
+            dist = np.linalg.norm(Fn[cand] - Fn[first][:, None, :], axis=2)
+        dist[np.isnan(dist)] = np.inf                                # inf - inf: no preference
         mate = cand[np.arange(n_select), np.argmin(dist, axis=1)]
         return np.stack([first, mate], axis=1)
 

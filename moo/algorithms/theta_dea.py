@@ -50,6 +50,8 @@ Readings where the paper leaves room (all deliberate):
   otherwise) and SBX keeps both children (pymoo's mating); duplicates are
   eliminated as in the project's NSGA-III, for a like-for-like comparison.
 * Ties in ``F_j`` are broken by position in ``S`` (deterministic).
+* Individuals with a NaN or infinite objective rank behind all others
+  (:func:`finite_first`); the paper assumes finite objectives.
 * Degenerate normalisation ranges are repaired as documented in
   :mod:`moo.algorithms._normalize` (the paper has no such case).
 """
@@ -58,6 +60,7 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.population import Population
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
@@ -75,6 +78,7 @@ __all__ = [
     "theta_clustering",
     "theta_nondominated_ranks",
     "select_by_fronts",
+    "finite_first",
     "make_theta_dea",
 ]
 
@@ -160,6 +164,22 @@ def select_by_fronts(ranks: np.ndarray, n_survive: int, last_front_key: np.ndarr
     return np.sort(np.concatenate([full, chosen]))
 
 
+def finite_first(survive, problem, pop, n_survive: int, random_state):
+    """Apply ``survive`` to the rows of ``pop`` with finite objectives; non-finite rows fill up last.
+
+    Individuals with a NaN or infinite objective cannot be normalised or
+    placed on a reference direction; they are ranked behind every finite one
+    (in population order) and only survive when the finite ones are too few.
+    """
+    finite = np.all(np.isfinite(pop.get("F")), axis=1)
+    good, bad = np.flatnonzero(finite), np.flatnonzero(~finite)
+    if len(good) == 0:
+        return pop[bad[:n_survive]]
+    survivors = survive(problem, pop[good], n_survive=min(n_survive, len(good)), random_state=random_state)
+    rest = n_survive - len(survivors)
+    return Population.merge(survivors, pop[bad[:rest]]) if rest > 0 else survivors
+
+
 class RandomFeasibleSelection(Selection):
     """Uniform random parents; on constrained problems a binary tournament on the violation.
 
@@ -190,6 +210,7 @@ class ThetaSurvival(Survival):
     Keeps its own :class:`~moo.algorithms._normalize.HyperplaneNormalization`
     (ideal point, extreme points, nadir) across calls, so it may be called
     any number of times per generation on populations of any size.
+    Individuals with non-finite objectives are ranked last (:func:`finite_first`).
     After a call the survivors carry ``rank`` (Pareto front), ``theta_rank``,
     ``cluster`` and ``theta_fitness``.
     """
@@ -206,6 +227,8 @@ class ThetaSurvival(Survival):
         F = pop.get("F").astype(float)
         if F.shape[1] != self.ref_dirs.shape[1]:
             raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has {self.ref_dirs.shape[1]} columns")
+        if not np.all(np.isfinite(F)):
+            return finite_first(self._do, problem, pop, n_survive, random_state)
         fronts = NonDominatedSorting().do(F, n_stop_if_ranked=n_survive)
         S = np.concatenate(fronts)
         pareto_rank = np.concatenate([np.full(len(f), i) for i, f in enumerate(fronts)])
