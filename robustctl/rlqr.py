@@ -88,6 +88,7 @@ __all__ = ["rlqr", "rlqr_gains", "rlqr_step", "rlqr_step_block", "RLQRBatch", "R
 _DEFAULT_ALPHA = 0.1
 _DEFAULT_TOL = 1e-10
 _DEFAULT_MAX_ITER = 10_000
+_MU_MIN = 1e-100  # smallest accepted penalty (mu^-1 enters products with P)
 _DIVERGED = 1e250  # |P| beyond this: the recursion is diverging
 
 
@@ -472,6 +473,8 @@ def _check_mu(mu, name: str = "mu") -> np.ndarray:
         raise ValueError(f"{name} must not be NaN")
     if np.any(arr <= 0):
         raise ValueError(f"{name} must be > 0 (np.inf allowed), got min {arr.min():g}")
+    if np.any(arr < _MU_MIN):  # 1/mu would overflow the products of the recursion
+        raise ValueError(f"{name} must be >= {_MU_MIN:g} (or np.inf), got min {arr.min():g}")
     return arr
 
 
@@ -513,7 +516,7 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
     EF : (B, l, n) array_like
     EG : (B, l, m) array_like
     mu : (B,) array_like
-        Penalty parameters, ``> 0``; ``np.inf`` gives the limit form.
+        Penalty parameters in ``[1e-100, inf]``; ``np.inf`` gives the limit form.
         Any of ``EF``, ``EG``, ``mu`` may omit the batch axis to be shared.
     Q, R : weights (defaults identity); ``H`` (n, p), default ``ones((n, l))``.
     alpha : float
@@ -537,7 +540,8 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
     All designs are solved together with stacked ``(B, k, k)`` solves by
     doubling (module docstring); no Python loop over designs.
     """
-    EF = np.asarray(EF, dtype=float) if not isinstance(EF, (str, bytes)) else EF
+    if not isinstance(plant, Plant):
+        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
     EF = as_batch(EF if np.ndim(EF) == 3 else np.atleast_2d(EF)[None], "EF", (None, None, plant.n),
                   ("", "", "the number of states"))
     l = EF.shape[1]
@@ -601,7 +605,7 @@ def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DE
     EF : (l, n) array_like
     EG : (l, m) array_like
     mu : float
-        Penalty parameter ``> 0``; ``np.inf`` gives Algorithm 1 (``Sigma = 0``),
+        Penalty parameter in ``[1e-100, inf]``; ``np.inf`` gives Algorithm 1 (``Sigma = 0``),
         which forces ``EF + EG K = 0`` and ``L = F + G K`` and needs ``EG`` of
         full row rank.
     Q : (n, n) symmetric PSD, default identity (PD for ``implementation="block"``)

@@ -1,0 +1,137 @@
+"""Plant, NormBounded, Controller and design(): construction, checks, python-control agreement."""
+
+import control
+import numpy as np
+import pytest
+
+import robustctl as rc
+
+A = np.array([[0.0, 1.0], [-2.0, -3.0]])
+B = np.array([[0.0], [1.0]])
+
+
+@pytest.mark.parametrize("method,pc_method", [("zoh", "zoh"), ("tustin", "tustin")])
+def test_from_continuous_matches_control_c2d(method, pc_method):
+    p = rc.Plant.from_continuous(A, B, dt=0.05, method=method)
+    ref = control.c2d(control.ss(A, B, np.eye(2), 0), 0.05, method=pc_method)
+    np.testing.assert_allclose(p.F, ref.A, atol=1e-14)
+    np.testing.assert_allclose(p.G, ref.B, atol=1e-14)
+    assert p.dt == 0.05 and p.n == 2 and p.m == 1
+
+
+def test_from_continuous_zoh_is_matrix_exponential():
+    """Independent closed form: expm([[A, B], [0, 0]] dt) = [[F, G], [0, I]]."""
+    from scipy.linalg import expm
+
+    M = np.zeros((3, 3))
+    M[:2, :2], M[:2, 2:] = A, B
+    E = expm(M * 0.1)
+    p = rc.Plant.from_continuous(A, B, dt=0.1)
+    np.testing.assert_allclose(p.F, E[:2, :2], atol=1e-14)
+    np.testing.assert_allclose(p.G, E[:2, 2:], atol=1e-14)
+
+
+def test_euler_and_continuous():
+    p = rc.Plant.from_continuous(A, B, dt=0.1, method="euler")
+    np.testing.assert_allclose(p.F, np.eye(2) + 0.1 * A)
+    np.testing.assert_allclose(p.G, 0.1 * B)
+    c = rc.Plant.from_continuous(A, B, dt=None)
+    assert not c.is_discrete and c.dt is None
+    np.testing.assert_array_equal(c.F, A)
+
+
+def test_from_statespace_roundtrip():
+    sysd = control.c2d(control.ss(A, B, np.eye(2), 0), 0.2)
+    p = rc.Plant.from_statespace(sysd)
+    assert p.dt == 0.2
+    np.testing.assert_array_equal(p.F, sysd.A)
+    back = p.to_statespace()
+    np.testing.assert_array_equal(back.B, sysd.B)
+    assert rc.Plant.from_statespace(control.ss(A, B, np.eye(2), 0)).dt is None
+
+
+def test_plant_is_immutable():
+    p = rc.Plant(np.eye(2), np.ones((2, 1)), 0.1)
+    with pytest.raises(ValueError):
+        p.F[0, 0] = 5.0
+
+
+@pytest.mark.parametrize(
+    "args,match",
+    [
+        ((np.eye(2), np.ones((3, 1)), 0.1), r"G must have 2 rows .*got shape \(3, 1\)"),
+        ((np.ones((2, 3)), np.ones((2, 1)), 0.1), r"F must be square, got shape \(2, 3\)"),
+        ((np.eye(2), np.ones((2, 1)), 0.0), r"dt must be > 0"),
+        ((np.eye(2), np.ones((2, 1)), -1), r"dt must be > 0"),
+        ((np.eye(2) * np.nan, np.ones((2, 1)), 0.1), r"F must have finite entries"),
+        ((np.eye(2), np.ones((2, 1)), np.inf), r"dt must be finite"),
+    ],
+)
+def test_plant_bad_input(args, match):
+    with pytest.raises(ValueError, match=match):
+        rc.Plant(*args)
+
+
+def test_plant_bad_types_and_methods():
+    with pytest.raises(TypeError, match="F must be"):
+        rc.Plant("abc", np.ones((2, 1)), 0.1)
+    with pytest.raises(ValueError, match="method must be one of"):
+        rc.Plant.from_continuous(A, B, dt=0.1, method="foh2")
+    with pytest.raises(TypeError, match="sys must be a control.StateSpace"):
+        rc.Plant.from_statespace(np.eye(2))
+
+
+def test_norm_bounded_perturb():
+    F, G = np.diag([0.5, 0.2]), np.array([[1.0], [0.0]])
+    plant = rc.Plant(F, G, 0.1)
+    unc = rc.NormBounded([1.0, 2.0], [[0.1, 0.2]], [[0.3]])
+    assert (unc.n, unc.m, unc.p, unc.l) == (2, 1, 1, 1)
+    pert = unc.perturb(plant, -0.5)
+    np.testing.assert_allclose(pert.F, F - 0.5 * np.array([[0.1, 0.2], [0.2, 0.4]]))
+    np.testing.assert_allclose(pert.G, G - 0.5 * np.array([[0.3], [0.6]]))
+    Fs, Gs = unc.perturbed_matrices(plant, np.array([-1.0, 0.0, 1.0]))
+    assert Fs.shape == (3, 2, 2) and Gs.shape == (3, 2, 1)
+    np.testing.assert_allclose(Fs[1], F)
+    with pytest.raises(ValueError, match="contraction"):
+        unc.perturb(plant, 1.5)
+    with pytest.raises(ValueError, match="H must have 2 rows"):
+        rc.NormBounded(np.ones((3, 1)), [[0.1, 0.2]], [[0.3]])
+    with pytest.raises(ValueError, match="EG must have 1 rows"):
+        rc.NormBounded([1.0, 2.0], [[0.1, 0.2]], np.ones((2, 1)))
+    with pytest.raises(ValueError, match="uncertainty is for n=2"):
+        unc.perturb(rc.Plant(np.eye(3), np.ones((3, 1)), 0.1), 0.0)
+
+
+def test_controller_interface():
+    plant = rc.Plant(np.array([[1.1, 0.1], [0.0, 0.9]]), np.array([[1.0], [0.5]]), 0.1)
+    K = np.array([[-0.5, -0.1]])
+    c = rc.Controller(K, "custom", plant)
+    np.testing.assert_allclose(c([1.0, 2.0]), K @ [1.0, 2.0])
+    np.testing.assert_allclose(c(np.ones((5, 2))), np.ones((5, 2)) @ K.T)
+    np.testing.assert_allclose(c.closed_loop(), plant.F + plant.G @ K)
+    assert c.is_stabilizing() == (np.abs(np.linalg.eigvals(plant.F + plant.G @ K)).max() < 1)
+    assert not rc.Controller(np.zeros((1, 2)), "zero", plant).is_stabilizing()  # F has eigenvalue 1.1
+    other = rc.Plant(np.eye(2) * 0.5, np.zeros((2, 1)), 0.1)
+    np.testing.assert_allclose(c.closed_loop(other), other.F)
+    assert "method='custom'" in repr(c) and "K=" in repr(c)
+    with pytest.raises(ValueError, match="K must have 1 rows"):
+        rc.Controller(np.zeros((2, 2)), "x", plant)
+    with pytest.raises(ValueError, match="x must have 2 entries"):
+        c(np.ones(3))
+    with pytest.raises(TypeError):
+        c.info["new"] = 1  # read-only mapping
+
+
+def test_continuous_controller_stability():
+    plant = rc.Plant.from_continuous(A, B, dt=None)
+    assert rc.Controller(np.zeros((1, 2)), "zero", plant).is_stabilizing()  # A is Hurwitz
+    assert not rc.Controller(np.array([[5.0, 5.0]]), "bad", plant).is_stabilizing()
+
+
+def test_design_dispatch_errors():
+    plant = rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1)
+    with pytest.raises(ValueError, match="unknown design method 'pid'; valid: hinf, lqr, rlqr"):
+        rc.design("pid", plant)
+    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+        rc.design("lqr", np.eye(2))
+    assert rc.design("LQR", plant).method == "lqr"
