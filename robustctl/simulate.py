@@ -53,6 +53,8 @@ class SimulationResult:
         Applied (saturated) physical inputs.
     sq_error_sum : (B, S, n) ndarray
         ``sum_k (x[k] - x_ref[k])^2``.
+    sq_state_sum : (B, S, n) ndarray
+        ``sum_k x[k]^2`` (for regulation errors, see :meth:`mse`).
     diverged : (B, S) ndarray of bool
         Run left the ``bound`` (then frozen; see the module docstring).
     diverged_step : (B, S) ndarray of int
@@ -73,6 +75,7 @@ class SimulationResult:
     errors: np.ndarray | None
     inputs: np.ndarray | None
     sq_error_sum: np.ndarray
+    sq_state_sum: np.ndarray
     diverged: np.ndarray
     diverged_step: np.ndarray
     saturated_steps: np.ndarray
@@ -91,15 +94,31 @@ class SimulationResult:
     def S(self) -> int:
         return self.diverged.shape[1]
 
-    def mse(self) -> np.ndarray:
+    def mse(self, target: str = "reference") -> np.ndarray:
         """Mean squared error of each objective state, shape (B, S, len(objectives)).
 
         For :func:`simulate` this is the paper's ``[f1, f2, f3, f4]`` =
         MSE of ``[rho, psidot, ydot, theta]`` errors (lateral displacement [m^2],
         yaw rate [(rad/s)^2], lateral velocity [(m/s)^2], orientation [rad^2]).
         Diverged runs get a large finite value (see the module docstring).
+
+        Parameters
+        ----------
+        target : {"reference", "zero"}
+            ``"reference"`` (default): MSE of the tracking error ``x - x_ref``.
+            ``"zero"``: MSE of the states themselves, the *regulation* error
+            of a regulator driving every state to zero. For the truck the two
+            differ only in ``ydot``, ``psidot`` and ``theta`` (``rho_ref = 0``):
+            in a bend the yaw rate must be ``v kappa``, so its regulation error
+            measures the path as much as the controller.
         """
-        return self.sq_error_sum[..., list(self.objectives)] / self.T
+        if target == "reference":
+            sums = self.sq_error_sum
+        elif target == "zero":
+            sums = self.sq_state_sum
+        else:
+            raise ValueError(f"target must be 'reference' or 'zero', got {target!r}")
+        return sums[..., list(self.objectives)] / self.T
 
     @property
     def steering(self) -> np.ndarray:
@@ -280,6 +299,7 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
     x = (xr[:, 0] + e0)[:, :, None] * np.ones((1, 1, B))
     KT = np.ascontiguousarray(np.transpose(Keff, (1, 2, 0)))    # (p, n, B)
     sq = np.zeros((S, n, B))
+    sqx = np.zeros((S, n, B))
     alive = np.ones((S, B), dtype=bool)
     div_step = np.full((S, B), -1, dtype=np.int64)
     sat_steps = np.zeros((S, B), dtype=np.int64)
@@ -303,6 +323,8 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
             u = np.clip(u, -lim[None, :, None], lim[None, :, None])
             sat_steps += at_lim.any(axis=1) & alive
         sq += e * e
+        xs = e + xr[:, k, :, None]
+        sqx += xs * xs
         if keep_trajectories:
             E_all[k] = e
             U_all[k] = u
@@ -315,6 +337,7 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
         inputs = np.transpose(U_all, (3, 1, 0, 2))
     return SimulationResult(
         errors=errors, inputs=inputs, sq_error_sum=np.transpose(sq, (2, 0, 1)),
+        sq_state_sum=np.transpose(sqx, (2, 0, 1)),
         diverged=(div_step >= 0).T, diverged_step=div_step.T, saturated_steps=sat_steps.T,
         x_ref=np.asarray(x_ref), objectives=objectives, T=T, dt=dt)
 
@@ -426,5 +449,6 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParam
                           input_map=np.ones((1, Kb.shape[1])), bound=bound,
                           keep_trajectories=keep_trajectories, objectives=_truck.OBJECTIVE_STATES,
                           dt=p.dt)
-    return SimulationResult(res.errors, res.inputs, res.sq_error_sum, res.diverged, res.diverged_step,
-                            res.saturated_steps, res.x_ref, res.objectives, res.T, res.dt, path, scen)
+    return SimulationResult(res.errors, res.inputs, res.sq_error_sum, res.sq_state_sum, res.diverged,
+                            res.diverged_step, res.saturated_steps, res.x_ref, res.objectives, res.T,
+                            res.dt, path, scen)

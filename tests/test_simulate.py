@@ -193,3 +193,14 @@ def test_bad_inputs(K_lqr):
         simulate_linear(np.zeros((1, 4)), np.eye(4), np.ones((4, 1)), np.zeros((5, 4)), u_limit=-1.0)
     with pytest.raises(ValueError, match="F"):
         simulate_linear(np.zeros((1, 4)), np.eye(3), np.ones((4, 1)), np.zeros((5, 4)))
+
+
+def test_mse_regulation_target(K_lqr):
+    res = simulate(K_lqr, default_route(duration=60.0), [0.0, 300.0])
+    x = res.states
+    np.testing.assert_allclose(res.mse("zero"), np.mean(x**2, axis=2)[..., [2, 1, 0, 3]], rtol=1e-12)
+    np.testing.assert_allclose(res.mse("zero")[..., 0], res.mse()[..., 0], rtol=1e-12)   # rho_ref = 0
+    lean = simulate(K_lqr, default_route(duration=60.0), [0.0, 300.0], keep_trajectories=False)
+    np.testing.assert_allclose(lean.mse("zero"), res.mse("zero"), rtol=1e-12)
+    with pytest.raises(ValueError, match="target"):
+        res.mse("path")
