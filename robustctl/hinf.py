@@ -510,11 +510,15 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
         V = prob.variables()
         t = cp.Variable(name="t")
         # scaled level a * b * gamma_fix = 1
+        # Feasibility as a always-feasible problem: the largest t with every
+        # block >= t I (t <= 1 keeps it bounded); strictly feasible iff t > 0.
+        infeasible = f"no gain achieves gamma={gamma_fix:.6g}: {what} at this level"
         rep = _cvx.solve_sdp(cp.Maximize(t), prob.lmis(V, 1.0, t, b=1.0 / (prob.a * gamma_fix)),
-                             [t <= 1.0, t >= _STRICT], solver=solver, tol=_CENTRE_TOL,
-                             infeasible_msg=f"no gain achieves gamma={gamma_fix:.6g}: {what} at this level")
+                             [t <= 1.0], solver=solver, tol=_CENTRE_TOL, infeasible_msg=infeasible)
         solves.append(rep.as_dict())
         final_margin = float(t.value)
+        if not final_margin > _STRICT:
+            raise InfeasibleError(f"{infeasible} (largest strictness margin {final_margin:.3g})")
 
     K, X = prob.gain(V)
     if not np.all(np.isfinite(K)):
