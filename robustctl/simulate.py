@@ -132,15 +132,22 @@ class SimulationResult:
         self._need_trajectories()
         return self.errors + self.x_ref
 
-    def pose(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def pose(self, method: str = "path") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Global position and heading of the vehicle, each of shape (B, S, T).
 
-        The vehicle's pose is the path point at ``s = v t`` displaced by ``rho``
-        along the path's left normal, with heading ``path heading + theta``:
+        ``method="path"`` (default): the path point at ``s = v t`` displaced by
+        ``rho`` along the path's left normal, with heading ``path heading + theta``:
         ``X = X_p - rho sin(h_p)``, ``Y = Y_p + rho cos(h_p)``, ``heading = h_p + theta``.
         This is the model's own frame (its ``rho, theta`` are defined relative
         to the path point reached at speed ``v``), so the drawn track is
-        exactly the simulated one, with no drift from re-integrating.
+        exactly the simulated one, with no drift.
+
+        ``method="integrated"``: dead reckoning from the simulated body
+        velocities, ``psi' = psidot``, ``X' = v cos(psi) - ydot sin(psi)``,
+        ``Y' = v sin(psi) + ydot cos(psi)`` (trapezoidal rule), from the start
+        pose of the ``"path"`` method. It differs from ``"path"`` by the
+        linearisation of the model (second order in ``theta`` and
+        ``kappa rho``), which accumulates along the route.
         """
         self._need_trajectories()
         if self.path is None:
@@ -148,8 +155,24 @@ class SimulationResult:
         x = self.states
         rho, theta = x[..., 2], x[..., 3]
         h = self.path.heading[: self.T]
-        return (self.path.X[: self.T] - rho * np.sin(h), self.path.Y[: self.T] + rho * np.cos(h),
-                h + theta)
+        X0 = self.path.X[0] - rho[..., 0] * np.sin(h[0])
+        Y0 = self.path.Y[0] + rho[..., 0] * np.cos(h[0])
+        if method == "path":
+            return (self.path.X[: self.T] - rho * np.sin(h), self.path.Y[: self.T] + rho * np.cos(h),
+                    h + theta)
+        if method != "integrated":
+            raise ValueError(f"method must be 'path' or 'integrated', got {method!r}")
+        dt, v = self.path.dt, self.path.speed
+
+        def integrate(rate, start):
+            steps = 0.5 * (rate[..., 1:] + rate[..., :-1]) * dt
+            return np.concatenate([start[..., None], start[..., None] + np.cumsum(steps, axis=-1)], axis=-1)
+
+        psi = integrate(x[..., 1], h[0] + theta[..., 0])
+        ydot = x[..., 0]
+        X = integrate(v * np.cos(psi) - ydot * np.sin(psi), X0)
+        Y = integrate(v * np.sin(psi) + ydot * np.cos(psi), Y0)
+        return X, Y, psi
 
     def _need_trajectories(self):
         if self.errors is None:

@@ -204,3 +204,16 @@ def test_mse_regulation_target(K_lqr):
     np.testing.assert_allclose(lean.mse("zero"), res.mse("zero"), rtol=1e-12)
     with pytest.raises(ValueError, match="target"):
         res.mse("path")
+
+
+def test_integrated_pose_agrees_with_path_frame(K_lqr):
+    """Dead reckoning from the body velocities stays within a few cm of the path-frame pose."""
+    path = ReferencePath.from_segments([Straight(100.0), Curve(250.0, 60.0, 60.0), Straight(100.0)])
+    res = simulate(K_lqr, path, [0.0, 300.0])
+    Xp, Yp, hp = res.pose()
+    Xi, Yi, hi = res.pose("integrated")
+    assert np.max(np.hypot(Xp - Xi, Yp - Yi)) < 0.3          # over 460 m of road
+    assert np.max(np.abs(hp - hi)) < 1e-2
+    np.testing.assert_allclose(Xi[..., 0], Xp[..., 0])
+    with pytest.raises(ValueError, match="method"):
+        res.pose("gps")
