@@ -1,0 +1,56 @@
+"""The cvxpy solve wrapper robustctl._cvx: status handling, symmetrisation, certificate."""
+
+from __future__ import annotations
+
+import pathlib
+import re
+
+import numpy as np
+import pytest
+
+cp = pytest.importorskip("cvxpy")
+
+from robustctl import _cvx  # noqa: E402
+from robustctl.errors import InfeasibleError  # noqa: E402
+
+
+def test_margin_and_certificate_are_reported():
+    X = cp.Variable((3, 3), symmetric=True)
+    C = np.diag([1.0, 2.0, 3.0])
+    rep = _cvx.solve_sdp(cp.Minimize(cp.trace(X)), [_cvx.LMI("X-C", X - C, 0.5)])
+    assert rep.status == "optimal"
+    # minimum of trace X subject to X >= C + 0.5 I is trace(C) + 1.5, at X = C + 0.5 I
+    assert rep.value == pytest.approx(7.5, rel=1e-8)
+    assert np.allclose(X.value, C + 0.5 * np.eye(3), atol=1e-7)
+    assert rep.certificate["X-C"] == pytest.approx(np.linalg.eigvalsh(X.value - C).min(), abs=1e-9)
+    assert rep.certificate["X-C"] == pytest.approx(0.5, abs=1e-7)
+    assert rep.iterations > 0 and rep.solve_time >= 0
+
+
+def test_infeasible_lmi_raises_with_the_callers_message():
+    X = cp.Variable((2, 2), symmetric=True)
+    with pytest.raises(InfeasibleError, match="no X for the test"):
+        _cvx.solve_sdp(cp.Minimize(0), [_cvx.LMI("pos", X, 1.0), _cvx.LMI("neg", -X, 1.0)],
+                       infeasible_msg="no X for the test")
+
+
+def test_non_symmetric_block_is_caught():
+    x = cp.Variable()
+    M = cp.bmat([[x, 1.0], [0.0, x]])   # only its symmetric part would be constrained
+    with pytest.raises(ValueError, match="not symmetric"):
+        _cvx.solve_sdp(cp.Minimize(x), [_cvx.LMI("M", M, 0.0)])
+
+
+def test_unknown_solver_is_named():
+    with pytest.raises(ValueError, match="solver must be an installed SDP solver"):
+        _cvx.check_solver("GUROBI_DOES_NOT_EXIST")
+    with pytest.raises(TypeError, match="solver"):
+        _cvx.check_solver(3)
+
+
+def test_only_the_wrapper_calls_solve():
+    root = pathlib.Path(_cvx.__file__).parent
+    pattern = re.compile(r"\.solve\(\s*(solver|verbose|\*\*|\))")
+    offenders = [str(p.relative_to(root)) for p in root.rglob("*.py")
+                 if p.name != "_cvx.py" and pattern.search(p.read_text())]
+    assert offenders == []
