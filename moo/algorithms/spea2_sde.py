@@ -238,16 +238,16 @@ def sde_truncation(dist, n_keep: int) -> np.ndarray:
         raise ValueError("dist must not contain NaN off the diagonal")
     np.fill_diagonal(D, np.inf)
     # sort each row once and drop the diagonal entry (column id == row id)
-    order = np.argsort(D, axis=1, kind="stable")
+    order = np.argsort(D, axis=1)
     order = order[order != np.arange(n)[:, None]].reshape(n, n - 1)
     S = np.take_along_axis(D, order, axis=1)
     dead = np.zeros(n, dtype=bool)
     ptr = np.zeros(n, dtype=np.intp)                 # position of each row's nearest living neighbour
+    nearest = order[:, 0].copy()                     # id of that neighbour
+    cur = S[:, 0].copy()                             # distance to it (inf once the row is removed)
     rows = np.arange(n)
     for _ in range(n - n_keep):
-        alive = rows[~dead]
-        first = S[alive, ptr[alive]]
-        cand = alive[first == first.min()]
+        cand = np.flatnonzero(cur == cur.min())
         if cand.size > 1:
             # compare the tied rows over their remaining entries (lexsort is stable: lowest id wins ties)
             live = ~dead[order[cand]]
@@ -255,13 +255,18 @@ def sde_truncation(dist, n_keep: int) -> np.ndarray:
             cand = cand[np.lexsort(sub.T[::-1])]
         victim = cand[0]
         dead[victim] = True
-        # advance the pointers that now point at a dead individual
-        alive = rows[~dead]
-        hit = alive[dead[order[alive, ptr[alive]]]]
+        cur[victim] = np.inf
+        # advance the pointers of the living rows whose nearest neighbour was the victim
+        moved = np.flatnonzero(nearest == victim)
+        moved = moved[~dead[moved]]
+        hit = moved
         while hit.size:
             ptr[hit] += 1
-            hit = hit[ptr[hit] < n - 1]           # a lone survivor has no neighbour left
+            hit = hit[ptr[hit] < n - 1]               # a lone survivor has no neighbour left
             hit = hit[dead[order[hit, ptr[hit]]]]
+        moved = moved[ptr[moved] < n - 1]
+        nearest[moved] = order[moved, ptr[moved]]
+        cur[moved] = S[moved, ptr[moved]]
     return rows[~dead]
 
 
