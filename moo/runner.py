@@ -25,8 +25,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib.metadata import PackageNotFoundError, version
 
+import moocore
 import numpy as np
 from pymoo.core.callback import Callback
+from pymoo.core.population import Population
 
 from moo.algorithms import make_algorithm
 from moo.indicators import hypervolume
@@ -51,7 +53,9 @@ class RunResult:
     """The record of one run (see :func:`run`); :meth:`to_dict` gives its JSON form.
 
     ``F``/``X`` are the objectives and decision vectors of the final
-    non-dominated set; ``hv_history`` is an ``(n_gen, 2)`` array of
+    non-dominated set (of the final population together with the algorithm's
+    ``opt``, finite and feasible individuals only, duplicates in objective
+    space removed); ``hv_history`` is an ``(n_gen, 2)`` array of
     (evaluations used, hypervolume) after each generation, the initial one
     included.
     """
@@ -102,6 +106,25 @@ class RunResult:
                 f"hv={self.hv:.6g}, {self.wall_time:.2f} s)")
 
 
+def _front(algorithm) -> tuple[np.ndarray, np.ndarray]:
+    """Objectives and decisions of the non-dominated set of population + ``opt``.
+
+    Only individuals with finite objectives (and feasible ones, for constrained
+    problems) count; of duplicate objective vectors the first is kept.
+    """
+    pool = algorithm.pop if algorithm.opt is None else Population.merge(algorithm.pop, algorithm.opt)
+    F = np.asarray(pool.get("F"), dtype=float)
+    X = np.asarray(pool.get("X"), dtype=float)
+    keep = np.all(np.isfinite(F), axis=1)
+    if algorithm.problem.has_constraints():
+        keep &= np.asarray(pool.get("FEAS"), dtype=bool).ravel()
+    F, X = F[keep], X[keep]
+    if len(F) == 0:
+        return F, X
+    nd = moocore.is_nondominated(F, keep_weakly=False)
+    return F[nd], X[nd]
+
+
 class _HVHistory(Callback):
     def __init__(self, ref_point: np.ndarray, progress: Callable[[int, int], None] | None, budget: int):
         super().__init__()
@@ -110,8 +133,8 @@ class _HVHistory(Callback):
 
     def notify(self, algorithm):
         n_eval = algorithm.evaluator.n_eval
-        F = algorithm.opt.get("F") if algorithm.opt is not None and len(algorithm.opt) else None
-        hv = 0.0 if F is None else hypervolume(F, self.ref_point)
+        F, _ = _front(algorithm)
+        hv = hypervolume(F, self.ref_point) if len(F) else 0.0
         self.rows.append((n_eval, hv))
         if self.progress is not None:
             self.progress(n_eval, self.budget)
@@ -179,9 +202,7 @@ def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | Non
         alg.next()
     wall = time.perf_counter() - start
 
-    opt = alg.opt
-    F = np.asarray(opt.get("F"), dtype=float)
-    X = np.asarray(opt.get("X"), dtype=float)
+    F, X = _front(alg)
     return RunResult(
         problem=problem.lower(), n_obj=prob.n_obj, algorithm=algorithm.lower(), molsp=bool(molsp),
         max_leaders=max_leaders, seed=seed, pop_size=int(alg.pop_size), budget=evals,

@@ -46,7 +46,8 @@ def test_run_zdt1_nsga2_record(tmp_path):
     assert np.all((X >= 0) & (X <= 1))
     # the objectives are those of the decision vectors (pymoo's own ZDT1)
     assert np.allclose(get_problem("zdt1").evaluate(X), F, rtol=1e-12, atol=0)
-    # the final set is non-dominated
+    # the final set is non-dominated, without repeated objective vectors
+    assert len(np.unique(F, axis=0)) == len(F)
     for i in range(len(F)):
         dominated = np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)
         assert not dominated.any()
