@@ -208,9 +208,10 @@ def write_csv(path: Path, mse: dict, names: list[str]) -> None:
                     w.writerow([obj, name, ov, f"{mse[obj][name][i]:.10e}"])
 
 
-def _sci_tex(x: float) -> str:
+def _sci_tex(x: float, bold: bool = False) -> str:
     m, e = f"{x:.3e}".split("e")
-    return f"${m}\\times10^{{{int(e)}}}$"
+    body = f"{m}\\times10^{{{int(e)}}}"
+    return f"$\\mathbf{{{body}}}$" if bold else f"${body}$"
 
 
 def write_markdown(path: Path, mse: dict, names: list[str]) -> None:
@@ -250,8 +251,7 @@ def write_latex(path: Path, mse: dict, names: list[str]) -> None:
         for j, name in enumerate(names):
             cells = []
             for i in range(4):
-                c = _sci_tex(mse[obj][name][i])
-                cells.append(r"\textbf{" + c + "}" if best[i] == name else c)
+                cells.append(_sci_tex(mse[obj][name][i], bold=best[i] == name))
             first = rf"\multirow{{{len(names)}}}{{*}}{{$f_{obj[1]}$}}" if j == 0 else ""
             lines.append(f"{first} & {tex_name.get(name, name)} & " + " & ".join(cells) + r" \\")
         lines.append(r"\hline")
@@ -399,12 +399,19 @@ def run(out: Path, *, z=truck.RLQR_MOP_Z, uncertainty: str = "printed", measure:
             flags.append("saturated steps " + "/".join(str(int(x)) for x in sat))
         if flags:
             log(f"      {d.name}: {'; '.join(flags)}")
+    diverged = [f"{d.name} at {ov} %" for b, d in enumerate(designs)
+                for ov, dv in zip(OVERLOADS, res.diverged[b]) if dv]
+    div_note = ("Diverged runs (stopped at the divergence bound; their MSE is large but finite): "
+                + ", ".join(diverged) + ".") if diverged else ""
     log("[3/4] writing tables ...")
     write_csv(out / "mse_table.csv", mse, names)
     write_markdown(out / "mse_table.md", mse, names)
     write_latex(out / "mse_table.tex", mse, names)
-    table = format_table(mse, names, measure)
+    table = format_table(mse, names, measure) + ("\n" + div_note if div_note else "")
     (out / "mse_table.txt").write_text(table + "\n")
+    if div_note:
+        with open(out / "mse_table.md", "a") as fh:
+            fh.write("\n" + div_note + "\n")
     other = next(m for m in MEASURES if m != measure)
     write_csv(out / f"mse_table_{other}.csv", tables[other], names)
     write_markdown(out / f"mse_table_{other}.md", tables[other], names)
