@@ -185,15 +185,27 @@ class SimulationResult:
 
 
 # -- generic layer -----------------------------------------------------------------------
-def _as_gains(K, name: str = "K") -> np.ndarray:
-    arr = np.asarray(K, dtype=float) if not isinstance(K, (str, bytes)) else None
-    if arr is None or arr.ndim not in (2, 3):
-        shape = None if arr is None else arr.shape
-        raise ValueError(f"{name} must be an (m, n) gain or a (B, m, n) stack of gains, got shape {shape}")
-    return as_batch(arr[None] if arr.ndim == 2 else arr, name, (None, None, None))
+def _as_gains(K, name: str = "K", nan_gains: str = "raise") -> tuple[np.ndarray, np.ndarray]:
+    """(B, m, n) gains and a (B,) mask of gains with non-finite entries (zeroed)."""
+    if isinstance(K, (str, bytes)):
+        raise TypeError(f"{name} must be an array of numbers, got {type(K).__name__}")
+    try:
+        arr = np.array(K, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of real numbers") from None
+    if arr.ndim not in (2, 3):
+        raise ValueError(f"{name} must be an (m, n) gain or a (B, m, n) stack of gains, got shape {arr.shape}")
+    arr = arr[None] if arr.ndim == 2 else arr
+    if nan_gains not in ("raise", "flag"):
+        raise ValueError(f"nan_gains must be 'raise' or 'flag', got {nan_gains!r}")
+    bad = ~np.isfinite(arr).all(axis=(1, 2))
+    if nan_gains == "raise":
+        return as_batch(arr, name, (None, None, None)), bad
+    arr[bad] = 0.0
+    return arr, bad
 
 
-def _time_matrices(M, name: str, S_T: tuple[int, int] | None, rows: int, cols: int | None):
+def _time_matrices(M, name: str, rows: int, cols: int | None):
     """Return M as (S, T, rows, cols) (a broadcast view when constant in time)."""
     arr = np.asarray(M, dtype=float)
     if arr.ndim == 2:
@@ -209,8 +221,8 @@ def _time_matrices(M, name: str, S_T: tuple[int, int] | None, rows: int, cols: i
 
 def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None, input_map=None,
                     bound: float = DEFAULT_BOUND, keep_trajectories: bool = True,
-                    objectives: Sequence[int] | None = None, dt: float | None = None
-                    ) -> SimulationResult:
+                    objectives: Sequence[int] | None = None, dt: float | None = None,
+                    nan_gains: str = "raise") -> SimulationResult:
     """Simulate ``x[k+1] = F x[k] + G u[k] + w[k]``, ``u[k] = sat(M K (x[k] - x_ref[k]) + u_ff[k])``.
 
     All B gains are run on all S plants (scenarios) in one array recursion.
@@ -246,12 +258,17 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
         State indices :meth:`SimulationResult.mse` reports (default all, in order).
     dt : float, optional
         Sampling time, only recorded in the result.
+    nan_gains : {"raise", "flag"}
+        A gain with NaN/inf entries (e.g. a failed design of a batch) raises
+        ``ValueError`` (default), or with ``"flag"`` is not simulated and is
+        reported as diverged at step 0 with every error at ``bound`` (MSE =
+        ``bound**2``).
 
     Returns
     -------
     SimulationResult
     """
-    Kb = _as_gains(K)
+    Kb, bad_gain = _as_gains(K, nan_gains=nan_gains)
     B, m, n = Kb.shape
     x_ref = np.asarray(x_ref, dtype=float)
     if x_ref.ndim == 2:
@@ -264,8 +281,8 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
         raise ValueError(f"x_ref must have shape (T, {n}) or (S, T, {n}), got shape {x_ref.shape}")
     if T < 1:
         raise ValueError("x_ref must have at least one sample (T >= 1)")
-    Fa = _time_matrices(F, "F", None, n, n)
-    Ga = _time_matrices(G, "G", None, n, None)
+    Fa = _time_matrices(F, "F", n, n)
+    Ga = _time_matrices(G, "G", n, None)
     p = Ga.shape[-1]
     S = max(Fa.shape[0], Ga.shape[0], x_ref.shape[0] if x_ref.ndim == 3 else 1)
     for name, arr in (("F", Fa), ("G", Ga)):
@@ -301,12 +318,15 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
         M = as_batch(np.atleast_2d(np.asarray(input_map, dtype=float)), "input_map", (p, m),
                      (f"the plant's inputs, from G", "the controller's inputs, from K"))
         Keff = np.einsum("pm,bmn->bpn", M, Kb)
-    if u_limit is None:
-        lim = None
-    else:
-        lim = np.broadcast_to(np.asarray(u_limit, dtype=float), (p,)).copy() if np.ndim(u_limit) <= 1 else None
+    lim = None
+    if u_limit is not None:
+        try:
+            lim = np.broadcast_to(np.asarray(u_limit, dtype=float), (p,)).copy()
+        except (TypeError, ValueError):
+            lim = None
         if lim is None or not np.all(lim > 0) or not np.all(np.isfinite(lim)):
-            raise ValueError(f"u_limit must be a positive scalar or ({p},) array, got {u_limit!r}")
+            raise ValueError(f"u_limit must be a positive scalar or a ({p},) array (one per plant input), "
+                             f"got {u_limit!r}")
     bound = check_positive_scalar(bound, "bound")
     if x0 is None:
         e0 = np.zeros((S, n))
@@ -329,6 +349,10 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
     E_all = np.empty((T, S, n, B)) if keep_trajectories else None
     U_all = np.empty((T, S, p, B)) if keep_trajectories else None
     e_frozen = np.zeros((S, n, B))
+    if bad_gain.any():
+        alive[:, bad_gain] = False
+        div_step[:, bad_gain] = 0
+        e_frozen[:, :, bad_gain] = bound
     for k in range(T):
         e = x - xr[:, k, :, None]
         bad = np.abs(e).max(axis=1) > bound                       # (S, B)
@@ -392,7 +416,7 @@ def _scenarios(overloads, T: int):
 def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParameters | None = None,
              nominal_overload: float = 0.0, steer_limit: float | None = _truck.STEER_LIMIT,
              feedforward: bool = True, x0=DEFAULT_INITIAL_ERROR, bound: float = DEFAULT_BOUND,
-             keep_trajectories: bool = True) -> SimulationResult:
+             keep_trajectories: bool = True, nan_gains: str = "raise") -> SimulationResult:
     """Truck path following: B gains x S payload scenarios over ``path``.
 
     The true plant is the truck at each scenario's overload; the controller
@@ -434,6 +458,10 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParam
         Divergence bound (see the module docstring).
     keep_trajectories : bool
         False keeps only the MSE sums (for optimisers).
+    nan_gains : {"raise", "flag"}
+        ``"flag"``: gains with NaN entries (failed designs, e.g.
+        ``RLQRBatch.K`` where ``ok`` is False) are reported as diverged at
+        step 0 with MSE ``bound**2`` instead of raising.
 
     Returns
     -------
@@ -448,7 +476,7 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParam
     if abs(path.speed - p.v) > 1e-9 * p.v or abs(path.dt - p.dt) > 1e-12:
         raise ValueError(f"path speed/dt ({path.speed:g} m/s, {path.dt:g} s) must equal the model's "
                          f"({p.v:g} m/s, {p.dt:g} s)")
-    Kb = _as_gains(K)
+    Kb, _ = _as_gains(K, nan_gains=nan_gains)
     if Kb.shape[2] != 4:
         raise ValueError(f"K must have 4 columns (the truck's states), got shape {np.shape(K)}")
     T = path.T
@@ -468,10 +496,11 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParam
     x_ref, a_ff = _truck.reference_states(path.kappa, nominal_overload, params=p)
     if not feedforward:
         a_ff = np.zeros_like(a_ff)
-    res = simulate_linear(Kb, F, G, x_ref, u_ff=a_ff[:, None], w=w, x0=x0, u_limit=steer_limit,
+    K_in = np.asarray(K, dtype=float)
+    res = simulate_linear(K_in if K_in.ndim == 3 else K_in[None], F, G, x_ref, u_ff=a_ff[:, None], w=w, x0=x0, u_limit=steer_limit,
                           input_map=np.ones((1, Kb.shape[1])), bound=bound,
                           keep_trajectories=keep_trajectories, objectives=_truck.OBJECTIVE_STATES,
-                          dt=p.dt)
+                          dt=p.dt, nan_gains=nan_gains)
     return SimulationResult(res.errors, res.inputs, res.sq_error_sum, res.sq_state_sum, res.diverged,
                             res.diverged_step, res.saturated_steps, res.x_ref, res.objectives, res.T,
                             res.dt, path, scen)

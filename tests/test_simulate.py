@@ -191,6 +191,10 @@ def test_bad_inputs(K_lqr):
         simulate_linear(np.zeros((2, 4)), np.eye(4), np.ones((4, 1)), np.zeros((5, 4)))
     with pytest.raises(ValueError, match="u_limit"):
         simulate_linear(np.zeros((1, 4)), np.eye(4), np.ones((4, 1)), np.zeros((5, 4)), u_limit=-1.0)
+    with pytest.raises(ValueError, match="u_limit"):
+        simulate_linear(np.zeros((1, 4)), np.eye(4), np.ones((4, 1)), np.zeros((5, 4)), u_limit=[1.0, 2.0])
+    with pytest.raises(ValueError, match="u_limit"):
+        simulate_linear(np.zeros((1, 4)), np.eye(4), np.ones((4, 1)), np.zeros((5, 4)), u_limit="big")
     with pytest.raises(ValueError, match="F"):
         simulate_linear(np.zeros((1, 4)), np.eye(3), np.ones((4, 1)), np.zeros((5, 4)))
 
@@ -217,3 +221,16 @@ def test_integrated_pose_agrees_with_path_frame(K_lqr):
     np.testing.assert_allclose(Xi[..., 0], Xp[..., 0])
     with pytest.raises(ValueError, match="method"):
         res.pose("gps")
+
+
+def test_nan_gains_flagged_or_rejected(K_lqr):
+    path = ReferencePath.straight(10.0)
+    K = np.stack([K_lqr, np.full((1, 4), np.nan)])
+    with pytest.raises(ValueError, match="finite"):
+        simulate(K, path)
+    res = simulate(K, path, [0.0, 100.0], nan_gains="flag", bound=50.0)
+    assert res.diverged.tolist() == [[False, False], [True, True]]
+    assert np.all(res.diverged_step[1] == 0)
+    np.testing.assert_allclose(res.mse()[1], 50.0**2)
+    ok = simulate(K_lqr, path, [0.0, 100.0])
+    np.testing.assert_allclose(res.mse()[0], ok.mse()[0], rtol=1e-12)
