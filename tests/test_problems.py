@@ -48,7 +48,7 @@ def _generic_reference(z, *, deltas, x0s, horizon, Q=np.eye(3), R=np.eye(1), agg
     for zi in np.atleast_2d(z):
         try:
             ctrl = rc.design("rlqr", rc.Plant(F, G, dt=1.0), zi[None, :3], zi[None, 3:4],
-                             10.0 ** np.sqrt(zi[4]), Q=Q, R=R, H=H)
+                             10.0 ** np.sqrt(zi[4]), Q=Q, R=R, H=H, max_iter=1000)
         except (rc.ConvergenceError, rc.RankConditionError):
             out.append(np.full(3, 2 * penalty))
             continue
@@ -208,6 +208,7 @@ def test_generic_decode():
     (dict(Q=-np.eye(3)), ValueError, "Q"),
     (dict(R=np.eye(2)), ValueError, "R"),
     (dict(alpha=0.0), ValueError, "alpha"),
+    (dict(max_iter=0), ValueError, "max_iter"),
     (dict(deltas=[0.5, 1.5]), ValueError, "deltas"),
     (dict(deltas=np.ones((2, 2))), ValueError, "deltas"),
     (dict(deltas=[np.nan]), ValueError, "deltas"),
@@ -234,6 +235,8 @@ def test_generic_bad_population(generic):
         generic.decode(np.zeros((2, 4)))
     with pytest.raises(ValueError, match="finite"):
         generic.decode(np.full(5, np.nan))
+    with pytest.raises(ValueError, match="log10 mu"):
+        generic.decode([1.0, 1.0, 1.0, 1.0, -1.0])
 
 
 # ------------------------------------------------------------------ applied --
@@ -266,7 +269,8 @@ def _applied_reference(z, problem, *, aggregate="mean"):
     for zi in np.atleast_2d(z):
         try:
             K = rc.design("rlqr", truck.truck_plant(0.0, doubled=True), zi[None, :4], zi[None, 4:6],
-                          10.0 ** np.sqrt(zi[6]), Q=problem.Q, R=problem.R, H=np.ones((4, 1))).K
+                          10.0 ** np.sqrt(zi[6]), Q=problem.Q, R=problem.R, H=np.ones((4, 1)),
+                          max_iter=problem.max_iter).K
         except (rc.ConvergenceError, rc.RankConditionError):
             out.append(np.full(4, 2 * pen))
             continue
@@ -371,6 +375,7 @@ def test_applied_extreme_population_is_finite(applied_short):
     (dict(R=np.eye(1)), ValueError, "R"),
     (dict(R=np.diag([1.0, -1.0])), ValueError, "R"),
     (dict(alpha=-0.1), ValueError, "alpha"),
+    (dict(max_iter=10.5), TypeError, "max_iter"),
     (dict(path="default"), TypeError, "path"),
     (dict(overloads=[]), ValueError, "overloads"),
     (dict(overloads=[0.0, -10.0]), ValueError, "overloads"),

@@ -39,8 +39,8 @@ from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
 from robustctl.simulate import DEFAULT_BOUND, simulate
 
-from .generic import (_as_population, _check_aggregate, _check_penalty, _check_ref_point, _decode, _penalise,
-                      _spectral_radius, _weights)
+from .generic import (_as_population, _check_aggregate, _check_int, _check_penalty, _check_ref_point, _decode,
+                      _penalise, _spectral_radius, _weights)
 
 __all__ = ["AppliedRLQRProblem"]
 
@@ -88,6 +88,9 @@ class AppliedRLQRProblem(Problem):
         split evenly costs what it costs on the single-column plant.
     alpha : float
         RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin.
+    max_iter : int
+        Recursion steps of :func:`robustctl.rlqr_gains` before its Newton phase
+        (default 1000; see :class:`~moo.problems.generic.GenericRLQRProblem`).
     path : ReferencePath, optional
         Reference path (default :func:`robustctl.path.default_route`, 540 s).
     overloads : sequence of float
@@ -139,6 +142,7 @@ class AppliedRLQRProblem(Problem):
         Q=None,
         R=None,
         alpha: float = 0.1,
+        max_iter: int = 1000,
         path: ReferencePath | None = None,
         overloads=(0.0, 100.0),
         aggregate: Literal["mean", "max"] = "mean",
@@ -152,6 +156,7 @@ class AppliedRLQRProblem(Problem):
         Q_default, R_default = truck.lqr_weights(doubled=True)
         self.Q, self.R = _weights(Q_default if Q is None else Q, R_default if R is None else R, n, m)
         self.alpha = check_positive_scalar(alpha, "alpha")
+        self.max_iter = _check_int(max_iter, "max_iter", 1)
         if path is None:
             path = default_route()
         elif not isinstance(path, ReferencePath):
@@ -175,14 +180,13 @@ class AppliedRLQRProblem(Problem):
     def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(EF (B, 1, 4), EG (B, 1, 2), mu (B,))`` of a population ``z`` (B, 7) or one ``z`` (7,)."""
         z = _as_population(z, self.n_var)
-        if np.any(z[:, -1] < 0):
-            raise ValueError(f"z[:, 6] = (log10 mu)^2 must be >= 0, got {z[:, -1].min():g}")
         return _decode(z, self.plant.n, self.plant.m)
 
     def gains(self, z) -> "rc.RLQRBatch":
         """The batched RLQR design of a population ``z`` (B, 7)."""
         EF, EG, mu = self.decode(z)
-        return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha)
+        return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
+                             max_iter=self.max_iter)
 
     def closed_loop_radius(self, K: np.ndarray) -> np.ndarray:
         """Spectral radius (B, S) of ``F_s + G_s [1 1] K`` at each scenario payload (NaN for non-finite K)."""
