@@ -44,16 +44,17 @@ and ``n`` the size of the set being ranked (archive plus offspring):
 
 Readings where the papers leave a choice
 ----------------------------------------
-* Normalisation. ``sd`` is scale dependent. [1] applies SDE to the objective
-  values of its (commensurable) test problems; PlatEMO's implementation, on
-  which the Morais et al. (2022) experiments ran, uses the raw objectives.
-  The control-design problems of this project have objectives of very
-  different magnitudes, so by default (``normalize=True``) the objectives are
-  mapped to ``[0, 1]`` by the minimum and maximum of the set being ranked
-  before the distances are computed (an objective with zero range maps to
-  0). The map is increasing in every objective, so dominance, ``S`` and ``R``
-  are unchanged; only the densities depend on it. ``normalize=False`` gives
-  the raw-objective form.
+* Normalisation. ``sd`` is scale dependent and [1] defines it on the
+  objective values; PlatEMO's implementation, on which the Morais et al.
+  (2022) experiments ran, uses the raw objectives. The control-design
+  problems of this project have objectives of very different magnitudes, so
+  by default (``normalize=True``) the objectives are mapped to ``[0, 1]`` by
+  the minimum and maximum of the set being ranked before the distances are
+  computed (an objective with zero range maps to 0); the truncation uses the
+  same normalised distances. The map is increasing in every objective, so
+  dominance, ``S`` and ``R`` are unchanged; only the densities depend on it.
+  ``normalize=False`` gives the raw-objective form. On DTLZ2 (commensurable
+  objectives) the two give IGDs within the seed-to-seed spread.
 * Population and archive have the same size ``N`` (92 by default), as in [1]
   and in the paper being reproduced.
 * Survival is a function of the set it receives (no hidden state), so it can
