@@ -359,7 +359,7 @@ def default_route(*, speed: float = DEFAULT_SPEED, dt: float = 0.1,
     """The reference path of the paper reproduction (the paper does not publish its path).
 
     A 9.0 km road for a heavy truck at 60 km/h (about 540 s, over the paper's
-    "more than 400 s"): straights, four lane changes of 3.5 m (one lane) over
+    "more than 400 s"): straights, five lane changes of 3.5 m (one lane) over
     120-150 m, and bends of radius 200-500 m (lateral acceleration at most
     ``v^2/R = 1.4 m/s^2``, comfortable for a truck) entered through clothoid
     transitions of 60-80 m, as road design prescribes at this speed. The

@@ -60,7 +60,8 @@ class SimulationResult:
     diverged_step : (B, S) ndarray of int
         First step beyond the bound, -1 if none.
     saturated_steps : (B, S) ndarray of int
-        Steps at which an input was at its limit.
+        Steps at which an input was at its limit (after divergence the frozen
+        run's input keeps being counted).
     x_ref : (T, n) or (S, T, n) ndarray
     objectives : tuple of int
         State indices :meth:`mse` reports, in order.
@@ -338,7 +339,9 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
     if any(i < 0 or i >= n for i in objectives):
         raise ValueError(f"objectives must be state indices in [0, {n}), got {objectives}")
 
-    # state layout (S, n, B): one batched matmul per step
+    # State layout (S, n, B): one batched matmul per step. A frozen (diverged)
+    # run keeps x = x_ref + e_frozen, so its error stays e_frozen (|e| <= bound)
+    # and the cheap global bound check below stays false for it.
     x = (xr[:, 0] + e0)[:, :, None] * np.ones((1, 1, B))
     KT = np.ascontiguousarray(np.transpose(Keff, (1, 2, 0)))    # (p, n, B)
     sq = np.zeros((S, n, B))
@@ -349,35 +352,40 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
     E_all = np.empty((T, S, n, B)) if keep_trajectories else None
     U_all = np.empty((T, S, p, B)) if keep_trajectories else None
     e_frozen = np.zeros((S, n, B))
-    if bad_gain.any():
+    any_dead = bool(bad_gain.any())
+    if any_dead:
         alive[:, bad_gain] = False
         div_step[:, bad_gain] = 0
         e_frozen[:, :, bad_gain] = bound
+        x = np.where(alive[:, None, :], x, xr[:, 0, :, None] + e_frozen)
+    alive3 = alive[:, None, :]                                   # view: follows alive
+    if lim is not None:
+        lo, hi = -lim[None, :, None], lim[None, :, None]
     for k in range(T):
         e = x - xr[:, k, :, None]
-        bad = np.abs(e).max(axis=1) > bound                       # (S, B)
-        newly = bad & alive
-        if newly.any():
+        if np.abs(e).max() > bound:                              # rare: someone diverges now
+            newly = (np.abs(e).max(axis=1) > bound) & alive
             div_step[newly] = k
-            alive &= ~bad
+            alive &= ~newly
+            any_dead = True
             e_frozen = np.where(newly[:, None, :], np.clip(e, -bound, bound), e_frozen)
-        if not alive.all():
-            e = np.where(alive[:, None, :], e, e_frozen)
+            e = np.where(alive3, e, e_frozen)
+            x = np.where(alive3, x, xr[:, k, :, None] + e_frozen)
         # u[s, p, b] = sum_n Keff[b, p, n] e[s, n, b]
         u = np.einsum("pnb,snb->spb", KT, e) + uff[:, k, :, None]
         if lim is not None:
-            at_lim = np.abs(u) >= lim[None, :, None]
-            u = np.clip(u, -lim[None, :, None], lim[None, :, None])
-            sat_steps += at_lim.any(axis=1) & alive
+            sat = (u <= lo) | (u >= hi)
+            sat_steps += sat[:, 0] if p == 1 else sat.any(axis=1)
+            u = np.minimum(np.maximum(u, lo), hi)
         sq += e * e
-        xs = e + xr[:, k, :, None]
-        sqx += xs * xs
+        sqx += x * x
         if keep_trajectories:
             E_all[k] = e
             U_all[k] = u
         if k + 1 < T:
-            x_new = Fa[:, k] @ x + Ga[:, k] @ u + wa[:, k, :, None]
-            x = np.where(alive[:, None, :], x_new, x)
+            x = Fa[:, k] @ x + Ga[:, k] @ u + wa[:, k, :, None]
+            if any_dead:
+                x = np.where(alive3, x, xr[:, k + 1, :, None] + e_frozen)
     errors = inputs = None
     if keep_trajectories:
         errors = np.transpose(E_all, (3, 1, 0, 2))    # (B, S, T, n)
