@@ -136,30 +136,35 @@ def igd_ns(Q, reference) -> float:
     return float(D.min(axis=0).sum() + D.min(axis=1)[~contributing].sum())
 
 
-def _two_nearest(DT: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Row-wise indices of the smallest and second-smallest entries (ties: lower index first)."""
-    two = np.argpartition(DT, 1, axis=1)[:, :2]
+def _two_nearest(DT: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Row-wise nearest and second-nearest columns of ``DT`` and their values (ties: lower index first).
+
+    Two ``argmin`` passes (much faster than ``argpartition`` on short rows);
+    ``DT`` is modified during the call and restored.
+    """
     rows = np.arange(DT.shape[0])
-    a, b = two[:, 0], two[:, 1]
-    da, db = DT[rows, a], DT[rows, b]
-    swap = (db < da) | ((db == da) & (b < a))
-    return np.where(swap, b, a), np.where(swap, a, b)
+    i1 = DT.argmin(axis=1)
+    v1 = DT[rows, i1]
+    DT[rows, i1] = np.inf
+    i2 = DT.argmin(axis=1)
+    v2 = DT[rows, i2]
+    DT[rows, i1] = v1
+    return i1, i2, v1, v2
 
 
-def _scores(n1, n2, d1, d2, con, alive) -> np.ndarray:
+def _relative_scores(n1, n2, d1, d2, con, alive) -> tuple[np.ndarray, float]:
+    """Deletion scores minus the current IGD-NS value (and that value); ``inf`` for dead candidates."""
     n = len(alive)
-    contributing = np.zeros(n, dtype=bool)
-    contributing[n1] = True
+    contributing = np.bincount(n1, minlength=n) > 0
     noncontrib = alive & ~contributing
-    total = d1.sum() + con[noncontrib].sum()
-    scores = np.full(n, np.inf)
-    scores[noncontrib] = total - con[noncontrib]
-    increase = np.bincount(n1, weights=d2 - d1, minlength=n)
+    delta = np.bincount(n1, weights=d2 - d1, minlength=n)
     # S(x) = {n2(y) : n1(y) = x} minus the contributing set, each member counted once
-    pairs = np.unique((n1 * n + n2)[noncontrib[n2]])
-    promoted = np.bincount(pairs // n, weights=con[pairs % n], minlength=n)
-    scores[contributing] = total + increase[contributing] - promoted[contributing]
-    return scores
+    promoted = noncontrib[n2]
+    if promoted.any():
+        pairs = np.unique(n1[promoted] * n + n2[promoted])
+        delta -= np.bincount(pairs // n, weights=con[pairs % n], minlength=n)
+    total = float(d1.sum() + con[noncontrib].sum())
+    return np.where(contributing, delta, np.where(noncontrib, -con, np.inf)), total
 
 
 def igd_ns_deletion_scores(D: np.ndarray, alive: np.ndarray) -> np.ndarray:
@@ -197,10 +202,9 @@ def igd_ns_deletion_scores(D: np.ndarray, alive: np.ndarray) -> np.ndarray:
                          f"got D {D.shape} and alive {alive.shape}")
     if alive.sum() < 2:
         raise ValueError(f"at least two candidates must be alive, got {int(alive.sum())}")
-    DT = np.where(alive[None, :], D.T, np.inf)
-    n1, n2 = _two_nearest(DT)
-    cols = np.arange(D.shape[1])
-    return _scores(n1, n2, DT[cols, n1], DT[cols, n2], D.min(axis=1), alive)
+    n1, n2, d1, d2 = _two_nearest(np.where(alive[None, :], D.T, np.inf))
+    relative, total = _relative_scores(n1, n2, d1, d2, D.min(axis=1), alive)
+    return total + relative
 
 
 def reduce_by_igd_ns(F, reference, n_keep: int) -> np.ndarray:
@@ -224,16 +228,17 @@ def reduce_by_igd_ns(F, reference, n_keep: int) -> np.ndarray:
         raise ValueError("reference must contain at least one point")
     DT = cdist(R, F)                          # (r, n): one row per reference point
     con = DT.min(axis=0)
-    cols = np.arange(len(R))
     alive = np.ones(n, dtype=bool)
-    n1, n2 = _two_nearest(DT)
-    for _ in range(n - n_keep):               # one vectorised scoring per deletion
-        x = int(np.argmin(_scores(n1, n2, DT[cols, n1], DT[cols, n2], con, alive)))
+    n1, n2, d1, d2 = _two_nearest(DT)
+    for step in range(n - n_keep):            # one vectorised scoring per deletion
+        x = int(np.argmin(_relative_scores(n1, n2, d1, d2, con, alive)[0]))
         alive[x] = False
+        if step == n - n_keep - 1:
+            break
         DT[:, x] = np.inf
-        stale = (n1 == x) | (n2 == x)
-        if np.any(stale) and alive.sum() >= 2:
-            n1[stale], n2[stale] = _two_nearest(DT[stale])
+        stale = np.flatnonzero((n1 == x) | (n2 == x))
+        if stale.size:
+            n1[stale], n2[stale], d1[stale], d2[stale] = _two_nearest(DT[stale])
     return np.flatnonzero(alive)
 
 
@@ -258,16 +263,16 @@ def truncate_by_angle(F, max_size: int, random_state=None) -> np.ndarray:
         return np.sort(random_state.choice(extremes, size=max_size, replace=False))
     V = F - F.min(axis=0)
     V = V / np.maximum(np.linalg.norm(V, axis=1, keepdims=True), 1e-300)
-    chosen = np.zeros(n, dtype=bool)
-    chosen[extremes] = True
+    # score = largest cosine similarity to the kept rows, +inf for the kept rows themselves
+    # (row by row: a full n x n product costs more than the rows actually needed)
+    score = np.max(V @ V[extremes].T, axis=1)
+    score[extremes] = np.inf
     order = list(extremes)
-    max_cos = (V @ V[extremes].T).max(axis=1)
     for _ in range(max_size - len(extremes)):
-        candidate = np.where(chosen, np.inf, max_cos)
-        k = int(np.argmin(candidate))
-        chosen[k] = True
+        k = int(np.argmin(score))
         order.append(k)
-        max_cos = np.maximum(max_cos, V @ V[k])
+        np.maximum(score, V @ V[k], out=score)
+        score[k] = np.inf
     return np.asarray(order, dtype=int)
 
 

@@ -145,7 +145,12 @@ def asf_matrix(F_norm: np.ndarray, weights: np.ndarray) -> np.ndarray:
         ``ASF[n, k] = max_i F_norm[n, i] / weights[k, i]``.
     """
     W = np.maximum(np.asarray(weights, dtype=float), ZERO_WEIGHT)
-    return np.max(F_norm[:, None, :] / W[None, :, :], axis=2)
+    F_norm = np.asarray(F_norm, dtype=float)
+    # one (N, K) pass per objective: faster than reducing a (N, K, M) array over its short last axis
+    out = F_norm[:, :1] / W[None, :, 0]
+    for i in range(1, W.shape[1]):
+        np.maximum(out, F_norm[:, i:i + 1] / W[None, :, i], out=out)
+    return out
 
 
 def r2_ranking(F: np.ndarray, weights: np.ndarray, ideal: np.ndarray, nadir: np.ndarray
