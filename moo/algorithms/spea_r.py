@@ -64,6 +64,9 @@ Readings where the paper leaves room (all deliberate):
   of the final population as the result.
 * A point at ``z_min`` (zero normalised vector) has angle 0 to every
   direction and joins direction 0; ties of ``F`` are broken by position.
+* Constraints (not treated in the paper): the survival takes feasible
+  solutions first and fills up with the least violating ones (pymoo's
+  ``Survival`` split); the mating ignores the violation.
 * Individuals with a NaN or infinite objective rank behind all others in
   the survival (:func:`~moo.algorithms.theta_dea.finite_first`) and count
   as infinitely far in the mating; the paper assumes finite objectives.

@@ -49,6 +49,10 @@ Readings where the paper leaves room (all deliberate):
   on constraint violation when the problem has constraints, a no-op
   otherwise) and SBX keeps both children (pymoo's mating); duplicates are
   eliminated as in the project's NSGA-III, for a like-for-like comparison.
+* Constraints (not treated in the paper): the survival takes feasible
+  solutions first and fills up with the least violating ones (pymoo's
+  ``Survival`` split), and the random mating becomes a binary tournament on
+  the violation.
 * Ties in ``F_j`` are broken by position in ``S`` (deterministic).
 * Individuals with a NaN or infinite objective rank behind all others
   (:func:`finite_first`); the paper assumes finite objectives.
