@@ -240,6 +240,15 @@ def test_dtlz1_converges_to_linear_front():
     assert np.median(np.abs(s - 0.5)) < 0.01 and np.mean(np.abs(s - 0.5) < 0.05) >= 0.9, (np.median(s), np.max(s))
 
 
+def test_constrained_problem_returns_feasible_points():
+    # C2-DTLZ2 (one inequality constraint): the final non-dominated set must be feasible (G <= 0) and near the
+    # unit sphere (the feasible part of DTLZ2's front)
+    res = _run(make_spea_r(n_obj=3), get_problem("c2dtlz2", n_obj=3), 3000, 1)
+    assert res.F is not None and len(res.F) > 10
+    assert np.all(res.G <= 0)
+    assert np.median(np.linalg.norm(res.F, axis=1)) < 1.1
+
+
 def test_runs_wrapped_in_molsp():
     molsp = pytest.importorskip("moo.molsp").molsp
     p = get_problem("dtlz2", n_obj=3)
