@@ -241,3 +241,12 @@ def test_runs_wrapped_with_molsp():
     assert res.algorithm.data["molsp_n_eval"] > 0
     again = minimize(problem, molsp(make_bige(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
     np.testing.assert_array_equal(res.pop.get("F"), again.pop.get("F"))
+
+
+def test_constrained_problem_c2dtlz2():
+    # C2-DTLZ2: only regions of the unit sphere are feasible. 3000 evaluations: measured median
+    # | ||f|| - 1 | 0.005-0.013 over seeds 0-2; every survivor feasible.
+    problem = get_problem("c2dtlz2", n_obj=3)
+    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 3000), seed=0)
+    assert np.all(res.pop.get("FEAS"))
+    assert np.median(np.abs(np.linalg.norm(res.F, axis=1) - 1.0)) < 0.03
