@@ -277,7 +277,7 @@ def make_figures(out: Path, res, designs: list[Design], path) -> list[Path]:
     k_bend = int(np.argmax(np.abs(path.kappa)))
     shown = [b for b, d in enumerate(designs) if not res.diverged[b].any()]
     hidden = [d.name for b, d in enumerate(designs) if b not in shown]
-    note = f" ({', '.join(hidden)} not drawn: diverges)" if hidden else ""
+    note = f" ({', '.join(hidden)} not drawn: diverges at some payload, see the table)" if hidden else ""
     start = path.s <= 300.0
     for s, ov in enumerate(OVERLOADS):
         fig = plt.figure(figsize=(14, 9), layout="constrained")
