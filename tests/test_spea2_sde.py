@@ -24,6 +24,7 @@ from moo.algorithms import make_algorithm
 from moo.algorithms.spea2_sde import (
     SPEA2SDE,
     SPEA2SDESurvival,
+    _BinaryTournament,
     _sde_tournament,
     make_spea2_sde,
     sde_fitness,
@@ -266,6 +267,18 @@ def test_tournament_prefers_lower_fitness_cv_first_and_breaks_ties_at_random():
     ties = np.tile([[0, 2]], (200, 1))
     won = _sde_tournament(pop, ties, random_state=np.random.default_rng(1))[:, 0]
     assert set(won) == {0, 2} and 60 < np.sum(won == 0) < 140
+
+
+def test_mating_selection_is_a_binary_tournament_with_replacement():
+    # Fitness 0.1 < 0.2 < 0.3 < 0.4, pairs drawn uniformly with replacement from 4:
+    #   P(best chosen)  = P(0 in the pair) = 1 - (3/4)^2 = 7/16
+    #   P(worst chosen) = P(pair = (3, 3)) = 1/16   (a permutation-based tournament gives 0)
+    pop = _pop(np.zeros((4, 2)))
+    pop.set("sde_fitness", np.array([0.1, 0.2, 0.3, 0.4]))
+    S = _BinaryTournament().do(_Dummy(), pop, 8000, 2, to_pop=False, random_state=np.random.default_rng(0))
+    assert S.shape == (8000, 2)
+    freq = np.bincount(S.ravel(), minlength=4) / S.size
+    np.testing.assert_allclose(freq, [7 / 16, 5 / 16, 3 / 16, 1 / 16], atol=0.015)
 
 
 # ----------------------------------------------------------------------------- whole runs

@@ -29,6 +29,8 @@ applies Pareto dominance in that bi-goal space:
 * mating selection ([1], Alg. 2): binary tournament; the candidate that
   Pareto-dominates the other in ``(f_pr, f_cd)`` wins, otherwise the winner
   is drawn at random. The goals are estimated on the current population;
+  the two candidates are drawn uniformly *with replacement* (the paper does
+  not say; SPEA2's convention and PlatEMO's);
 * environmental selection ([1], Alg. 3 together with Sec. 4): the merged
   population is sorted into Pareto fronts of the *actual* objectives; whole
   fronts are kept while they fit; the goals are estimated on the critical
@@ -66,7 +68,7 @@ import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.operators.selection.tournament import TournamentSelection
+from pymoo.core.selection import Selection
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
@@ -222,6 +224,15 @@ def _bige_tournament(pop, P, random_state=None, **kwargs):
     return winner[:, None].astype(int)
 
 
+class _BinaryTournament(Selection):
+    """Binary tournament with replacement; the goals are estimated once per call on the population."""
+
+    def _do(self, problem, pop, n_select, n_parents, *args, random_state=None, **kwargs):
+        rng = random_state if random_state is not None else np.random.default_rng()
+        P = rng.integers(0, len(pop), size=(n_select * n_parents, 2))
+        return _bige_tournament(pop, P, random_state=rng).reshape(n_select, n_parents)
+
+
 class BiGE(GeneticAlgorithm):
     """BiGE as a pymoo algorithm.
 
@@ -241,7 +252,7 @@ class BiGE(GeneticAlgorithm):
         super().__init__(
             pop_size=pop_size,
             sampling=sampling if sampling is not None else FloatRandomSampling(),
-            selection=TournamentSelection(func_comp=_bige_tournament, pressure=2),
+            selection=_BinaryTournament(),
             crossover=crossover if crossover is not None else paper_crossover(),
             mutation=mutation if mutation is not None else paper_mutation(),
             survival=BiGESurvival(),

@@ -38,9 +38,9 @@ and ``n`` the size of the set being ranked (archive plus offspring):
   distances to the remaining ones is lexicographically smallest (closest
   shifted neighbour, ties by the second closest, ...), recomputing after each
   removal. Exact ties (identical vectors) remove the lowest index;
-* mating selection: binary tournament with replacement on ``F`` (ties at
-  random); infeasible individuals lose to feasible ones and to smaller
-  constraint violations.
+* mating selection ([2], Step 5): binary tournament *with replacement* on
+  the archive, lower ``F`` wins (ties at random); infeasible individuals lose
+  to feasible ones and to smaller constraint violations.
 
 Readings where the papers leave a choice
 ----------------------------------------
@@ -67,7 +67,7 @@ import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.operators.selection.tournament import TournamentSelection
+from pymoo.core.selection import Selection
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 from pymoo.util.display.multi import MultiObjectiveOutput
 
@@ -331,6 +331,15 @@ def _sde_tournament(pop, P, random_state=None, **kwargs):
     return winner[:, None].astype(int)
 
 
+class _BinaryTournament(Selection):
+    """Binary tournament *with replacement* on the archive (Zitzler et al. 2001, Step 5)."""
+
+    def _do(self, problem, pop, n_select, n_parents, *args, random_state=None, **kwargs):
+        rng = random_state if random_state is not None else np.random.default_rng()
+        P = rng.integers(0, len(pop), size=(n_select * n_parents, 2))
+        return _sde_tournament(pop, P, random_state=rng).reshape(n_select, n_parents)
+
+
 class SPEA2SDE(GeneticAlgorithm):
     """SPEA2+SDE as a pymoo algorithm (archive = ``pop``, offspring = population).
 
@@ -352,7 +361,7 @@ class SPEA2SDE(GeneticAlgorithm):
         super().__init__(
             pop_size=pop_size,
             sampling=sampling if sampling is not None else FloatRandomSampling(),
-            selection=TournamentSelection(func_comp=_sde_tournament, pressure=2),
+            selection=_BinaryTournament(),
             crossover=crossover if crossover is not None else paper_crossover(),
             mutation=mutation if mutation is not None else paper_mutation(),
             survival=SPEA2SDESurvival(normalize=normalize),
