@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 from pymoo.indicators.igd import IGD
@@ -256,3 +258,62 @@ def test_runs_wrapped_in_molsp():
     assert res.algorithm.evaluator.n_eval <= 1500 + 92
     assert np.all(np.isfinite(res.F)) and len(res.F) > 10
     assert np.median(np.linalg.norm(res.F, axis=1)) < 1.5
+
+
+# ---------------------------------------------------------------------------------------------
+# property test against a brute-force reference (plain Python loops, no code under test)
+# ---------------------------------------------------------------------------------------------
+
+def _brute_spea_r_survivors(F, n_survive, W):
+    n, M = F.shape
+    dom = [[all(x <= y for x, y in zip(F[i], F[j])) and any(x < y for x, y in zip(F[i], F[j]))
+            for j in range(n)] for i in range(n)]
+    nd = [i for i in range(n) if not any(dom[j][i] for j in range(n))]
+    lo = [min(F[i, m] for i in nd) for m in range(M)]
+    hi = [max(F[i, m] for i in nd) for m in range(M)]
+    rng = [hi[m] - lo[m] if hi[m] - lo[m] > 1e-10 else max(F[:, m]) - lo[m] for m in range(M)]
+    rng = [r if r > 1e-10 else 1.0 for r in rng]
+    norm = lambda v: math.sqrt(sum(x * x for x in v))  # noqa: E731
+    cosang = lambda u, v: sum(a * b for a, b in zip(u, v)) / (norm(u) * norm(v))  # noqa: E731
+    theta_bar = max(min(math.acos(min(1.0, cosang(W[i], W[j]))) for j in range(len(W)) if j != i)
+                    for i in range(len(W)))
+    niche, angle = [], []
+    for i in range(n):
+        fn = [(F[i, m] - lo[m]) / rng[m] for m in range(M)]
+        if norm(fn) == 0:
+            niche.append(0)
+            angle.append(0.0)
+            continue
+        cos = [cosang(fn, w) for w in W]
+        j = max(range(len(W)), key=lambda k: cos[k])
+        niche.append(j)
+        angle.append(math.acos(min(1.0, cos[j])))
+    S = [sum(dom[i]) for i in range(n)]
+    Sl = [sum(1 for j in range(n) if dom[i][j] and niche[j] == niche[i]) for i in range(n)]
+    fit = []
+    for i in range(n):
+        R = sum(S[j] for j in range(n) if dom[j][i])
+        Rl = sum(Sl[j] for j in range(n) if dom[j][i] and niche[j] == niche[i])
+        alone = sum(1 for j in range(n) if niche[j] == niche[i]) == 1
+        fit.append(Rl + angle[i] / (angle[i] + theta_bar) + (0 if alone else R))
+    chosen, left = [], set(range(n))
+    while len(chosen) < n_survive:                       # the paper's rounds, literally
+        H = [min((i for i in left if niche[i] == j), key=lambda i: fit[i]) for j in sorted({niche[i] for i in left})]
+        left -= set(H)
+        if len(chosen) + len(H) <= n_survive:
+            chosen += H
+        else:
+            chosen += sorted(H, key=lambda i: fit[i])[:n_survive - len(chosen)]
+    return set(chosen)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), M=st.sampled_from([2, 3, 4]), extra=st.integers(0, 30))
+def test_survival_matches_brute_force_reference(seed, M, extra):
+    rng = np.random.default_rng(seed)
+    W = get_reference_directions("das-dennis", M, n_partitions={2: 7, 3: 4, 4: 3}[M])
+    n_survive = len(W)
+    F = rng.random((n_survive + extra + 1, M)) ** rng.uniform(0.5, 3.0)
+    F[:, 0] *= 10.0
+    got = set(SPEARSurvival(W).do(_Dummy(M), _pop(F), n_survive=n_survive, random_state=rng, return_indices=True))
+    assert got == _brute_spea_r_survivors(F, n_survive, W)

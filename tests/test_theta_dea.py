@@ -6,8 +6,12 @@ closed forms independent of the code under test).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 from pymoo.indicators.igd import IGD
@@ -297,3 +301,50 @@ def test_runs_wrapped_in_molsp():
     assert res.algorithm.evaluator.n_eval <= 1500 + 92
     assert np.all(np.isfinite(res.F)) and len(res.F) > 10
     assert np.median(np.linalg.norm(res.F, axis=1)) < 1.5
+
+
+# ---------------------------------------------------------------------------------------------
+# property test against a brute-force reference (plain Python loops, no code under test)
+# ---------------------------------------------------------------------------------------------
+
+def _brute_theta_survivors(F, n_survive, ideal, nadir, W, theta):
+    """Reference: Pareto peeling, loop clustering, theta-ranks; returns (S, rank of each member of S)."""
+    n, M = F.shape
+    dom = lambda a, b: all(x <= y for x, y in zip(a, b)) and any(x < y for x, y in zip(a, b))  # noqa: E731
+    remaining, S = list(range(n)), []
+    while len(S) < n_survive:
+        front = [i for i in remaining if not any(dom(F[j], F[i]) for j in remaining if j != i)]
+        S += front
+        remaining = [i for i in remaining if i not in front]
+    info = {}
+    for i in S:
+        fn = [(F[i, m] - ideal[m]) / (nadir[m] - ideal[m]) for m in range(M)]
+        best = None
+        for j, w in enumerate(W):
+            nw = math.sqrt(sum(x * x for x in w))
+            d1 = sum(a * b for a, b in zip(fn, w)) / nw
+            d2 = math.sqrt(sum((fn[m] - d1 * w[m] / nw) ** 2 for m in range(M)))
+            if best is None or d2 < best[0]:
+                best = (d2, j, d1)
+        d2, j, d1 = best
+        th = 1e6 if sum(1 for x in W[j] if x != 0) == 1 else theta
+        info[i] = (j, abs(d1) + th * d2)
+    rank = {i: sum(1 for k in S if info[k][0] == info[i][0] and info[k][1] < info[i][1]) for i in S}
+    return S, rank
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), M=st.sampled_from([2, 3, 4]), extra=st.integers(0, 30))
+def test_survival_matches_brute_force_reference(seed, M, extra):
+    rng = np.random.default_rng(seed)
+    W = get_reference_directions("das-dennis", M, n_partitions={2: 7, 3: 4, 4: 3}[M])
+    n_survive = len(W)
+    F = rng.random((n_survive + extra + 1, M)) ** rng.uniform(0.5, 3.0)      # random shapes, rarely ties
+    F[:, 0] *= 10.0                                                             # unequal scales
+    surv = ThetaSurvival(W, theta=5.0)
+    got = set(surv.do(_Dummy(M), _pop(F), n_survive=n_survive, random_state=rng, return_indices=True))
+    S, rank = _brute_theta_survivors(F, n_survive, surv.norm.ideal_point, surv.norm.nadir_point, W, 5.0)
+    assert len(got) == n_survive and got <= set(S)
+    k = max(rank[i] for i in got)                                   # the theta-front cut
+    assert {i for i in S if rank[i] < k} <= got
+    assert all(rank[i] <= k for i in got)
