@@ -19,6 +19,13 @@ magnitude the run is frozen and flagged (``diverged``, ``diverged_step``), and
 its error is held at its last value clipped to ``[-bound, bound]`` for the rest
 of the horizon. Its MSE is therefore large (up to ``bound**2``), finite, and
 grows the earlier the run diverged - a usable ranking for an optimiser.
+
+References
+----------
+K. J. Astrom & R. M. Murray, *Feedback Systems*, 2nd ed., Princeton 2021,
+Sec. 8.5 (two-degree-of-freedom tracking: feedforward plus feedback on the
+error from a reference trajectory). Morais et al. (2022), Section 4.5.2
+(the four objectives f1..f4 and the payload cases).
 """
 
 from __future__ import annotations
@@ -437,7 +444,8 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParam
     with ``F, G, Gk`` the ZOH model of the true vehicle (:func:`robustctl.models.truck.discretise`),
     ``kappa`` the path curvature, and ``x_ref``, ``alpha_ff`` the nominal
     model's steady cornering along the path (:func:`robustctl.models.truck.reference_states`;
-    ``x_ref = [ydot_ss, v kappa, 0, -ydot_ss / v] kappa``). The steady-state
+    ``x_ref = [beta_1 v, v, 0, -beta_1] kappa`` with ``beta_1`` the nominal
+    sideslip per unit curvature). The steady-state
     steering feedforward is the same for every controller; with it, the
     nominal plant follows a constant-curvature path with zero error, and
     errors come from transients, the initial offset and payload mismatch.
