@@ -48,7 +48,12 @@ union ``Q = P u P'`` of parents and offspring:
    members of ``P`` drawn at random, ``K = 20`` by default - a restricted
    mating that recombines neighbours.
 
-Readings where the paper leaves room (all deliberate):
+Readings where the paper leaves room (all deliberate). Two details above
+were fixed from a public implementation (read for understanding, not
+ported) because the paper's text was not at hand while writing: the value
+``K = 20`` of the mating and the global raw fitness term ``R(x)`` for
+crowded subregions; both are exposed or documented here so they can be
+checked against the paper (``k_mating`` is a keyword argument).
 
 * Population ``N = 92`` with the project's 91 (3 objectives) / 84
   (4 objectives) directions.
