@@ -200,6 +200,17 @@ def test_tournament_bigoal_dominance_cv_first_else_random():
     np.testing.assert_array_equal(S[:, 0], [0, 2])
 
 
+def test_tournament_estimates_goals_on_feasible_individuals_only():
+    # FRONT plus two infeasible points (10, -5). N = 5 -> r = 5^(-1/2) = 0.447 < every distance in
+    # FRONT -> f_cd = 0; feasible-only normalisation keeps FRONT as is: goals (1,0), (0.9,0), (1,0),
+    # so p1 beats p2. Normalising with the infeasible points too would give f_pr = [1, 0.967, 0.933]
+    # and p2 would win instead.
+    pop = _pop(np.vstack([FRONT, [[10.0, -5.0], [10.0, -5.0]]]), cv=[0, 0, 0, 1.0, 2.0])
+    S = _bige_tournament(pop, np.array([[1, 2], [2, 1], [0, 1], [3, 4], [4, 0]]),
+                         random_state=np.random.default_rng(0))
+    np.testing.assert_array_equal(S[:, 0], [1, 1, 1, 3, 0])
+
+
 def test_mating_selection_is_a_binary_tournament_with_replacement():
     # Goals as above: p0 is dominated by p1 and p2, which are mutually non-dominated.
     # Pairs uniform with replacement from 3: p0 wins only (0, 0): 1/9;

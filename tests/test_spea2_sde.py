@@ -269,6 +269,15 @@ def test_tournament_prefers_lower_fitness_cv_first_and_breaks_ties_at_random():
     assert set(won) == {0, 2} and 60 < np.sum(won == 0) < 140
 
 
+def test_tournament_ranks_an_unranked_population_itself():
+    # No stored fitness (a population that never went through the survival): the feasible
+    # individuals are ranked on the spot. (0,0) dominates (1,1) -> R = [0, 1] -> 0 wins.
+    pop = _pop([[0.0, 0.0], [1.0, 1.0], [-1.0, -1.0]], cv=[0.0, 0.0, 3.0])
+    S = _sde_tournament(pop, np.array([[0, 1], [1, 0], [2, 1]]), random_state=np.random.default_rng(0))
+    # the infeasible (-1,-1) would dominate both but loses on CV
+    np.testing.assert_array_equal(S[:, 0], [0, 0, 1])
+
+
 def test_mating_selection_is_a_binary_tournament_with_replacement():
     # Fitness 0.1 < 0.2 < 0.3 < 0.4, pairs drawn uniformly with replacement from 4:
     #   P(best chosen)  = P(0 in the pair) = 1 - (3/4)^2 = 7/16

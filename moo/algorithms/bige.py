@@ -55,7 +55,8 @@ Readings where the paper leaves a choice
   larger ``f_cd``.
 * Constraints: survival works on the feasible individuals first (pymoo's
   ``Survival``, infeasible ones sorted by violation fill any remaining
-  slots); in the tournament a smaller constraint violation wins first.
+  slots); in the tournament a smaller constraint violation wins first and
+  the goals are estimated on the feasible individuals only.
 * Survival keeps no state between calls, so it may be called again on any
   merged population (MO-LSP).
 * The proximity is the plain sum of normalised objectives of Eq. 1 (no
@@ -208,17 +209,21 @@ def _bige_tournament(pop, P, random_state=None, **kwargs):
     rng = random_state if random_state is not None else np.random.default_rng()
     F = pop.get("F").astype(np.float64, copy=False)
     n, m = F.shape
-    f_pr, f_cd = bige_estimation(F, niche_radius(n, m), rng)
-    goals = np.column_stack([f_pr, f_cd])
     cv = pop.get("CV")
     cv = np.zeros(n) if cv is None else np.asarray(cv, dtype=np.float64).reshape(n, -1)[:, 0]
+    feasible = cv <= 0
+    # goals of the feasible individuals (the set the survival ranks); infeasible ones compare by CV
+    goals = np.full((n, 2), np.inf)
+    if feasible.any():
+        f_pr, f_cd = bige_estimation(F[feasible], niche_radius(n, m), rng)
+        goals[feasible] = np.column_stack([f_pr, f_cd])
     a, b = P[:, 0], P[:, 1]
     ga, gb = goals[a], goals[b]
     a_dom = np.all(ga <= gb, axis=1) & np.any(ga < gb, axis=1)
     b_dom = np.all(gb <= ga, axis=1) & np.any(gb < ga, axis=1)
     coin = rng.random(len(P)) < 0.5
     winner = np.where(a_dom, a, np.where(b_dom, b, np.where(coin, a, b)))
-    infeasible = (cv[a] > 0) | (cv[b] > 0)
+    infeasible = ~(feasible[a] & feasible[b])
     by_cv = np.where(cv[a] < cv[b], a, np.where(cv[b] < cv[a], b, np.where(coin, a, b)))
     winner = np.where(infeasible, by_cv, winner)
     return winner[:, None].astype(int)

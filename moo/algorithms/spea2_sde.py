@@ -315,16 +315,21 @@ def _sde_tournament(pop, P, random_state=None, **kwargs):
     if P.shape[1] != 2:
         raise ValueError(f"SPEA2+SDE uses a binary tournament, got tournaments of size {P.shape[1]}")
     rng = random_state if random_state is not None else np.random.default_rng()
-    fit = pop.get(_FITNESS)
-    if fit is None or fit.dtype == object or np.any(np.isnan(fit.astype(np.float64))):
-        # population not ranked by the survival (e.g. a user-supplied one): rank it now
-        fit, _, _ = sde_fitness(pop.get("F"))
-    fit = np.asarray(fit, dtype=np.float64)
+    n = len(pop)
     cv = pop.get("CV")
-    cv = np.zeros(len(pop)) if cv is None else np.asarray(cv, dtype=np.float64).reshape(len(pop), -1)[:, 0]
+    cv = np.zeros(n) if cv is None else np.asarray(cv, dtype=np.float64).reshape(n, -1)[:, 0]
+    feasible = cv <= 0
+    fit = pop.get(_FITNESS)
+    if fit.dtype == object:                     # individuals never ranked carry None
+        fit = np.where(np.equal(fit, None), np.nan, fit)
+    fit = fit.astype(np.float64)
+    if np.any(np.isnan(fit[feasible])):
+        # feasible individuals not ranked by the survival (e.g. a user-supplied population):
+        # rank the feasible ones now, as the survival does
+        fit[feasible] = sde_fitness(pop.get("F")[feasible])[0]
     a, b = P[:, 0], P[:, 1]
     coin = rng.random(len(P)) < 0.5
-    infeasible = (cv[a] > 0) | (cv[b] > 0)
+    infeasible = ~(feasible[a] & feasible[b])
     va = np.where(infeasible, cv[a], fit[a])
     vb = np.where(infeasible, cv[b], fit[b])
     winner = np.where(va < vb, a, np.where(vb < va, b, np.where(coin, a, b)))
