@@ -16,9 +16,12 @@ Two layers:
 Diverging runs (an unstable closed loop, or a saturated one that drifts away)
 are not integrated to overflow: once any error component exceeds ``bound`` in
 magnitude the run is frozen and flagged (``diverged``, ``diverged_step``), and
-its error is held at its last value clipped to ``[-bound, bound]`` for the rest
-of the horizon. Its MSE is therefore large (up to ``bound**2``), finite, and
-grows the earlier the run diverged - a usable ranking for an optimiser.
+from then on *every* component of its error is held at ``±bound`` (the sign it
+had at divergence). A run that diverges at step ``k`` therefore has, in every
+objective, an MSE of at least ``(T - k) / T * bound**2``: large, finite, larger
+the earlier it diverged, and never better than a stable run in any single
+objective (which holding the last value would allow, e.g. a small yaw-rate
+error while ``rho`` blows up) - a safe ranking for an optimiser.
 
 References
 ----------
@@ -375,7 +378,7 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
             div_step[newly] = k
             alive &= ~newly
             any_dead = True
-            e_frozen = np.where(newly[:, None, :], np.clip(e, -bound, bound), e_frozen)
+            e_frozen = np.where(newly[:, None, :], np.where(e < 0, -bound, bound), e_frozen)
             e = np.where(alive3, e, e_frozen)
             x = np.where(alive3, x, xr[:, k, :, None] + e_frozen)
         # u[s, p, b] = sum_n Keff[b, p, n] e[s, n, b]

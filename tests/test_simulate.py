@@ -135,6 +135,9 @@ def test_divergence_is_flagged_without_warnings():
         mse = r.mse()
         assert np.all(np.isfinite(mse)) and np.all(mse <= 1e6)
         assert np.all(np.isfinite(r.errors)) and np.max(np.abs(r.errors)) <= 1e3
+        k = r.diverged_step[0, 0]
+        np.testing.assert_array_equal(np.abs(r.errors[0, 0, k:]), 1e3)    # every component at the bound
+        assert np.all(mse >= (path.T - k) / path.T * 1e6)
     # earlier divergence -> larger error; the stable run is not flagged
     assert res.diverged_step[0, 0] < res_sat.diverged_step[0, 0]
     ok = simulate(np.zeros((1, 4)), path, 0.0, x0=np.zeros(4))
