@@ -48,7 +48,7 @@ def _generic_reference(z, *, deltas, x0s, horizon, Q=np.eye(3), R=np.eye(1), agg
     for zi in np.atleast_2d(z):
         try:
             ctrl = rc.design("rlqr", rc.Plant(F, G, dt=1.0), zi[None, :3], zi[None, 3:4],
-                             10.0 ** np.sqrt(zi[4]), Q=Q, R=R, H=H, max_iter=1000)
+                             10.0 ** np.sqrt(zi[4]), Q=Q, R=R, H=H, max_iter=200)
         except (rc.ConvergenceError, rc.RankConditionError):
             out.append(np.full(3, 2 * penalty))
             continue
@@ -158,6 +158,14 @@ def test_generic_unstable_designs_get_finite_penalties(generic):
     assert rho > 1.0
     f = generic.evaluate(z)
     assert np.all(np.isfinite(f)) and np.all(f >= generic.penalty) and np.all(f <= 2 * generic.penalty)
+
+
+def test_generic_slowly_converging_design_is_penalised(generic):
+    """A design (found by an MO-LSP run) whose RLQR recursion does not converge in 20000 steps."""
+    z = np.array([[47.8069, 103.7683, 181.5866, 53.6425, 117.4085]])
+    assert not generic.gains(z).ok[0]                     # capped at max_iter = 200
+    f = generic.evaluate(z)
+    np.testing.assert_array_equal(f, np.full((1, 3), 2 * generic.penalty))
 
 
 def test_generic_not_computable_designs_get_finite_penalties(generic, monkeypatch):

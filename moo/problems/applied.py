@@ -89,8 +89,11 @@ class AppliedRLQRProblem(Problem):
     alpha : float
         RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin.
     max_iter : int
-        Recursion steps of :func:`robustctl.rlqr_gains` before its Newton phase
-        (default 1000; see :class:`~moo.problems.generic.GenericRLQRProblem`).
+        Recursion steps of :func:`robustctl.rlqr_gains` before its Newton phase;
+        a design not converged by then counts as not computable. Default 2000:
+        of 3000 uniformly random designs, the 2710 stable ones converged within
+        12 steps except two with ``E_G1 ~ E_G2`` (a nearly singular split of the
+        doubled column), which took 346 and 872.
     path : ReferencePath, optional
         Reference path (default :func:`robustctl.path.default_route`, 540 s).
     overloads : sequence of float
@@ -142,7 +145,7 @@ class AppliedRLQRProblem(Problem):
         Q=None,
         R=None,
         alpha: float = 0.1,
-        max_iter: int = 1000,
+        max_iter: int = 2000,
         path: ReferencePath | None = None,
         overloads=(0.0, 100.0),
         aggregate: Literal["mean", "max"] = "mean",
