@@ -67,12 +67,13 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.core.selection import Selection
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+from scipy.spatial.distance import cdist
 
 from .operators import POP_SIZE, paper_crossover, paper_mutation
 
@@ -142,8 +143,7 @@ def bige_estimation(F, radius: float, random_state: np.random.Generator) -> tupl
     span = F.max(axis=0) - fmin
     G = (F - fmin) / np.where(span > 0, span, 1.0)
     f_pr = G.sum(axis=1)
-    diff = G[:, None, :] - G[None, :, :]
-    d = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    d = cdist(G, G)
     near = d < radius
     np.fill_diagonal(near, False)
     weight = np.where(f_pr[:, None] < f_pr[None, :], 0.5, 1.5)

@@ -65,9 +65,9 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.core.selection import Selection
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 from pymoo.util.display.multi import MultiObjectiveOutput
 
@@ -124,9 +124,14 @@ def shifted_distances(F) -> np.ndarray:
         ``inf`` on the diagonal. Row ``i`` is the neighbourhood seen from ``i``.
     """
     F = _as_objectives(F)
-    diff = F[None, :, :] - F[:, None, :]          # diff[i, j] = F[j] - F[i]
-    np.maximum(diff, 0.0, out=diff)
-    D = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    n, m = F.shape
+    D = np.zeros((n, n))
+    for k in range(m):                      # a loop over objectives keeps memory at O(n^2)
+        col = F[:, k]
+        step = col[None, :] - col[:, None]  # step[i, j] = F[j, k] - F[i, k]
+        np.maximum(step, 0.0, out=step)
+        D += step * step
+    np.sqrt(D, out=D)
     np.fill_diagonal(D, np.inf)
     return D
 
