@@ -141,11 +141,6 @@ def directional_projection(F: np.ndarray) -> np.ndarray:
     return np.where(s > 0, P, centre)
 
 
-def _kth_sum_inverse(nearest: np.ndarray) -> np.ndarray:
-    with np.errstate(divide="ignore"):
-        return np.sum(1.0 / nearest, axis=1)
-
-
 def select_by_dd_fc(
     P_selected: np.ndarray,
     P_candidates: np.ndarray,
@@ -199,39 +194,36 @@ def select_by_dd_fc(
         raise ValueError("random_state is required with candidate_choice='roulette'")
 
     D_cc = cdist(P_c, P_c)
-    remaining = np.ones(c, dtype=bool)
-    picked: list[int] = []
-    # nearest[i]: the (up to K) smallest distances from candidate i to the selected set,
-    # kept sorted and padded with inf; updated incrementally after every pick.
-    if len(P_s):
-        nearest = np.sort(cdist(P_c, P_s), axis=1)[:, :k]
-    else:
-        nearest = np.empty((c, 0))
-
-    for _ in range(n_select):
-        idx = np.flatnonzero(remaining)
-        if nearest.shape[1] == 0:
-            # nothing selected yet: density among the candidates themselves
-            d = D_cc[np.ix_(idx, idx)]
+    taken = np.zeros(c, dtype=bool)
+    picked = np.empty(n_select, dtype=np.int64)
+    with np.errstate(divide="ignore"):
+        # nearest[i]: the (up to K) smallest distances from candidate i to the selected set,
+        # sorted; updated incrementally after every pick (one column more until it holds K).
+        if len(P_s):
+            nearest = np.sort(cdist(P_c, P_s), axis=1)[:, :k]
+            dd_first = None
+        else:
+            # nothing selected yet: the first pick's density is measured among the candidates
+            d = D_cc.copy()
             np.fill_diagonal(d, np.inf)
-            near = np.sort(d, axis=1)[:, : min(k, len(idx) - 1)]
-            dd = _kth_sum_inverse(near) if near.shape[1] else np.zeros(len(idx))
-        else:
-            dd = _kth_sum_inverse(nearest[idx])
-        order = np.lexsort((idx, dd))[:L]             # smallest DD, ties by index
-        tour = idx[order]
-        if candidate_choice == "best":
-            win = tour[np.lexsort((np.arange(len(tour)), dd[order], fc[tour]))[0]]
-        else:
-            weight = 1.0 / np.maximum(fc[tour], _FC_FLOOR)
-            win = tour[random_state.choice(len(tour), p=weight / weight.sum())]
-        picked.append(int(win))
-        remaining[win] = False
-        new = D_cc[:, win][:, None]
-        merged = np.concatenate([nearest, new], axis=1)
-        merged.sort(axis=1)
-        nearest = merged[:, :k]
-    return np.asarray(picked, dtype=np.int64)
+            near = np.sort(d, axis=1)[:, : min(k, c - 1)]
+            nearest = None
+            dd_first = (1.0 / near).sum(axis=1) if near.shape[1] else np.zeros(c)
+        for step in range(n_select):
+            dd = dd_first if nearest is None else (1.0 / nearest).sum(axis=1)
+            dd[taken] = np.nan                            # NaN sorts after inf: never chosen
+            tour = np.argsort(dd, kind="stable")[: min(L, c - step)]   # least crowded, ties by index
+            if candidate_choice == "best":
+                win = tour[np.argmin(fc[tour])]           # FC ties: smaller DD, then index
+            else:
+                cum = np.cumsum(1.0 / np.maximum(fc[tour], _FC_FLOOR))
+                pos = np.searchsorted(cum, random_state.random() * cum[-1], side="right")
+                win = tour[min(pos, len(tour) - 1)]
+            picked[step] = win
+            taken[win] = True
+            new = D_cc[:, win, None]
+            nearest = new if nearest is None else np.sort(np.concatenate([nearest, new], axis=1), axis=1)[:, :k]
+    return picked
 
 
 class DDFCSurvival(Survival):
