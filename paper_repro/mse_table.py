@@ -17,7 +17,9 @@ Controllers (one Q, R for all: :func:`robustctl.models.truck.lqr_weights`):
 
 Extra rows the paper does not have (``--no-extras`` drops them):
 ``Hinf_polytopic`` (the same H-infinity design made robust over the 0-300 %
-payload polytope) and ``RLQR_A_computed`` / ``RLQR_A_printed`` (the RLQR^A
+payload polytope), ``Hinf_unbounded`` (the nominal H-infinity design without
+the input bound: the aggressive, saturating controller the paper's figures
+describe) and ``RLQR_A_computed`` / ``RLQR_A_printed`` (the RLQR^A
 with the other uncertainty source).
 
 Every controller drives the same truck along the same path
@@ -71,7 +73,7 @@ OBJECTIVE_LABELS = {
     "f4": ("orientation error", "rad"),
 }
 COLORS = {"RLQR_MOP": "tab:blue", "RLQR_A": "tab:orange", "Hinf": "tab:red", "LQR": "tab:green",
-          "Hinf_polytopic": "tab:purple", "RLQR_A_computed": "tab:brown", "RLQR_A_printed": "tab:brown"}
+          "Hinf_polytopic": "tab:purple", "Hinf_unbounded": "tab:pink", "RLQR_A_computed": "tab:brown", "RLQR_A_printed": "tab:brown"}
 # H-infinity disturbance channels (columns of Bw): a 1 m lateral-displacement
 # impulse (the run's initial offset) and the path curvature scaled by the
 # tightest curve of the route (1/200 m).
@@ -100,14 +102,16 @@ def _rlqr(name: str, EF, EG, mu, note: str) -> Design:
     return Design(name, ctrl.K, note)
 
 
-def _hinf(name: str, vertices: list, note: str) -> Design:
+def _hinf(name: str, vertices: list, note: str, input_bound: bool = True) -> Design:
     Q, R = truck.lqr_weights()
     _, _, Gk = truck.discretise(0.0)
     Bw = np.column_stack([[0.0, 0.0, HINF_RHO_IMPULSE, 0.0], Gk[0] * HINF_KAPPA_SCALE])
     Cz = np.vstack([np.sqrt(Q), np.zeros((1, 4))])
     Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
-    ctrl = rc.design("hinf", truck.truck_plant(0.0), Bw=Bw, Cz=Cz, Dzu=Dzu, vertices=vertices or None,
-                     u_max=truck.STEER_LIMIT, w_energy=1.0)
+    bound = dict(u_max=truck.STEER_LIMIT, w_energy=1.0) if input_bound else {}
+    ctrl = rc.design("hinf", truck.truck_plant(0.0), Bw=Bw, Cz=Cz, Dzu=Dzu, vertices=vertices or None, **bound)
+    if not input_bound:
+        return Design(name, ctrl.K, f"{note}; gamma = {ctrl.gamma:.4g}")
     return Design(name, ctrl.K, f"{note}; gamma = {ctrl.gamma:.4g}, guaranteed |alpha| <= "
                                 f"{float(np.max(ctrl.info['u_bound'])):.3g} rad for unit-energy w")
 
@@ -115,7 +119,7 @@ def _hinf(name: str, vertices: list, note: str) -> Design:
 def available_controllers(uncertainty: str = "printed") -> tuple[str, ...]:
     """Names :func:`design_controllers` accepts: the paper's four, then the extra rows."""
     other = "RLQR_A_computed" if uncertainty == "printed" else "RLQR_A_printed"
-    return CONTROLLERS + ("Hinf_polytopic", other)
+    return CONTROLLERS + ("Hinf_polytopic", "Hinf_unbounded", other)
 
 
 def design_controllers(z=truck.RLQR_MOP_Z, uncertainty: str = "printed",
@@ -146,6 +150,9 @@ def design_controllers(z=truck.RLQR_MOP_Z, uncertainty: str = "printed",
                                  f"EG = {np.array2string(u.EG[0], precision=4)}, mu = {u.mu:.3g}"))
         elif name == "Hinf":
             designs.append(_hinf(name, [], "LMI H-infinity, nominal payload, |alpha| <= 0.45 rad input bound"))
+        elif name == "Hinf_unbounded":
+            designs.append(_hinf(name, [], "LMI H-infinity, nominal payload, no input bound",
+                                 input_bound=False))
         elif name == "Hinf_polytopic":
             designs.append(_hinf(name, [truck.truck_plant(300.0)],
                                  "LMI H-infinity over the 0-300 % payload polytope, |alpha| <= 0.45 rad bound"))
@@ -241,6 +248,7 @@ def write_markdown(path: Path, mse: dict, names: list[str]) -> None:
 def write_latex(path: Path, mse: dict, names: list[str]) -> None:
     tex_name = {"RLQR_MOP": r"RLQR$^{MOP}$", "RLQR_A": r"RLQR$^{A}$", "Hinf": r"$\mathcal{H}_\infty$",
                 "LQR": "LQR", "Hinf_polytopic": r"$\mathcal{H}_\infty$ polytopic",
+                "Hinf_unbounded": r"$\mathcal{H}_\infty$ without input bound",
                 "RLQR_A_computed": r"RLQR$^{A}$ (computed)", "RLQR_A_printed": r"RLQR$^{A}$ (printed)"}
     lines = [r"\begin{tabular}{c c c c c c}", r"\hline",
              r"Objective & Controller & \multicolumn{4}{c}{Overload} \\",
@@ -449,7 +457,7 @@ def main(argv=None) -> int:
                     help="only the paper's four controllers (no polytopic H-infinity, no other RLQR^A)")
     ap.add_argument("--controllers", nargs="+", metavar="NAME", default=None,
                     help="controllers to run (default all): RLQR_MOP RLQR_A Hinf LQR Hinf_polytopic "
-                         "RLQR_A_computed (RLQR_A_printed with --uncertainty computed)")
+                         "Hinf_unbounded RLQR_A_computed (RLQR_A_printed with --uncertainty computed)")
     args = ap.parse_args(argv)
     z = truck.RLQR_MOP_Z if args.z is None else tuple(args.z)
     try:
