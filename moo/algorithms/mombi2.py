@@ -62,6 +62,10 @@ Readings where the paper is ambiguous (chosen as a careful reader would)
 * Ranks used by the mating tournament are recomputed on the survivors with
   the updated reference points (the rank of an individual in the population
   it now belongs to).
+* Mating selection: the binary tournament on the R2 rank (the criterion
+  MOMBI-II's ranking provides, and the mating selection of the PlatEMO
+  implementation the reproduced paper's experiments ran on); the authors'
+  C code instead draws the two parents uniformly at random.
 * Infeasible individuals are placed after the feasible ones by pymoo's
   :class:`~pymoo.core.survival.Survival` (least violation first); only
   feasible ones enter the ideal/nadir estimation, as in the authors' code.
