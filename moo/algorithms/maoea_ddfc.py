@@ -52,6 +52,14 @@ Environmental selection on the merged population of parents and offspring:
 
 Readings where the paper leaves room
 ------------------------------------
+* How the FC tournament is decided. The paper describes the environmental
+  selection as "tournament-like"; PlatEMO (on which the reproduced study ran)
+  draws the winner by roulette wheel on ``1/FC``. The roulette is the default;
+  ``candidate_choice="best"`` is the greedy reading. Measured on DTLZ2
+  (3 objectives, 10000 evaluations, 24 seeds) the roulette reaches a mean IGD
+  of about 1.08x NSGA-III's, the greedy choice about 1.4x: FC alone favours
+  directions near the boundary of the front (``FC -> 0`` as any
+  ``f~_i -> 0``), and the greedy choice follows that bias more strictly.
 * FC is computed on the same normalised objectives as DD, so that it does not
   depend on the units of the objectives (the paper's control MOPs have
   objectives of very different scales); PlatEMO translates by the ideal point
