@@ -57,7 +57,7 @@ Readings where the paper leaves room
   draws the winner by roulette wheel on ``1/FC``. The roulette is the default;
   ``candidate_choice="best"`` is the greedy reading. Measured on DTLZ2
   (3 objectives, 10000 evaluations, 24 seeds) the roulette reaches a mean IGD
-  of about 1.08x NSGA-III's, the greedy choice about 1.4x: FC alone favours
+  of about 1.08x NSGA-III's, the greedy choice about 1.4x (8 seeds): FC alone favours
   directions near the boundary of the front (``FC -> 0`` as any
   ``f~_i -> 0``), and the greedy choice follows that bias more strictly.
 * FC is computed on the same normalised objectives as DD, so that it does not
