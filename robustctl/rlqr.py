@@ -413,6 +413,11 @@ class RLQRBatch:
     reason : (B,) str ndarray
         ``"ok"``, ``"rank"`` (``mu = inf`` and ``EG`` not of full row rank),
         ``"not converged"`` or ``"diverged"`` (no stabilising steady state).
+    stabilizing : (B,) bool ndarray
+        ``F + G K`` is Schur stable (the nominal closed loop). For finite
+        ``mu`` the RLQR stabilises its own closed loop ``L``, not necessarily
+        ``F + G K``: a converged design (``ok``) can still destabilise the
+        nominal plant.
     iterations : (B,) int ndarray
         Doubling steps (plus recursion steps where the plain recursion was needed).
     residual : (B,) ndarray
@@ -424,6 +429,7 @@ class RLQRBatch:
     L: np.ndarray
     ok: np.ndarray
     reason: np.ndarray
+    stabilizing: np.ndarray
     iterations: np.ndarray
     residual: np.ndarray
 
@@ -589,7 +595,9 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
         reason[idx[~diverged & ~((res < tol) & stable)]] = "not converged"
     ok = reason == "ok"
     K[~ok], P[~ok], L[~ok] = np.nan, np.nan, np.nan
-    return RLQRBatch(*(_frozen(a) for a in (K, P, L)), ok, reason, iterations, residual)
+    stabilizing = np.zeros(B, dtype=bool)
+    stabilizing[ok] = _spectral_radius(plant.F + plant.G @ K[ok]) < 1.0
+    return RLQRBatch(*(_frozen(a) for a in (K, P, L)), ok, reason, stabilizing, iterations, residual)
 
 
 def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DEFAULT_ALPHA,
@@ -634,6 +642,8 @@ def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DE
     -------
     Controller (steady state; ``info`` holds ``P``, ``L``, ``lambda``,
     ``iterations``, ``residual``) or :class:`RLQRSchedule` (``horizon`` given).
+    For finite ``mu`` the RLQR stabilises its closed loop ``L``; check
+    ``ctrl.is_stabilizing()`` for the nominal ``F + G K``.
 
     Raises
     ------

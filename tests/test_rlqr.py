@@ -219,6 +219,8 @@ def test_batch_flags_instead_of_nan():
     b = rc.rlqr_gains(plant, EF, EG, mu)
     assert list(b.reason) == ["ok", "rank", "ok" if b.ok[2] else b.reason[2]]
     assert b.ok[0] and not b.ok[1]
+    assert b.stabilizing[0] == (np.abs(np.linalg.eigvals(GENERIC_F + GENERIC_G @ b.K[0])).max() < 1)
+    assert not b.stabilizing[1]
     assert np.isfinite(b.K[b.ok]).all() and np.isnan(b.K[~b.ok]).all()
     bad = rc.rlqr_gains(rc.Plant(np.diag([1.5, 0.5, 0.2]), [[1.0], [0.0], [0.0]], 0.1),
                         [[0.0, 1.0, 0.0]], [[1.0]], np.inf)
