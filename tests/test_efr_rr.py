@@ -237,5 +237,6 @@ def test_runs_wrapped_with_molsp():
     res = minimize(problem, molsp(make_efr_rr(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
     assert len(res.pop) == 92 and 1500 <= res.algorithm.evaluator.n_eval < 1500 + 92
     assert res.algorithm.data["molsp_n_eval"] > 0
-    again = minimize(problem, molsp(make_efr_rr(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
+    again = minimize(problem, molsp(make_efr_rr(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500),
+                     seed=2)
     np.testing.assert_array_equal(res.pop.get("F"), again.pop.get("F"))

@@ -214,7 +214,8 @@ def test_survival_any_size_and_repeated_calls():
 # ----------------------------------------------------------------------------- runs
 def _run(seed, n_eval=600, **kw):
     problem = get_problem("dtlz2", n_obj=3, n_var=12)
-    return minimize(problem, make_maoea_ddfc(n_obj=3, **kw), ("n_eval", n_eval), seed=seed).algorithm.pop.get("F")
+    res = minimize(problem, make_maoea_ddfc(n_obj=3, **kw), ("n_eval", n_eval), seed=seed)
+    return res.algorithm.pop.get("F")
 
 
 def test_determinism():
@@ -234,7 +235,8 @@ def test_reused_algorithm_starts_fresh():
 def test_registry_and_defaults():
     alg = make_algorithm("maoea-ddfc", n_obj=4)
     assert isinstance(alg, MaOEADDFC) and alg.pop_size == 92
-    assert (alg.survival.n_neighbors, alg.survival.n_candidates, alg.survival.candidate_choice) == (5, 3, "roulette")
+    s = alg.survival
+    assert (s.n_neighbors, s.n_candidates, s.candidate_choice) == (5, 3, "roulette")
 
 
 @pytest.mark.parametrize("kwargs, exc, word", [

@@ -230,7 +230,10 @@ def select_by_dd_fc(
             picked[step] = win
             taken[win] = True
             new = D_cc[:, win, None]
-            nearest = new if nearest is None else np.sort(np.concatenate([nearest, new], axis=1), axis=1)[:, :k]
+            if nearest is None:
+                nearest = new
+            else:
+                nearest = np.sort(np.concatenate([nearest, new], axis=1), axis=1)[:, :k]
     return picked
 
 
