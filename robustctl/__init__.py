@@ -11,18 +11,11 @@ Sign convention everywhere: ``u = K x``.
 from .controller import Controller
 from .design import design
 from .errors import ConvergenceError, InfeasibleError, RankConditionError, RobustCtlError
+from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .lqr import lqr
 from .plant import Plant
 from .rlqr import RLQRBatch, rlqr, rlqr_gains
 from .uncertainty import NormBounded
-
-
-def __getattr__(name):  # lazy: cvxpy is slow to import
-    if name in ("hinf", "HinfController"):
-        from . import hinf as _hinf
-
-        return getattr(_hinf, name)
-    raise AttributeError(f"module 'robustctl' has no attribute {name!r}")
 
 
 __all__ = [
