@@ -240,3 +240,18 @@ def test_runs_wrapped_with_molsp():
     again = minimize(problem, molsp(make_efr_rr(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500),
                      seed=2)
     np.testing.assert_array_equal(res.pop.get("F"), again.pop.get("F"))
+
+
+def test_rank_tournament_frequencies():
+    # Two individuals with global ranks 1 and 2: the worse one wins only when drawn twice,
+    # probability 1/4; with equal ranks the coin makes each win half of the time.
+    from moo.algorithms.efr_rr import RankTournament
+
+    rng = np.random.default_rng(5)
+    pop = _pop([[0, 1], [1, 0]])
+    pop.set("rank", np.array([1, 2]))
+    picks = RankTournament().do(_Dummy(), pop, 4000, 1, to_pop=False, random_state=rng).ravel()
+    assert abs(np.mean(picks == 1) - 0.25) < 0.03          # ~4 standard deviations
+    pop.set("rank", np.array([3, 3]))
+    picks = RankTournament().do(_Dummy(), pop, 4000, 1, to_pop=False, random_state=rng).ravel()
+    assert abs(np.mean(picks == 1) - 0.5) < 0.035
