@@ -177,6 +177,18 @@ def test_survival_by_hand():
     np.testing.assert_array_equal(np.sort(surv.archive.get("F"), axis=0), [[0.0, 0.0], [1.0, 1.0]])
 
 
+def test_survival_feasible_first_and_archive_from_feasible_only():
+    # the infeasible (-1,-1) would dominate everything; it must neither survive ahead of
+    # the feasible points nor enter the archive
+    F = np.array([[0.0, 1.0], [1.0, 0.0], [0.5, 0.5], [-1.0, -1.0], [2.0, 2.0]])
+    cv = np.array([0, 0, 0, 0.3, 0.1])[:, None]
+    pop = Population.new(X=np.zeros((5, 1)), F=F, CV=cv)
+    surv = IGDNSSurvival(archive_size=10)
+    kept = surv.do(Problem(n_var=1, n_obj=2, n_ieq_constr=1), pop, n_survive=4, return_indices=True)
+    assert sorted(kept[:3]) == [0, 1, 2] and kept[3] == 4
+    assert len(surv.archive) == 3 and np.all(surv.archive.get("F") >= 0)
+
+
 def test_survival_any_merged_size():
     rng = np.random.default_rng(5)
     surv = IGDNSSurvival(archive_size=50)

@@ -197,6 +197,20 @@ def test_survival_ideal_is_running_minimum_and_any_size_works():
     assert np.all(np.isin(s2.get("F")[:, 0], s1.get("F")[:, 0]))  # the worse newcomers are ranked behind
 
 
+def test_survival_feasible_first_and_reference_points_from_feasible_only():
+    # F5 feasible except e=(1,1) (CV .5) and an extra infeasible point (-5,-5) (CV .1), which
+    # would otherwise move the ideal point; 5 survivors: the 4 feasible ones, then the
+    # least violating infeasible one
+    F = np.vstack([F5, [[-5.0, -5.0]]])
+    cv = np.array([0, 0, 0, 0, 0.5, 0.1])[:, None]
+    pop = Population.new(X=np.zeros((6, 1)), F=F, CV=cv)
+    surv = R2RankingSurvival(W2)
+    kept = surv.do(Problem(n_var=1, n_obj=2, n_ieq_constr=1), pop, n_survive=5, return_indices=True)
+    assert kept == [1, 0, 2, 3, 5]
+    np.testing.assert_array_equal(surv.ideal, [0, 0])
+    np.testing.assert_array_equal(surv.nadir, [1, 1])
+
+
 def test_tournament_rules():
     pop = Population.new(X=np.zeros((5, 1)))
     pop.set("rank", np.array([1, 2, 2, 1, 1]), "r2_norm", np.array([0.5, 0.5, 0.3, 0.1, 0.5]),
