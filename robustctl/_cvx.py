@@ -150,6 +150,10 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
                 prob.solve(solver=solver, **_settings(solver, attempt_tol))
         except cp.error.SolverError as exc:
             failure = f"{solver} failed ({exc})"
+        except BaseException as exc:  # a Rust panic inside Clarabel surfaces as pyo3's PanicException
+            if type(exc).__name__ != "PanicException":
+                raise
+            failure = f"{solver} crashed internally ({exc})"
         else:
             if prob.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE, cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
                 break

@@ -96,6 +96,11 @@ __all__ = ["hinf", "HinfController"]
 # problem, whose data are normalised (||Bw~|| = 1, level 1, unit energy).
 # The gamma minimisation uses the non-strict LMIs: it computes an infimum.
 _STRICT = 1e-8
+# Regularisation (relative to lambda_max) of the optimal X before it defines
+# the coordinates of the centring problem.
+_RECENTRE_REG = 1e-3
+# The same for polishing an inaccurate gamma minimisation (a pure similarity).
+_POLISH_REG = 1e-6
 # Solver tolerance of the centring problem (its optimum need not be exact).
 _CENTRE_TOL = 1e-8
 # u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that solver rounding cannot
@@ -213,6 +218,18 @@ def _balance(F, Bw, G, Cz) -> np.ndarray:
 
 
 # ---------------------------------------------------------------- LMIs
+class _Value:
+    """Stands in for a cvxpy variable holding ``value`` (for :meth:`_Problem.recentre`)."""
+
+    def __init__(self, value):
+        self.value = value
+
+
+def _strict(certificate) -> bool:
+    """Every H-infinity block and the Lyapunov (slack) matrix strictly positive definite."""
+    return all(v > 0 for k, v in certificate.items() if k.startswith(("hinf", "X", "S")) and k != "X_upper")
+
+
 class _Problem:
     """The scaled data and the LMI builders for one synthesis.
 
@@ -235,11 +252,20 @@ class _Problem:
         if bw > 0 and np.isfinite(bw):
             d = d * bw
         self.d = d
+        # Only z'z matters: replace [Cz Dzu Dzw] by a full-row-rank factor R
+        # with R'R = [Cz Dzu Dzw]'[Cz Dzu Dzw] when that has fewer rows.
+        n, m, q = Cz.shape[1], Dzu.shape[1], Dzw.shape[1]
+        CD = np.hstack([Cz, Dzu, Dzw])
+        _, sv, Vt = np.linalg.svd(CD, full_matrices=False)
+        r = int(np.sum(sv > 1e-13 * max(1.0, sv[0] if sv.size else 0.0)))
+        if 0 < r < CD.shape[0]:
+            CD = sv[:r, None] * Vt[:r]
+            Cz, Dzu, Dzw = CD[:, :n], CD[:, n:n + m], CD[:, n + m:]
         self._orig = ([p.F for p in plants], [p.G for p in plants], Bw * self.a, Cz)
         self.Dzu, self.Dzw = Dzu, Dzw * self.a
         self._transform(np.diag(d))
         self.n, self.m = plants[0].n, plants[0].m
-        self.p, self.q = Cz.shape[0], Bw.shape[1]
+        self.p, self.q = Cz.shape[0], Bw.shape[1]  # p after compression
         self.extended = extended
         self.u_max = u_max
 
@@ -252,13 +278,15 @@ class _Problem:
         self.Bw = np.linalg.solve(T, Bw)
         self.Cz = Cz @ T
 
-    def recentre(self, V) -> None:
+    def recentre(self, V, reg: float) -> float:
         """Change coordinates so that the Lyapunov matrix of a previous solution becomes ~ I.
 
-        ``X = R R'`` (Cholesky of the solution, slightly regularised) and
-        ``x = T R x^``: a similarity, so the level and the input bound are
-        unchanged, but the centring margin ``t`` of the next solve is then
-        measured relative to the solution's own scale.
+        With ``X + reg lambda_max(X) I = R R'`` (Cholesky; ``X`` the previous
+        solution, ``S`` for the extended LMI) the new coordinates are
+        ``x^ = R^-1 x~``: a similarity, so levels and input bounds are
+        unchanged, but margins of the next solve are measured relative to the
+        solution's own shape. Returns ``lambda_max`` of the previous solution
+        in the new coordinates (<= 1), or ``nan`` if it was unusable.
         """
         if self.extended:
             Sv = V["S"].value
@@ -267,13 +295,15 @@ class _Problem:
             X = 0.5 * (V["X"].value + V["X"].value.T)
         lam = np.linalg.eigvalsh(X)
         if not (np.all(np.isfinite(lam)) and lam[-1] > 0):
-            return
-        X = X + max(0.0, 1e-6 * lam[-1] - lam[0]) * np.eye(self.n)
+            return float("nan")
+        Xr = X + max(0.0, reg * lam[-1] - lam[0]) * np.eye(self.n)
         try:
-            R = np.linalg.cholesky(X)
+            R = np.linalg.cholesky(Xr)
         except np.linalg.LinAlgError:
-            return
-        self._transform(self.T @ (R / np.sqrt(lam[-1])))
+            return float("nan")
+        self._transform(self.T @ R)
+        Xh = np.linalg.solve(R, np.linalg.solve(R, X).T)
+        return float(np.linalg.eigvalsh(0.5 * (Xh + Xh.T))[-1])
 
     def variables(self):
         cp = self.cp
@@ -293,9 +323,13 @@ class _Problem:
         ``X <= x_upper I``.
         """
         cp = self.cp
-        n, p, q = self.n, self.p, self.q
-        Iq, Ip = np.eye(q), np.eye(p)
+        n, p = self.n, self.p
+        Ip = np.eye(p)
         Cz, Dzu, Dzw = b * self.Cz, b * self.Dzu, b * self.Dzw
+        # The disturbance block (the constant I) is eliminated by a Schur
+        # complement, which keeps the LMIs linear and q rows smaller:
+        Bw = self.Bw
+        BB, BD, DD = Bw @ Bw.T, Bw @ Dzw.T, Dzw @ Dzw.T
         out = []
         for i, (F, G) in enumerate(zip(self.F, self.G)):
             if self.extended:
@@ -303,28 +337,25 @@ class _Problem:
                 AS = F @ S + G @ L
                 CS = Cz @ S + Dzu @ L
                 M = cp.bmat([
-                    [P, AS, self.Bw, np.zeros((n, p))],
-                    [AS.T, S + S.T - P, np.zeros((n, q)), CS.T],
-                    [self.Bw.T, np.zeros((q, n)), Iq, Dzw.T],
-                    [np.zeros((p, n)), CS, Dzw, mu * Ip]])
+                    [P - BB, AS, -BD],
+                    [AS.T, S + S.T - P, CS.T],
+                    [-BD.T, CS, mu * Ip - DD]])
             elif self.discrete:
                 X, Y = V["X"], V["Y"]
                 AX = F @ X + G @ Y
                 CX = Cz @ X + Dzu @ Y
                 M = cp.bmat([
-                    [X, AX, self.Bw, np.zeros((n, p))],
-                    [AX.T, X, np.zeros((n, q)), CX.T],
-                    [self.Bw.T, np.zeros((q, n)), Iq, Dzw.T],
-                    [np.zeros((p, n)), CX, Dzw, mu * Ip]])
+                    [X - BB, AX, -BD],
+                    [AX.T, X, CX.T],
+                    [-BD.T, CX, mu * Ip - DD]])
             else:
                 X, Y = V["X"], V["Y"]
                 AX = F @ X + G @ Y
                 CX = Cz @ X + Dzu @ Y
                 # -(continuous BRL) >= 0
                 M = cp.bmat([
-                    [-(AX + AX.T), -self.Bw, -CX.T],
-                    [-self.Bw.T, Iq, -Dzw.T],
-                    [-CX, -Dzw, mu * Ip]])
+                    [-(AX + AX.T) - BB, -CX.T - BD],
+                    [-CX - BD.T, mu * Ip - DD]])
             out.append(_cvx.LMI(f"hinf[{i}]", M, margin))
         if x_margin is not None:
             n_eye = np.eye(self.n)
@@ -406,7 +437,10 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
     backoff : float, default 1e-3
         The gain is computed at ``gamma = (1 + backoff) gamma_opt`` from a
         well-centred strictly feasible point. ``0`` returns the optimal
-        point's gain (can be badly conditioned).
+        point's gain (can be badly conditioned). If no strictly feasible point
+        with a positive certificate is found at that level (nearly infeasible
+        problems, e.g. a tight ``u_max``), the backoff is raised tenfold, at
+        most twice; ``info["backoff"]`` and ``gamma`` report the value used.
     extended : bool, default False
         Use the slack-variable condition of de Oliveira et al. (discrete time
         only): less conservative with ``vertices``, equal without.
@@ -473,16 +507,36 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
                  f"{w_energy:g} (the input bound may be too tight for this disturbance energy)")
     solves = []
 
-    # 1. minimise mu = gamma^2
-    gamma_opt = None
-    if gamma is None:
+    b_fix = None
+
+    def minimise():
         V = prob.variables()
         mu = cp.Variable(name="mu")
         rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0), solver=solver,
                              infeasible_msg=f"no H-infinity state feedback: {what}")
+        return V, mu, rep
+
+    # 1. minimise mu = gamma^2 (scaled level a * gamma)
+    gamma_opt = None
+    if gamma is None:
+        T_bal = prob.T
+        V, mu, rep = minimise()
         solves.append(rep.as_dict())
+        T_sol = prob.T
+        if rep.status != "optimal" and np.isfinite(prob.recentre(V, _POLISH_REG)):
+            # Polish: the same problem in coordinates where the optimal X is ~ I.
+            try:
+                V2, mu2, rep2 = minimise()
+            except (ConvergenceError, InfeasibleError):
+                rep2 = None
+            if rep2 is not None:
+                solves.append(rep2.as_dict(prefix=""))
+                if rep2.status == "optimal" or min(rep2.certificate.values()) > min(rep.certificate.values()):
+                    V, mu, rep, T_sol = V2, mu2, rep2, prob.T
         gamma_opt = float(np.sqrt(max(mu.value, 0.0))) / prob.a
         gamma_fix = gamma_opt * (1.0 + backoff)
+        prob._transform(T_sol)
+        _, X_opt = prob.gain(V)
     else:
         gamma_fix = gamma
 
@@ -492,19 +546,47 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
     elif gamma is None:
         # Maximise the smallest eigenvalue of X (S for the extended LMI) below
         # x_upper = 2 lambda_max of the optimal point: the best-conditioned
-        # X, hence a moderate K = Y X^-1, at the backed-off level.
-        Xopt = V["S"].value if extended else V["X"].value
-        x_upper = 2.0 * float(np.max(np.abs(np.linalg.eigvalsh(0.5 * (Xopt + Xopt.T)))))
-        V = prob.variables()
-        t = cp.Variable(name="t")
-        # H-infinity blocks strictly feasible by a margin that scales with the backoff
-        eps = max(_STRICT, 1e-2 * backoff)
-        rep = _cvx.solve_sdp(
-            cp.Maximize(t), prob.lmis(V, 1.0, eps, b=1.0 / (prob.a * gamma_fix), x_margin=t, x_upper=x_upper),
-            [t >= _STRICT * x_upper], solver=solver, tol=_CENTRE_TOL,
-            infeasible_msg=f"could not find a strictly feasible gain at gamma={gamma_fix:.6g} = "
-                           "(1 + backoff) gamma_opt; increase backoff")
-        solves.append(rep.as_dict())
+        # X, hence a moderate K = Y X^-1, at the backed-off level. The
+        # H-infinity blocks must hold with a margin that scales with the
+        # backoff, and the certificate must be strictly positive; if it is
+        # not, retry in coordinates where the optimal X is ~ I.
+        failure = None
+        for used_backoff in (backoff, 10.0 * backoff, 100.0 * backoff):
+            gamma_fix = gamma_opt * (1.0 + used_backoff)
+            eps = max(_STRICT, 1e-2 * used_backoff)
+            for attempt in ("balanced", "recentred"):
+                prob._transform(T_bal)
+                if attempt == "recentred":
+                    Vr = {"S": _Value(X_opt), "X": _Value(X_opt)}
+                    prob._transform(np.eye(prob.n))
+                    if not np.isfinite(prob.recentre(Vr, _RECENTRE_REG)):
+                        break
+                Xc = np.linalg.solve(prob.T, np.linalg.solve(prob.T, X_opt).T)
+                x_upper = 2.0 * float(np.max(np.abs(np.linalg.eigvalsh(0.5 * (Xc + Xc.T)))))
+                V = prob.variables()
+                t = cp.Variable(name="t")
+                try:
+                    rep = _cvx.solve_sdp(
+                        cp.Maximize(t), prob.lmis(V, 1.0, eps, b=1.0 / (prob.a * gamma_fix), x_margin=t,
+                                                  x_upper=x_upper),
+                        [t >= _STRICT * x_upper], solver=solver, tol=_CENTRE_TOL,
+                        infeasible_msg=f"could not find a strictly feasible gain at gamma={gamma_fix:.6g} = "
+                                       f"(1 + {used_backoff:g}) gamma_opt; increase backoff")
+                except (ConvergenceError, InfeasibleError) as exc:
+                    failure = exc
+                    continue
+                solves.append(rep.as_dict())
+                if _strict(rep.certificate):
+                    failure = None
+                    break
+                failure = ConvergenceError(
+                    f"the gain at gamma={gamma_fix:.6g} = (1 + {used_backoff:g}) gamma_opt has no strictly "
+                    f"positive certificate (smallest eigenvalues {rep.certificate}); increase backoff")
+            if failure is None:
+                break
+        if failure is not None:
+            raise failure
+        backoff = used_backoff
         final_margin = float(t.value) / x_upper
     else:
         V = prob.variables()
