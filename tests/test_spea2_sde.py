@@ -136,10 +136,16 @@ def test_fitness_hand_example_raw_objectives():
     np.testing.assert_array_equal(raw, [0, 0, 0, 2, 5])
     np.testing.assert_allclose(dens, [0.25, 0.25, 0.25, 1 / 3, 0.5], rtol=1e-15)
     np.testing.assert_allclose(fit, [0.25, 0.25, 0.25, 2 + 1 / 3, 5.5], rtol=1e-15)
-    # normalised: min (1,1), max (5,5) -> every distance / 4 -> sigma = [.5,.5,.5,.25,0]
+    # normalised by the ideal (1,1) and the non-dominated nadir (4.5, 4): spans (3.5, 3),
+    #   p0 (0,1), p1 (2/7,1/3), p2 (1,0), p3 (4/7,2/3), p4 (8/7,4/3); second smallest sd:
+    #   p0: to p1 (2/7,0), to p3 (4/7,0), to p2 (1,0)              -> sigma = 4/7, D = 7/18
+    #   p1: to p3 |(2/7,1/3)| = 0.439, to p0 (0,2/3), to p2 (5/7,0) -> sigma = 2/3, D = 3/8
+    #   p2: to p1 (0,1/3), to p3 (0,2/3), to p0 (0,1)              -> sigma = 2/3, D = 3/8
+    #   p3: to p1 0, to p0 (0,1/3), to p2 (3/7,0)                  -> sigma = 1/3, D = 3/7
+    #   p4: all 0                                                  -> D = 1/2
     fit_n, raw_n, dens_n = sde_fitness(F)
     np.testing.assert_array_equal(raw_n, raw)
-    np.testing.assert_allclose(dens_n, [1 / 2.5, 1 / 2.5, 1 / 2.5, 1 / 2.25, 0.5], rtol=1e-15)
+    np.testing.assert_allclose(dens_n, [7 / 18, 3 / 8, 3 / 8, 3 / 7, 0.5], rtol=1e-14)
 
 
 def test_fitness_matches_per_individual_reference():
@@ -147,7 +153,8 @@ def test_fitness_matches_per_individual_reference():
     for n, m in [(9, 2), (16, 3), (30, 4)]:
         F = rng.random((n, m)) * np.array([1.0, 100.0, 0.01, 5.0])[:m]
         F[n // 2] = F[0] + 0.1                 # make sure some dominance exists
-        lo, hi = F.min(0), F.max(0)
+        nondominated = [not any(np.all(g <= f) and np.any(g < f) for g in F) for f in F]
+        lo, hi = F.min(0), F[nondominated].max(0)
         for normalize, G in [(False, F), (True, (F - lo) / (hi - lo))]:
             got = sde_fitness(F, normalize=normalize)
             want = _reference_fitness(F, G)
@@ -217,20 +224,44 @@ def test_truncation_rejects_bad_input():
 # ----------------------------------------------------------------------------- survival and mating
 
 def test_survival_fills_by_fitness_then_truncates():
-    # Same five points as the fitness example (fitness [.4,.4,.4,2.44,5.5] normalised).
+    # Same five points as the fitness example, normalised fitness [7/18, 3/8, 3/8, 2 + 3/7, 5.5].
     F = np.vstack([THREE, [[3.0, 3.0], [5.0, 5.0]]])
     surv = SPEA2SDESurvival()
     problem = _Dummy()
-    # 4 survivors: the 3 non-dominated + the best dominated one (p3, fitness 2.44 < 5.5)
+    # 4 survivors: the 3 non-dominated + the best dominated one (p3, 2.43 < 5.5), in fitness order
     out = surv.do(problem, _pop(F), n_survive=4, random_state=np.random.default_rng(0))
-    np.testing.assert_array_equal(out.get("F"), F[[0, 1, 2, 3]])
-    np.testing.assert_allclose(out.get("sde_fitness"), [0.4, 0.4, 0.4, 2 + 1 / 2.25])
-    # 2 survivors: truncation of {p0, p1, p2}; normalisation by the 5-point set divides every
-    # distance by 4, so the order is the hand example's: p2 goes -> {p0, p1}
+    np.testing.assert_array_equal(out.get("F"), F[[1, 2, 0, 3]])
+    np.testing.assert_allclose(out.get("sde_fitness"), [3 / 8, 3 / 8, 7 / 18, 2 + 3 / 7], rtol=1e-14)
+    # 2 survivors: truncation of {p0, p1, p2} in the normalised space (see the fitness example):
+    #   sorted rows p0 (2/7, 1), p1 (2/3, 5/7), p2 (1/3, 1) -> p0 goes;
+    #   then p1 sees p2 at 5/7, p2 sees p1 at 1/3 -> p2 goes.
+    # (Raw objectives, the hand example above, remove p2 first: the scaling matters.)
     out = surv.do(problem, _pop(F), n_survive=2, random_state=np.random.default_rng(0))
-    np.testing.assert_array_equal(out.get("F"), F[[0, 1]])
+    np.testing.assert_array_equal(out.get("F"), F[[1, 2]])
     out = surv.do(problem, _pop(F), n_survive=1, random_state=np.random.default_rng(0))
     np.testing.assert_array_equal(out.get("F"), F[[1]])
+    raw = SPEA2SDESurvival(normalize=False).do(problem, _pop(F), n_survive=2, random_state=np.random.default_rng(0))
+    np.testing.assert_array_equal(raw.get("F"), F[[0, 1]])
+
+
+def test_normalised_survival_is_invariant_to_objective_scaling():
+    # Scaling objective k by a_k > 0 and shifting it leaves the normalised set unchanged, so the
+    # same individuals survive; the raw form is not invariant (it follows the largest objective).
+    rng = np.random.default_rng(4)
+    F = rng.random((60, 3))
+    F[:40] /= np.linalg.norm(F[:40], axis=1, keepdims=True)   # 40 on a sphere, 20 scattered
+    G = F * np.array([1.0, 1e3, 1e-2]) + np.array([5.0, -2.0, 0.0])
+    problem = _Dummy(3)
+
+    def kept(X, normalize):
+        pop = _pop(X)
+        pop.set("X", np.arange(60.0)[:, None])
+        out = SPEA2SDESurvival(normalize=normalize).do(problem, pop, n_survive=25,
+                                                        random_state=np.random.default_rng(0))
+        return sorted(out.get("X")[:, 0].astype(int))
+
+    assert kept(F, True) == kept(G, True)
+    assert kept(F, False) != kept(G, False)
 
 
 def test_survival_puts_feasible_first():
