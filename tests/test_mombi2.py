@@ -212,23 +212,26 @@ def test_survival_feasible_first_and_reference_points_from_feasible_only():
 
 
 def test_tournament_rules():
-    pop = Population.new(X=np.zeros((5, 1)))
-    pop.set("rank", np.array([1, 2, 2, 1, 1]), "r2_norm", np.array([0.5, 0.5, 0.3, 0.1, 0.5]),
-            "CV", np.array([[0.0], [0.0], [0.0], [1.0], [0.0]]))
+    cv = np.array([0.0, 0.0, 0.0, 1.0, 0.0])
+    rank = np.array([1, 2, 2, 1, 1])
+    norm = np.array([0.5, 0.5, 0.3, 0.1, 0.5])
     rng = np.random.default_rng(0)
     P = np.array([[0, 1], [1, 2], [3, 0], [1, 0]])
     # rank 1 beats 2; equal rank -> smaller norm; feasible beats infeasible (3 has the best rank/norm)
-    np.testing.assert_array_equal(r2_tournament(pop, P, random_state=rng)[:, 0], [0, 2, 0, 0])
+    np.testing.assert_array_equal(r2_tournament(P, cv, rank, norm, rng)[:, 0], [0, 2, 0, 0])
     # full tie (0 vs 4): both must win sometimes
-    winners = r2_tournament(pop, np.tile([0, 4], (200, 1)), random_state=rng)[:, 0]
+    winners = r2_tournament(np.tile([0, 4], (200, 1)), cv, rank, norm, rng)[:, 0]
     assert set(winners) == {0, 4}
+    with pytest.raises(ValueError, match=r"P must have shape \(n, 2\)"):
+        r2_tournament(np.zeros((3, 3)), cv, rank, norm, rng)
 
 
-def test_tournament_treats_unranked_as_worst():
+def test_tournament_in_population_treats_unranked_as_worst():
     pop = Population.new(X=np.zeros((2, 1)))
     pop[0].set("rank", 7)
     pop[0].set("r2_norm", 1.0)
-    out = r2_tournament(pop, np.array([[1, 0], [0, 1]]), random_state=np.random.default_rng(1))
+    out = MOMBI2(W2).mating.selection.func_comp(pop, np.array([[1, 0], [0, 1]]),
+                                                random_state=np.random.default_rng(1))
     np.testing.assert_array_equal(out[:, 0], [0, 0])
 
 

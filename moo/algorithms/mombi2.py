@@ -312,23 +312,44 @@ def _as_float_column(values, fill: float) -> np.ndarray:
     return arr.astype(float).reshape(len(arr), -1)[:, 0]
 
 
-def r2_tournament(pop, P, random_state=None, **kwargs) -> np.ndarray:
-    """Binary tournament of MOMBI-II: constraint violation, R2 rank, norm, then a coin.
+def r2_tournament(P: np.ndarray, cv: np.ndarray, rank: np.ndarray, norm: np.ndarray,
+                  random_state: np.random.Generator) -> np.ndarray:
+    """Winners of MOMBI-II's binary tournaments.
 
-    ``P`` is an ``(n, 2)`` array of competitor indices; returns the ``(n, 1)``
-    winners. Individuals without a rank (infeasible ones) count as rank ``inf``.
+    Parameters
+    ----------
+    P : ndarray of int, shape (n, 2)
+        Indices of the two competitors of each tournament.
+    cv, rank, norm : ndarray, shape (N,)
+        Constraint violation (``<= 0`` feasible), R2 rank and normalised norm
+        of every individual (``inf`` rank/norm for unranked ones).
+    random_state : numpy Generator
+        Source of the fair coin for complete ties.
+
+    Returns
+    -------
+    ndarray of int, shape (n, 1)
+        The winner of each tournament: smaller violation, then smaller rank,
+        then smaller norm, then a fair coin.
     """
     P = np.asarray(P, dtype=int)
+    if P.ndim != 2 or P.shape[1] != 2:
+        raise ValueError(f"P must have shape (n, 2), got shape {P.shape}")
+    cv = np.maximum(np.asarray(cv, dtype=float), 0.0)
+    rank = np.asarray(rank, dtype=float)
+    norm = np.asarray(norm, dtype=float)
     a, b = P[:, 0], P[:, 1]
-    cv = _as_float_column(pop.get("CV"), 0.0)
-    cv = np.maximum(cv, 0.0)
-    rank = _as_float_column(pop.get("rank"), np.inf)
-    norm = _as_float_column(pop.get("r2_norm"), np.inf)
     coin = random_state.random(len(P)) < 0.5
     a_wins = np.where(cv[a] != cv[b], cv[a] < cv[b],
                       np.where(rank[a] != rank[b], rank[a] < rank[b],
                                np.where(norm[a] != norm[b], norm[a] < norm[b], coin)))
     return np.where(a_wins, a, b)[:, None]
+
+
+def _compare_in_population(pop, P, random_state=None, **kwargs) -> np.ndarray:
+    """pymoo ``TournamentSelection`` hook: read CV, rank and norm from ``pop``."""
+    return r2_tournament(P, _as_float_column(pop.get("CV"), 0.0), _as_float_column(pop.get("rank"), np.inf),
+                         _as_float_column(pop.get("r2_norm"), np.inf), random_state)
 
 
 class MOMBI2(GeneticAlgorithm):
@@ -360,7 +381,7 @@ class MOMBI2(GeneticAlgorithm):
         super().__init__(
             pop_size=pop_size,
             sampling=sampling if sampling is not None else FloatRandomSampling(),
-            selection=TournamentSelection(func_comp=r2_tournament),
+            selection=TournamentSelection(func_comp=_compare_in_population),
             crossover=crossover if crossover is not None else paper_crossover(),
             mutation=mutation if mutation is not None else paper_mutation(),
             survival=R2RankingSurvival(ref_dirs, alpha=alpha, epsilon=epsilon, record_size=record_size),
