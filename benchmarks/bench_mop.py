@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_mop.py [--pop 92] [--elementwise 16] [--evals 10000] [--seed 1]
-                                   [--skip-runs] [--out benchmarks/results/mop.md]
+                                   [--repeats 2] [--skip-runs] [--out benchmarks/results/mop.md]
 
 Measured in one run, on the same machine (timings on a shared machine are noisy):
 
@@ -19,8 +19,9 @@ Measured in one run, on the same machine (timings on a shared machine are noisy)
    (``moo.algorithms.make_algorithm("nsga2")``, the paper's operators and
    population 92) on each MOP, without and with MO-LSP
    (``moo.molsp.molsp(..., ref_point=problem.molsp_ref_point)``), same seed and
-   budget. Reported: seconds, evaluations done, MO-LSP's extra time in percent
-   (target <= 10 %) and the mutants it evaluated.
+   budget; each configuration ``--repeats`` times, the fastest kept (the machine
+   is shared). Reported: seconds, evaluations done, MO-LSP's extra time in
+   percent (target <= 10 %) and the mutants it evaluated.
 3. **Objective scales** behind the reference points: for a seeded sample of
    random designs, the share that is stable and the share of those that
    dominate ``hv_ref_point`` / ``molsp_ref_point``.
@@ -101,24 +102,27 @@ def batched_vs_elementwise(pop: int, n_elem: int, seed: int) -> dict:
                 ratio=rate_b / rate_e, n_penalised=int(np.sum(F_batch[:, 0] >= p.penalty)))
 
 
-def nsga2_runs(evals: int, seed: int) -> list[dict]:
+def nsga2_runs(evals: int, seed: int, repeats: int) -> list[dict]:
+    """Each configuration ``repeats`` times (same seed, so the same work), alternating; the fastest counts."""
     rows = []
     for name, cls in (("generic", GenericRLQRProblem), ("applied", AppliedRLQRProblem)):
         problem = cls()
-        times = {}
-        for with_molsp in (False, True):
-            alg = make_algorithm("nsga2", n_obj=problem.n_obj)
-            if with_molsp:
-                alg = molsp(alg, ref_point=problem.molsp_ref_point)
-            t0 = time.perf_counter()
-            res = minimize(problem, alg, ("n_eval", evals), seed=seed, verbose=False)
-            dt = time.perf_counter() - t0
-            times[with_molsp] = dt
-            rows.append(dict(problem=name, molsp=with_molsp, seconds=dt, n_eval=res.algorithm.evaluator.n_eval,
-                             n_gen=res.algorithm.n_gen,
-                             mutants=res.algorithm.data.get("molsp_n_eval", 0) if with_molsp else 0,
-                             front=len(res.F)))
-        rows[-1]["overhead"] = 100.0 * (times[True] / times[False] - 1.0)
+        best = {}
+        for _ in range(repeats):
+            for with_molsp in (False, True):
+                alg = make_algorithm("nsga2", n_obj=problem.n_obj)
+                if with_molsp:
+                    alg = molsp(alg, ref_point=problem.molsp_ref_point)
+                t0 = time.perf_counter()
+                res = minimize(problem, alg, ("n_eval", evals), seed=seed, verbose=False)
+                dt = time.perf_counter() - t0
+                if with_molsp not in best or dt < best[with_molsp]["seconds"]:
+                    best[with_molsp] = dict(
+                        problem=name, molsp=with_molsp, seconds=dt, n_eval=res.algorithm.evaluator.n_eval,
+                        n_gen=res.algorithm.n_gen,
+                        mutants=res.algorithm.data.get("molsp_n_eval", 0) if with_molsp else 0)
+        best[True]["overhead"] = 100.0 * (best[True]["seconds"] / best[False]["seconds"] - 1.0)
+        rows += [best[False], best[True]]
     return rows
 
 
@@ -143,6 +147,7 @@ def main(argv=None) -> int:
     ap.add_argument("--elementwise", type=int, default=16)
     ap.add_argument("--evals", type=int, default=10000)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--repeats", type=int, default=2, help="runs per NSGA-II configuration (fastest kept)")
     ap.add_argument("--skip-runs", action="store_true", help="skip the NSGA-II runs")
     ap.add_argument("--out", type=Path, default=None, help="also write the report (Markdown) here")
     args = ap.parse_args(argv)
@@ -157,8 +162,8 @@ def main(argv=None) -> int:
               f"| **ratio** (target >= 30) | **{b['ratio']:.0f}x** |", ""]
     print("\n".join(lines), flush=True)
     if not args.skip_runs:
-        rows = nsga2_runs(args.evals, args.seed)
-        part = [f"## NSGA-II, {args.evals} evaluations, seed {args.seed}", "",
+        rows = nsga2_runs(args.evals, args.seed, args.repeats)
+        part = [f"## NSGA-II, {args.evals} evaluations, seed {args.seed}, fastest of {args.repeats}", "",
                 "| problem | MO-LSP | seconds | evaluations | generations | mutants | MO-LSP extra time |",
                 "|---|---|---|---|---|---|---|"]
         for r in rows:

@@ -48,7 +48,7 @@ def _generic_reference(z, *, deltas, x0s, horizon, Q=np.eye(3), R=np.eye(1), agg
     for zi in np.atleast_2d(z):
         try:
             ctrl = rc.design("rlqr", rc.Plant(F, G, dt=1.0), zi[None, :3], zi[None, 3:4],
-                             10.0 ** np.sqrt(zi[4]), Q=Q, R=R, H=H, max_iter=200)
+                             10.0 ** np.sqrt(zi[4]), Q=Q, R=R, H=H)
         except (rc.ConvergenceError, rc.RankConditionError):
             out.append(np.full(3, 2 * penalty))
             continue
@@ -163,7 +163,7 @@ def test_generic_unstable_designs_get_finite_penalties(generic):
 def test_generic_slowly_converging_design_is_penalised(generic):
     """A design (found by an MO-LSP run) whose RLQR recursion does not converge in 20000 steps."""
     z = np.array([[47.8069, 103.7683, 181.5866, 53.6425, 117.4085]])
-    assert not generic.gains(z).ok[0]                     # capped at max_iter = 200
+    assert not generic.gains(z).ok[0]                     # capped at max_iter = 50
     f = generic.evaluate(z)
     np.testing.assert_array_equal(f, np.full((1, 3), 2 * generic.penalty))
 
@@ -277,8 +277,7 @@ def _applied_reference(z, problem, *, aggregate="mean"):
     for zi in np.atleast_2d(z):
         try:
             K = rc.design("rlqr", truck.truck_plant(0.0, doubled=True), zi[None, :4], zi[None, 4:6],
-                          10.0 ** np.sqrt(zi[6]), Q=problem.Q, R=problem.R, H=np.ones((4, 1)),
-                          max_iter=problem.max_iter).K
+                          10.0 ** np.sqrt(zi[6]), Q=problem.Q, R=problem.R, H=np.ones((4, 1))).K
         except (rc.ConvergenceError, rc.RankConditionError):
             out.append(np.full(4, 2 * pen))
             continue
