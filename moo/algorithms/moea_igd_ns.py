@@ -41,6 +41,11 @@ largest minimum angle to those already kept (:func:`truncate_by_angle`).
 
 Readings where the paper is ambiguous (chosen as a careful reader would)
 ------------------------------------------------------------------------
+The full text of the paper was not at hand when this module was written; the
+archive bound, the archive truncation and the last-front evaluation below were
+checked against PlatEMO's MOEA/IGD-NS (by the paper's authors' group; read to
+resolve doubts, nothing ported).
+
 * The archive and the reference set derived from it are updated inside the
   survival from the population it receives (the MO-LSP contract: the host's
   survival may be called twice per generation on merged populations); since

@@ -49,6 +49,11 @@ wins, then the smaller R2 rank, then the smaller norm, then a fair coin.
 
 Readings where the paper is ambiguous (chosen as a careful reader would)
 ------------------------------------------------------------------------
+The full text of the paper was not at hand when this module was written; the
+rules above were checked against the first author's own C implementation (EMO
+framework) and read against jMetal's and PlatEMO's MOMBI-II (read to resolve
+doubts, nothing ported). Where those differ:
+
 * The update order follows the authors' C implementation (EMO framework):
   rule 1 uses the largest component of the *new* candidate, marks live for
   ``record_size`` updates, nothing is updated before the record is full, and
