@@ -58,7 +58,7 @@ def _pop(F, cv=None):
 
 
 def _reference_sd(F):
-    """Shifted distance by the case definition of Eq. 5: f_k(q') = f_k(p) if f_k(q) < f_k(p) else f_k(q)."""
+    """Shifted distance by the case definition (Li et al. 2014, Sec. III): f_k(q') = f_k(p) if f_k(q) < f_k(p) else f_k(q)."""
     n = len(F)
     D = np.full((n, n), np.inf)
     for p, q in itertools.permutations(range(n), 2):

@@ -60,7 +60,18 @@ Readings where the paper leaves a choice
 * Survival keeps no state between calls, so it may be called again on any
   merged population (MO-LSP).
 * The proximity is the plain sum of normalised objectives of Eq. 1 (no
-  weighting or norm).
+  weighting or norm; Sec. 6.3 of [1] restates it: "the sum of its
+  normalized values across the objectives").
+
+Behaviour worth knowing
+-----------------------
+On a concave front the sum of normalised objectives is smallest near the
+corners and edges, so the proximity goal pulls the population there (the
+paper notes the estimate's dependence on the front's shape, Sec. 3.2). On
+3-objective DTLZ2 at 10000 evaluations the final set crowds the boundary
+and its IGD is about 1.5 times NSGA-III's (1.33 times with 4 objectives);
+the paper targets 5 to 15 objectives. BiGE keeps no extreme points and can
+keep a dominance-resistant point of the critical front (e.g. on DTLZ1).
 """
 
 from __future__ import annotations

@@ -15,9 +15,9 @@ SDE [1]. With ``f(i)`` the objective vector of individual ``i`` (minimised)
 and ``n`` the size of the set being ranked (archive plus offspring):
 
 * strength ``S(i) = |{j : i dominates j}|`` and raw fitness
-  ``R(i) = sum_{j dominates i} S(j)`` ([2], Eqs. 1-2), so ``R(i) = 0`` exactly
+  ``R(i) = sum_{j dominates i} S(j)`` ([2], Sec. 3.1), so ``R(i) = 0`` exactly
   for the non-dominated individuals;
-* shifted distance ([1], Sec. III, Eqs. 4-5): to estimate the density around
+* shifted distance ([1], Sec. III): to estimate the density around
   ``i`` every other individual ``j`` is moved to ``j' = max(f(j), f(i))``
   (component-wise: an objective in which ``j`` is better than ``i`` is set to
   ``i``'s value), and
@@ -28,7 +28,7 @@ and ``n`` the size of the set being ranked (archive plus offspring):
   from* ``i``: an individual that is worse than its neighbours in many
   objectives sees them shifted onto itself and looks crowded;
 * density ``D(i) = 1 / (sigma_i^k + 2)`` with ``sigma_i^k`` the ``k``-th
-  smallest ``sd(i, j)``, ``j != i``, and ``k = floor(sqrt(n))`` ([2], Eq. 3;
+  smallest ``sd(i, j)``, ``j != i``, and ``k = floor(sqrt(n))`` ([2], Sec. 3.1;
   pymoo's SPEA2 uses the ``(k+1)``-th, we follow the report); fitness
   ``F(i) = R(i) + D(i)`` (lower is better; ``D < 1/2`` so ``F < 1`` iff
   non-dominated);
@@ -131,7 +131,7 @@ def shifted_distances(F) -> np.ndarray:
     -------
     numpy.ndarray, shape (n, n)
         ``D[i, j] = sqrt(sum_k max(0, F[j, k] - F[i, k])**2)`` for ``i != j``
-        (Li, Yang & Liu 2014, Eqs. 4-5: ``j`` shifted to ``max(F[j], F[i])``),
+        (Li, Yang & Liu 2014, Sec. III: ``j`` shifted to ``max(F[j], F[i])``),
         ``inf`` on the diagonal. Row ``i`` is the neighbourhood seen from ``i``.
     """
     F = _as_objectives(F)
@@ -199,7 +199,7 @@ def sde_fitness(F, *, normalize: bool = True) -> tuple[np.ndarray, np.ndarray, n
 
     References
     ----------
-    Zitzler, Laumanns & Thiele (2001), Eqs. 1-3; Li, Yang & Liu (2014), Sec. III.
+    Zitzler, Laumanns & Thiele (2001), Sec. 3.1; Li, Yang & Liu (2014), Sec. III.
     """
     F = _as_objectives(F)
     if not isinstance(normalize, (bool, np.bool_)):
