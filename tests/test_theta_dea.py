@@ -348,3 +348,32 @@ def test_survival_matches_brute_force_reference(seed, M, extra):
     k = max(rank[i] for i in got)                                   # the theta-front cut
     assert {i for i in S if rank[i] < k} <= got
     assert all(rank[i] <= k for i in got)
+
+
+# ---------------------------------------------------------------------------------------------
+# benchmarks/bench_moeas.py (owned with this module): a tiny smoke run, incl. a "missing" algorithm
+# ---------------------------------------------------------------------------------------------
+
+def test_bench_moeas_smoke(tmp_path, monkeypatch):
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    import moo.algorithms as registry
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_moeas.py"
+    spec = importlib.util.spec_from_file_location("bench_moeas", path)
+    bench = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "bench_moeas", bench)        # dataclasses look their module up there
+    spec.loader.exec_module(bench)
+    monkeypatch.setitem(registry.ALGORITHMS, "not-yet", "moo.algorithms.does_not_exist:make_does_not_exist")
+    out = tmp_path / "moeas.md"
+    assert bench.main(["--algorithms", "theta-dea,not-yet", "--seeds", "1", "--evals", "184",
+                       "--dtlz1-evals", "184", "--out", str(out)]) == 0
+    table = out.read_text()
+    rows = [line.split("|")[1:-1] for line in table.splitlines() if line.startswith("| ")][1:]
+    assert len(rows) == 3 * 4                                       # nsga2, nsga3, theta-dea, not-yet per case
+    by = {(r[0].strip(), r[1].strip()): [c.strip() for c in r[2:]] for r in rows}
+    assert by[("nsga3", "DTLZ2 M=3")][3] == "1.00" and by[("nsga2", "DTLZ2 M=4")][6] == "1.00"
+    assert by[("not-yet", "DTLZ1 M=3")][-1] == "missing"
+    assert by[("theta-dea", "DTLZ2 M=3")][-1] == "ok" and float(by[("theta-dea", "DTLZ2 M=3")][1]) > 0
