@@ -101,8 +101,10 @@ _STRICT = 1e-8
 _RECENTRE_REG = 1e-3
 # The same for polishing an inaccurate gamma minimisation (a pure similarity).
 _POLISH_REG = 1e-6
+# Upper bound of X in the centring problem, relative to lambda_max of the optimal X.
+_X_UPPER = 10.0
 # Solver tolerance of the centring problem (its optimum need not be exact).
-_CENTRE_TOL = 1e-8
+_CENTRE_TOL = 1e-7
 # u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that solver rounding cannot
 # exceed u_max (the bound is conservative by 0.005 %).
 _U_SLACK = 1e-4
@@ -531,7 +533,8 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
                 rep2 = None
             if rep2 is not None:
                 solves.append(rep2.as_dict(prefix=""))
-                if rep2.status == "optimal" or min(rep2.certificate.values()) > min(rep.certificate.values()):
+                # both passed the certificate check: the lower level is nearer the infimum
+                if rep2.value < rep.value:
                     V, mu, rep, T_sol = V2, mu2, rep2, prob.T
         gamma_opt = float(np.sqrt(max(mu.value, 0.0))) / prob.a
         gamma_fix = gamma_opt * (1.0 + backoff)
@@ -544,38 +547,45 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
     if gamma is None and backoff == 0:
         final_margin = 0.0
     elif gamma is None:
-        # Maximise the smallest eigenvalue of X (S for the extended LMI) below
-        # x_upper = 2 lambda_max of the optimal point: the best-conditioned
-        # X, hence a moderate K = Y X^-1, at the backed-off level. The
-        # H-infinity blocks must hold with a margin that scales with the
-        # backoff, and the certificate must be strictly positive; if it is
-        # not, retry in coordinates where the optimal X is ~ I.
+        # "conditioned": maximise the smallest eigenvalue of X (S for the
+        # extended LMI) below x_upper = 10 lambda_max of the optimal point:
+        # the best-conditioned X, hence a moderate K = Y X^-1, at the
+        # backed-off level, with the H-infinity blocks >= a margin that
+        # scales with the backoff. If the solver fails or the certificate is
+        # not strictly positive: "margin" (maximise the common smallest
+        # eigenvalue of all blocks), then "conditioned" in coordinates where
+        # the optimal X is ~ I, then a tenfold backoff.
         failure = None
         for used_backoff in (backoff, 10.0 * backoff, 100.0 * backoff):
             gamma_fix = gamma_opt * (1.0 + used_backoff)
             eps = max(_STRICT, 1e-2 * used_backoff)
-            for attempt in ("balanced", "recentred"):
+            for attempt in ("conditioned", "margin", "conditioned-recentred"):
                 prob._transform(T_bal)
-                if attempt == "recentred":
+                if attempt == "conditioned-recentred":
                     Vr = {"S": _Value(X_opt), "X": _Value(X_opt)}
                     prob._transform(np.eye(prob.n))
                     if not np.isfinite(prob.recentre(Vr, _RECENTRE_REG)):
                         break
-                Xc = np.linalg.solve(prob.T, np.linalg.solve(prob.T, X_opt).T)
-                x_upper = 2.0 * float(np.max(np.abs(np.linalg.eigvalsh(0.5 * (Xc + Xc.T)))))
                 V = prob.variables()
                 t = cp.Variable(name="t")
+                b_fix = 1.0 / (prob.a * gamma_fix)  # scaled level a * b * gamma_fix = 1
+                if attempt == "margin":
+                    # largest common margin of every block (bounded: t <= 1)
+                    lmis, cons, x_upper = prob.lmis(V, 1.0, t, b=b_fix), [t <= 1.0], 1.0
+                else:
+                    Xc = np.linalg.solve(prob.T, np.linalg.solve(prob.T, X_opt).T)
+                    x_upper = _X_UPPER * float(np.max(np.abs(np.linalg.eigvalsh(0.5 * (Xc + Xc.T)))))
+                    lmis, cons = prob.lmis(V, 1.0, eps, b=b_fix, x_margin=t, x_upper=x_upper), []
                 try:
                     rep = _cvx.solve_sdp(
-                        cp.Maximize(t), prob.lmis(V, 1.0, eps, b=1.0 / (prob.a * gamma_fix), x_margin=t,
-                                                  x_upper=x_upper),
-                        [t >= _STRICT * x_upper], solver=solver, tol=_CENTRE_TOL,
+                        cp.Maximize(t), lmis, cons, solver=solver, tol=_CENTRE_TOL,
                         infeasible_msg=f"could not find a strictly feasible gain at gamma={gamma_fix:.6g} = "
                                        f"(1 + {used_backoff:g}) gamma_opt; increase backoff")
                 except (ConvergenceError, InfeasibleError) as exc:
                     failure = exc
                     continue
-                solves.append(rep.as_dict())
+                solves.append(rep.as_dict(prefix=""))
+                solves[-1]["centring"] = attempt
                 if _strict(rep.certificate):
                     failure = None
                     break
