@@ -82,10 +82,14 @@ from __future__ import annotations
 import numpy as np
 from moocore import is_nondominated
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.crossover import Crossover
+from pymoo.core.mutation import Mutation
+from pymoo.core.sampling import Sampling
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.util.display.multi import MultiObjectiveOutput
+from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
 from ._normalize import front_bounds
@@ -267,8 +271,9 @@ class SPEAR(GeneticAlgorithm):
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, pop_size: int | None = None, k_mating: int = 20,
-                 sampling=None, crossover=None, mutation=None, eliminate_duplicates: bool = True,
-                 n_offsprings: int | None = None, output=None):
+                 sampling: Sampling | None = None, crossover: Crossover | None = None,
+                 mutation: Mutation | None = None, eliminate_duplicates: bool = True,
+                 n_offsprings: int | None = None, output: Output | None = None):
         ref_dirs = _check_reference_directions(ref_dirs)
         pop_size = len(ref_dirs) if pop_size is None else pop_size
         if not isinstance(pop_size, (int, np.integer)) or pop_size < 2:

@@ -64,11 +64,15 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.crossover import Crossover
+from pymoo.core.mutation import Mutation
 from pymoo.core.population import Population
+from pymoo.core.sampling import Sampling
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.util.display.multi import MultiObjectiveOutput
+from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
@@ -265,8 +269,9 @@ class ThetaDEA(GeneticAlgorithm):
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, theta: float = 5.0, pop_size: int | None = None,
-                 sampling=None, crossover=None, mutation=None, eliminate_duplicates: bool = True,
-                 n_offsprings: int | None = None, output=None):
+                 sampling: Sampling | None = None, crossover: Crossover | None = None,
+                 mutation: Mutation | None = None, eliminate_duplicates: bool = True,
+                 n_offsprings: int | None = None, output: Output | None = None):
         ref_dirs = _check_reference_directions(ref_dirs)
         pop_size = len(ref_dirs) if pop_size is None else pop_size
         if not isinstance(pop_size, (int, np.integer)) or pop_size < 2:
