@@ -370,10 +370,14 @@ def test_bench_moeas_smoke(tmp_path, monkeypatch):
     out = tmp_path / "moeas.md"
     assert bench.main(["--algorithms", "theta-dea,not-yet", "--seeds", "1", "--evals", "184",
                        "--dtlz1-evals", "184", "--out", str(out)]) == 0
-    table = out.read_text()
+    table, criteria = out.read_text().split("## Criteria of issue 6")
     rows = [line.split("|")[1:-1] for line in table.splitlines() if line.startswith("| ")][1:]
     assert len(rows) == 3 * 4                                       # nsga2, nsga3, theta-dea, not-yet per case
     by = {(r[0].strip(), r[1].strip()): [c.strip() for c in r[2:]] for r in rows}
     assert by[("nsga3", "DTLZ2 M=3")][3] == "1.00" and by[("nsga2", "DTLZ2 M=4")][6] == "1.00"
     assert by[("not-yet", "DTLZ1 M=3")][-1] == "missing"
     assert by[("theta-dea", "DTLZ2 M=3")][-1] == "ok" and float(by[("theta-dea", "DTLZ2 M=3")][1]) > 0
+    verdicts = {line.split("|")[1].strip(): line.split("|")[-2].strip() for line in criteria.splitlines()
+                if line.startswith("| ")}
+    assert verdicts["not-yet"] == "missing"
+    assert verdicts["theta-dea"].startswith("fails: ") and "DTLZ1" in verdicts["theta-dea"]   # 184 evals: far off
