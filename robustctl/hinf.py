@@ -52,16 +52,34 @@ then uses ``[[u_max_j^2/E, l_j], [l_j', S + S' - P_i]] >= 0`` at each vertex
 
 Numerics
 --------
-* States are balanced by a diagonal similarity (SLICOT ``TB01ID`` on
-  ``[[F, [Bw G]], [Cz, 0]]``) before the LMIs are built.
-* ``gamma_opt`` comes from minimising ``mu``. At that optimum ``X`` can be
-  nearly singular and ``K = Y X^-1`` huge (in continuous time the optimum is
-  often reached only as ``|K| -> inf``). Therefore, unless ``backoff=0``,
-  the gain comes from a second problem at the fixed level
-  ``gamma = (1 + backoff) gamma_opt`` that maximises the smallest eigenvalue
-  ``t`` of every LMI block (a well-centred strictly feasible point).
+* Data normalisation (levels and input bounds are unchanged up to recorded
+  factors): states balanced by a diagonal similarity (SLICOT ``TB01ID`` on
+  ``[[F, [Bw G]], [Cz, 0]]``) and scaled so that ``||Bw|| = 1``; ``w``
+  scaled to unit energy when ``u_max`` is given; ``z`` scaled so that the
+  fixed level of the centring problem is 1; ``[Cz Dzu Dzw]`` replaced by a
+  factor with the same Gram matrix when that has fewer rows.
+* The constant disturbance block ``I`` is eliminated by a Schur complement
+  (e.g. the discrete block becomes ``[[X - Bw Bw', A X + G Y, -Bw Dzw'], [*,
+  X, (Cz X + Dzu Y)'], [*, *, mu I - Dzw Dzw']] >= 0``): same set, ``q``
+  rows smaller.
+* ``gamma_opt`` comes from minimising ``mu`` (non-strict LMIs: the
+  infimum). If the solver reports ``optimal_inaccurate`` the problem is
+  solved again in coordinates where the optimal ``X`` is ~ I (a similarity)
+  and the lower certified level is kept.
+* At the optimum ``X`` can be nearly singular and ``K = Y X^-1`` huge (in
+  continuous time the optimum is often reached only as ``|K| -> inf``).
+  Therefore, unless ``backoff=0``, the gain comes from a second problem at
+  the fixed level ``gamma = (1 + backoff) gamma_opt`` that maximises the
+  smallest eigenvalue ``t`` of every LMI block (a well-centred strictly
+  feasible point). If that fails or its certificate is not strictly
+  positive, two variants are tried (maximise ``lambda_min(X)`` under
+  ``X <= 10 lambda_max(X_opt)``, in the balanced and in the recentred
+  coordinates), then a tenfold backoff (at most twice).
 * Every solve goes through :func:`robustctl._cvx.solve_sdp`: status check,
-  explicit symmetrisation, certificate eigenvalues.
+  explicit symmetrisation, certificate eigenvalues; solver failures are
+  retried with looser tolerances, the certificate is checked regardless.
+* A fixed ``gamma`` is a feasibility problem posed as "maximise the common
+  margin ``t <= 1``" (always feasible); ``t <= 0`` means infeasible.
 
 References
 ----------
@@ -103,6 +121,8 @@ _RECENTRE_REG = 1e-3
 _POLISH_REG = 1e-6
 # Upper bound of X in the centring problem, relative to lambda_max of the optimal X.
 _X_UPPER = 10.0
+# Solver tolerance of the gamma minimisation.
+_MIN_TOL = 1e-10
 # Solver tolerance of the centring problem (its optimum need not be exact).
 _CENTRE_TOL = 1e-7
 # u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that solver rounding cannot
@@ -460,7 +480,10 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
         (per-solve diagnostics), ``X`` (Lyapunov matrix; ``P`` of the
         nominal vertex when ``extended``), ``u_bound`` (guaranteed
         ``max |u_j|`` for ``w_energy``, when ``u_max`` is given),
-        ``scaling`` (state balancing), ``lmi`` and ``backoff``.
+        ``scaling`` (state balancing), ``lmi``, ``vertices`` and ``backoff``
+        (the value used). Each entry of ``solves`` has the solver's
+        ``status``, ``value``, ``tol``, ``solve_time``, ``iterations`` and
+        ``certificate``; centring solves also name their ``centring`` variant.
 
     Raises
     ------
@@ -514,7 +537,7 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
     def minimise():
         V = prob.variables()
         mu = cp.Variable(name="mu")
-        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0), solver=solver,
+        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0), solver=solver, tol=_MIN_TOL,
                              infeasible_msg=f"no H-infinity state feedback: {what}")
         return V, mu, rep
 
@@ -559,7 +582,7 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
         for used_backoff in (backoff, 10.0 * backoff, 100.0 * backoff):
             gamma_fix = gamma_opt * (1.0 + used_backoff)
             eps = max(_STRICT, 1e-2 * used_backoff)
-            for attempt in ("conditioned", "margin", "conditioned-recentred"):
+            for attempt in ("margin", "conditioned", "conditioned-recentred"):
                 prob._transform(T_bal)
                 if attempt == "conditioned-recentred":
                     Vr = {"S": _Value(X_opt), "X": _Value(X_opt)}
