@@ -1,0 +1,241 @@
+"""moo.experiment: the grid, seeds, atomic writes, resumption, parallel runs, and the CLI end to end."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import moo.runner
+from moo.__main__ import main
+from moo.experiment import load_records, plan, run_experiment, run_seeds, write_json_atomic
+
+# ----------------------------------------------------------------------------- seeds and plan
+
+
+def test_run_seeds_from_seed_sequence_and_prefix_stable():
+    expected = [int(c.generate_state(1)[0]) for c in np.random.SeedSequence(5).spawn(4)]
+    assert run_seeds(4, base_seed=5) == expected
+    assert run_seeds(6, base_seed=5)[:4] == expected          # more runs extend the grid
+    assert len(set(run_seeds(50))) == 50
+    with pytest.raises(ValueError, match="runs"):
+        run_seeds(0)
+    with pytest.raises(TypeError, match="base_seed"):
+        run_seeds(2, base_seed=1.5)
+
+
+def test_plan_grid_and_paths(tmp_path):
+    specs = plan("zdt1", "nsga2,nsga3", runs=3, evals=300, max_leaders=4)
+    assert len(specs) == 3 * 2 * 2
+    assert {(s.algorithm, s.molsp) for s in specs} == {(a, v) for a in ("nsga2", "nsga3") for v in (False, True)}
+    assert all((s.max_leaders == 4) == s.molsp for s in specs)
+    # common random numbers: run i has one seed for every algorithm and variant
+    for i, seed in enumerate(run_seeds(3)):
+        assert {s.seed for s in specs if s.run_index == i} == {seed}
+    s = next(s for s in specs if s.molsp and s.algorithm == "nsga3")
+    assert s.path(tmp_path) == tmp_path / "zdt1" / "nsga3+molsp" / f"seed_{s.seed}.json"
+    d = plan("dtlz2", ["nsga2"], runs=1, evals=300, n_obj=5)[0]
+    assert d.path(tmp_path).parent.parent.name == "dtlz2-m5"
+    assert len(plan("zdt1", "all", runs=1, evals=300)) == 20
+
+
+@pytest.mark.parametrize("kwargs, exc, match", [
+    (dict(problem="nope"), ValueError, "unknown problem"),
+    (dict(algorithms="nsga2,foo"), ValueError, "unknown algorithm 'foo'"),
+    (dict(algorithms=[]), ValueError, "at least one"),
+    (dict(runs=0), ValueError, "runs must be >= 1"),
+    (dict(evals=2.5), TypeError, "evals must be an integer"),
+    (dict(max_leaders=0), ValueError, "max_leaders"),
+    (dict(variants=()), ValueError, "variants"),
+])
+def test_plan_bad_arguments(kwargs, exc, match):
+    args = dict(problem="zdt1", algorithms="nsga2", runs=2, evals=300)
+    args.update(kwargs)
+    with pytest.raises(exc, match=match):
+        plan(args.pop("problem"), args.pop("algorithms"), **args)
+
+
+# ----------------------------------------------------------------------------- atomic writes
+
+def test_write_json_atomic_writes_and_leaves_no_temp(tmp_path):
+    path = tmp_path / "a" / "b" / "seed_1.json"
+    write_json_atomic(path, {"x": [1, 2]})
+    assert json.loads(path.read_text()) == {"x": [1, 2]}
+    assert [p.name for p in path.parent.iterdir()] == ["seed_1.json"]
+
+
+def test_write_json_atomic_failure_keeps_old_file(tmp_path):
+    path = tmp_path / "seed_1.json"
+    write_json_atomic(path, {"old": True})
+    before = path.read_bytes()
+    with pytest.raises(TypeError):
+        write_json_atomic(path, {"big": list(range(10000)), "bad": object()})   # fails mid-dump
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["seed_1.json"]            # temp file removed
+
+
+# ----------------------------------------------------------------------------- resumption
+
+class _FakeResult:
+    def __init__(self, problem, algorithm, seed, evals, n_obj, molsp, max_leaders):
+        self.wall_time = 0.0
+        self._d = {"problem": problem, "n_obj": 2 if n_obj is None else n_obj, "algorithm": algorithm,
+                   "molsp": molsp, "max_leaders": max_leaders, "seed": seed, "budget": evals,
+                   "F": [[float(seed % 7), 1.0]], "hv_ref_point": [10.0, 10.0]}
+
+    def to_dict(self):
+        return dict(self._d)
+
+
+@pytest.fixture
+def fake_run(monkeypatch):
+    """Replace moo.runner.run by a counting stub; ``calls`` lists (algorithm, molsp, seed)."""
+    calls = []
+    state = {"fail_after": None}
+
+    def run(problem, algorithm, *, seed, evals, n_obj=None, molsp=False, pop_size=92, max_leaders=None):
+        if state["fail_after"] is not None and len(calls) >= state["fail_after"]:
+            raise KeyboardInterrupt
+        calls.append((algorithm, molsp, seed))
+        return _FakeResult(problem, algorithm, seed, evals, n_obj, molsp, max_leaders)
+
+    monkeypatch.setattr(moo.runner, "run", run)
+    return calls, state
+
+
+def test_resume_after_interrupt_computes_only_missing_runs(tmp_path, fake_run):
+    calls, state = fake_run
+    state["fail_after"] = 5
+    with pytest.raises(KeyboardInterrupt):
+        run_experiment("zdt1", "nsga2,nsga3", runs=3, evals=300, out=tmp_path, progress=False)
+    assert len(calls) == 5 and len(load_records(tmp_path)) == 5
+    done_before = set(calls)
+    state["fail_after"] = None
+    report = run_experiment("zdt1", "nsga2,nsga3", runs=3, evals=300, out=tmp_path, progress=False)
+    assert (report.total, report.skipped, report.completed) == (12, 5, 7)
+    assert len(calls) == 12 and not done_before & set(calls[5:])     # nothing recomputed
+    assert len(load_records(tmp_path)) == 12
+    # nothing left to do; raising --runs only adds the new seeds
+    assert run_experiment("zdt1", "nsga2,nsga3", runs=3, evals=300, out=tmp_path).completed == 0
+    report = run_experiment("zdt1", "nsga2,nsga3", runs=4, evals=300, out=tmp_path, progress=False)
+    assert (report.skipped, report.completed) == (12, 4) and {c[2] for c in calls[12:]} == {run_seeds(4)[3]}
+
+
+def test_resume_rejects_other_settings_and_redoes_corrupt_files(tmp_path, fake_run):
+    calls, _ = fake_run
+    run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path, progress=False)
+    with pytest.raises(ValueError, match="other settings.*budget"):
+        run_experiment("zdt1", "nsga2", runs=1, evals=400, out=tmp_path, progress=False)
+    spec = plan("zdt1", "nsga2", runs=1, evals=300)[0]
+    spec.path(tmp_path).write_text('{"problem": "zdt1", "F": [[1')         # truncated by hand
+    report = run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path, progress=False)
+    assert report.completed == 1 and json.loads(spec.path(tmp_path).read_text())["seed"] == spec.seed
+
+
+def test_resume_real_runs_keep_their_files(tmp_path):
+    kw = dict(runs=2, evals=60, pop_size=20, out=tmp_path, progress=False)
+    run_experiment("zdt1", "nsga2", variants=(False,), **kw)           # the plain half of the grid first
+    first = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("seed_*.json")}
+    assert len(first) == 2
+    report = run_experiment("zdt1", "nsga2", **kw)
+    assert (report.skipped, report.completed) == (2, 2)
+    assert all(p.stat().st_mtime_ns == t for p, t in first.items())
+    recs = load_records(tmp_path)
+    assert sorted((r["molsp"], r["seed"]) for r in recs) == sorted((v, s) for v in (False, True)
+                                                                    for s in run_seeds(2))
+    # same seed, same result: the record equals a direct call of the runner
+    r = moo.runner.run("zdt1", "nsga2", seed=run_seeds(2)[0], evals=60, pop_size=20)
+    rec = next(x for x in recs if not x["molsp"] and x["seed"] == r.seed)
+    assert np.array_equal(np.array(rec["F"]), r.F)
+
+
+def test_workers_give_the_same_records(tmp_path):
+    kw = dict(runs=2, evals=60, pop_size=20, progress=False)
+    run_experiment("zdt1", "nsga2", out=tmp_path / "serial", **kw)
+    report = run_experiment("zdt1", "nsga2", out=tmp_path / "parallel", workers=2, **kw)
+    assert report.completed == 4
+    serial, parallel = load_records(tmp_path / "serial"), load_records(tmp_path / "parallel")
+    assert [(r["molsp"], r["seed"], r["F"], r["n_evals"]) for r in serial] == \
+           [(r["molsp"], r["seed"], r["F"], r["n_evals"]) for r in parallel]
+
+
+def test_progress_goes_to_stderr_only_when_asked(tmp_path, fake_run, capsys):
+    run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path / "a", progress=True)
+    err = capsys.readouterr().err
+    assert "[2/2 runs]" in err and "ETA" in err
+    run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path / "b")   # stderr not a TTY under pytest
+    assert capsys.readouterr().err == ""
+
+
+# ----------------------------------------------------------------------------- CLI
+
+def test_cli_experiment_and_stats_end_to_end(tmp_path):
+    out = tmp_path / "res"
+    code = main(["experiment", "--problem", "zdt1", "--algorithms", "nsga2,nsga3", "--runs", "2",
+                 "--evals", "300", "--out", str(out)])
+    assert code == 0
+    files = sorted(p.relative_to(out).parent.as_posix() for p in out.rglob("seed_*.json"))
+    assert files == ["zdt1/nsga2"] * 2 + ["zdt1/nsga2+molsp"] * 2 + ["zdt1/nsga3"] * 2 + ["zdt1/nsga3+molsp"] * 2
+    for rec in load_records(out):
+        assert rec["budget"] == 300 and 300 <= rec["n_evals"] < 300 + 92
+    table, runs_csv = tmp_path / "t.csv", tmp_path / "runs.csv"
+    assert main(["stats", str(out), "--out", str(table), "--runs-out", str(runs_csv)]) == 0
+    rows = list(csv.DictReader(table.open()))
+    assert len(rows) == 2 * 5 and {r["algorithm"] for r in rows} == {"nsga2", "nsga3"}
+    assert all(int(r["n_plain"]) == 2 and int(r["n_molsp"]) == 2 for r in rows if r["indicator"] == "hv")
+    per_run = list(csv.DictReader(runs_csv.open()))
+    assert len(per_run) == 8 and all(float(r["igd"]) > 0 for r in per_run)
+    for ext in (".md", ".tex"):
+        assert main(["stats", str(out), "--out", str(tmp_path / f"t{ext}")]) == 0
+    assert "nsga2/MO-LSP" in (tmp_path / "t.md").read_text()
+    assert r"\begin{tabular}" in (tmp_path / "t.tex").read_text()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["experiment", "--problem", "zdt1", "--algorithms", "nsga2,foo", "--runs", "2", "--evals", "300"],
+     "unknown algorithm 'foo'"),
+    (["experiment", "--problem", "nope", "--runs", "2", "--evals", "300"], "unknown problem"),
+    (["experiment", "--problem", "zdt1", "--runs", "0", "--evals", "300"], "--runs must be >= 1"),
+    (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "50"], "population size"),
+    (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--workers", "0"], "--workers"),
+    (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--molsp-max-leaders", "0"],
+     "--molsp-max-leaders"),
+    (["experiment", "--problem", "zdt1", "--runs", "x", "--evals", "300"], "invalid int value"),
+    (["experiment", "--problem", "zdt1", "--evals", "300"], "required: --runs"),
+])
+def test_cli_experiment_bad_arguments(tmp_path, capsys, args, message):
+    code = main([*args, "--out", str(tmp_path / "res")])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and err.count("\n") == 1
+    assert not (tmp_path / "res").exists()
+
+
+def test_cli_stats_bad_arguments(tmp_path, capsys):
+    (tmp_path / "empty").mkdir()
+    cases = [(["stats", str(tmp_path / "missing")], "does not exist"),
+             (["stats", str(tmp_path / "empty"), "--out", str(tmp_path / "t.xlsx")], "--out must end in"),
+             (["stats", str(tmp_path / "empty")], "no run records"),
+             (["stats", str(tmp_path / "empty"), "--alpha", "2"], "--alpha")]
+    for args, message in cases:
+        code = main(args)
+        err = capsys.readouterr().err
+        assert code == 2 and message in err and err.count("\n") == 1, (args, err)
+
+
+def test_cli_out_is_a_file(tmp_path, capsys):
+    (tmp_path / "f").write_text("")
+    code = main(["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--out", str(tmp_path / "f")])
+    assert code == 2 and "not a directory" in capsys.readouterr().err
+
+
+def test_python_dash_m_exit_code_and_one_line(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "moo", "experiment", "--problem", "zdt1", "--runs", "-1",
+                           "--evals", "300", "--out", str(tmp_path / "r")], capture_output=True, text=True,
+                          cwd=Path(__file__).resolve().parents[1])
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.strip().splitlines() == ["python -m moo: error: --runs must be >= 1, got -1"]
