@@ -532,8 +532,6 @@ def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | Non
                  f"{w_energy:g} (the input bound may be too tight for this disturbance energy)")
     solves = []
 
-    b_fix = None
-
     def minimise():
         V = prob.variables()
         mu = cp.Variable(name="mu")
