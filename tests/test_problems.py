@@ -398,6 +398,11 @@ def test_applied_bad_arguments(kwargs, exc, words):
             else AppliedRLQRProblem(**kwargs)
 
 
+def test_applied_path_must_match_the_model():
+    with pytest.raises(ValueError, match="path speed"):
+        AppliedRLQRProblem(path=default_route(speed=10.0, duration=10.0))
+
+
 def test_applied_bad_population(applied_short):
     with pytest.raises(ValueError, match=r"\(B, 7\)"):
         applied_short.decode(np.ones((3, 5)))

@@ -164,6 +164,10 @@ class AppliedRLQRProblem(Problem):
             path = default_route()
         elif not isinstance(path, ReferencePath):
             raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
+        par = truck.PAPER_PARAMETERS
+        if abs(path.speed - par.v) > 1e-9 * par.v or abs(path.dt - par.dt) > 1e-12:
+            raise ValueError(f"path speed and dt ({path.speed:g} m/s, {path.dt:g} s) must equal the truck "
+                             f"model's ({par.v:g} m/s, {par.dt:g} s)")
         self.path = path
         if isinstance(overloads, (str, bytes)) or np.ndim(overloads) != 1 or len(overloads) == 0:
             raise ValueError(f"overloads must be a non-empty 1-D sequence of percentages, got {overloads!r}")
