@@ -101,6 +101,7 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _cvx
 from ._validation import as_matrix, check_positive_scalar
@@ -193,7 +194,8 @@ def _u_max(u_max, m: int) -> np.ndarray:
     if arr.ndim == 0:
         arr = np.full(m, float(arr))
     if arr.shape != (m,):
-        raise ValueError(f"u_max must be a scalar or have {m} entries (the number of inputs), got shape {arr.shape}")
+        raise ValueError(f"u_max must be a scalar or have {m} {'entry' if m == 1 else 'entries'} "
+                         f"(the number of inputs), got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ValueError("u_max must be finite (use u_max=None for no input bound)")
     if np.any(arr <= 0):
@@ -417,9 +419,10 @@ class _Problem:
 
 
 # ---------------------------------------------------------------- public
-def hinf(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, vertices: Sequence[Plant] | None = None,
-         gamma: float | None = None, u_max=None, w_energy: float | None = None,
-         backoff: float = 1e-3, extended: bool = False, solver: str = "CLARABEL") -> HinfController:
+def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: ArrayLike | None = None,
+         vertices: Sequence[Plant] | None = None, gamma: float | None = None, u_max: ArrayLike | None = None,
+         w_energy: float | None = None, backoff: float = 1e-3, extended: bool = False,
+         solver: str = "CLARABEL") -> HinfController:
     r"""H-infinity state feedback ``u = K x`` by LMI optimisation.
 
     Finds ``K`` minimising ``gamma`` such that ``||T_zw||_inf < gamma`` for

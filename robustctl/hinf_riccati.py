@@ -49,6 +49,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
+from numpy.typing import ArrayLike
 
 from ._validation import as_matrix, check_positive_scalar
 from .errors import InfeasibleError
@@ -172,7 +173,8 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     return L[:m], P
 
 
-def riccati_level(plant: Plant, gamma: float, *, Bw, Cz, Dzu, Dzw=None):
+def riccati_level(plant: Plant, gamma: float, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike,
+                  Dzw: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """Test one level: ``(K, P)`` if a gain with ``||T_zw||_inf < gamma`` exists, else ``None``.
 
     See the module docstring for the equations and the checks applied.
@@ -183,8 +185,8 @@ def riccati_level(plant: Plant, gamma: float, *, Bw, Cz, Dzu, Dzw=None):
     return level(F, G, Bw, Cz, Dzu, Dzw, gamma)
 
 
-def hinf_riccati(plant: Plant, *, Bw, Cz, Dzu, Dzw=None, rtol: float = 1e-9,
-                 gamma_max: float = 1e10) -> RiccatiHinf:
+def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: ArrayLike | None = None,
+                 rtol: float = 1e-9, gamma_max: float = 1e10) -> RiccatiHinf:
     """Optimal state-feedback H-infinity level by bisection on the game Riccati equation.
 
     Parameters

@@ -316,7 +316,7 @@ PLANT = Plant(np.diag([1.1, 0.5, 0.2]), np.ones((3, 1)), 0.1)
     (dict(Cz=np.full((4, 3), np.inf)), "Cz must have finite"),
     (dict(u_max=0.0), "u_max must be > 0"),
     (dict(u_max=-1.0), "u_max must be > 0"),
-    (dict(u_max=[1.0, 2.0]), r"u_max must be a scalar or have 1 entries"),
+    (dict(u_max=[1.0, 2.0]), r"u_max must be a scalar or have 1 entry \(the number of inputs\), got shape \(2,\)"),
     (dict(u_max=np.inf), "u_max must be finite"),
     (dict(w_energy=1.0), "w_energy is only used together with u_max"),
     (dict(u_max=1.0, w_energy=0.0), "w_energy must be > 0"),
