@@ -31,7 +31,9 @@ Parallelism
 -----------
 ``workers > 1`` runs the grid in a :class:`concurrent.futures.ProcessPoolExecutor`
 (spawned processes); each run is independent and deterministic, so the result
-files do not depend on ``workers``.
+files do not depend on ``workers``. If a run fails or the experiment is
+interrupted, queued runs are cancelled and the error propagates; the records
+already written stay and a rerun resumes from them.
 """
 
 from __future__ import annotations
@@ -310,7 +312,8 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
                 if bar is not None:
                     bar.update(done, f"{spec.variant} s{spec.run_index}")
         else:
-            with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
+            pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+            try:
                 futures = {pool.submit(_execute, spec, str(out)): spec for spec in todo}
                 for fut in as_completed(futures):
                     fut.result()
@@ -318,6 +321,11 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
                     if bar is not None:
                         spec = futures[fut]
                         bar.update(done, f"{spec.variant} s{spec.run_index}")
+            except BaseException:
+                # interrupted or a run failed: drop the queued runs (finished files stay) and re-raise
+                pool.shutdown(wait=False, cancel_futures=True)
+                raise
+            pool.shutdown()
     finally:
         if bar is not None:
             bar.close()

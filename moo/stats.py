@@ -28,7 +28,8 @@ ANOVA (:func:`scipy.stats.f_oneway`) and Tukey's HSD at 95 %
 (:func:`scipy.stats.tukey_hsd`) between the runs of the MOEA and those of its
 MO-LSP version. With two groups both p-values equal that of the two-sided
 pooled-variance t-test; both are reported. ``better`` is the variant with the
-better mean (lower IGD, SP, Spread; higher HV, PD); ``significant`` is
+better mean (lower IGD, SP, Spread; higher HV, PD; note that the paper's
+tables bold the *larger* SP as the better one); ``significant`` is
 ``p_tukey < alpha``. If both groups are constant the tests are undefined: p is
 1 when the two constants are equal and 0 otherwise.
 
@@ -267,7 +268,7 @@ def _mean_std(x: np.ndarray) -> tuple[float, float]:
 def compare(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Comparison]:
     """Mean, sample std (ddof 1) and tests of each MOEA vs its MO-LSP version, per indicator.
 
-    Rows are ordered by problem, algorithm (first appearance) and
+    Rows are ordered by problem, algorithm (registry order, then others by name) and
     :data:`INDICATORS`. An algorithm with runs of one variant only gets NaN
     statistics for the missing one and no test.
     """
@@ -276,8 +277,12 @@ def compare(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Comparis
     groups: dict[tuple[str, str], dict[bool, list[RunIndicators]]] = {}
     for r in runs:
         groups.setdefault((_pkey(r), r.algorithm), {False: [], True: []})[r.molsp].append(r)
+    from moo.algorithms import ALGORITHMS
+
+    order = {name: i for i, name in enumerate(ALGORITHMS)}
     rows = []
-    for (problem, algorithm), by_variant in groups.items():
+    for (problem, algorithm), by_variant in sorted(
+            groups.items(), key=lambda kv: (kv[0][0], order.get(kv[0][1], len(order)), kv[0][1])):
         for name in INDICATORS:
             a = _sample([getattr(r, name) for r in by_variant[False]], "plain")
             b = _sample([getattr(r, name) for r in by_variant[True]], "molsp")
