@@ -535,10 +535,12 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
                  f"{w_energy:g} (the input bound may be too tight for this disturbance energy)")
     solves = []
 
+    b_min = 1.0  # output scaling of the minimisation: level (a b gamma)^2 = mu
+
     def minimise():
         V = prob.variables()
         mu = cp.Variable(name="mu")
-        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0), solver=solver, tol=_MIN_TOL,
+        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0, b=b_min), solver=solver, tol=_MIN_TOL,
                              infeasible_msg=f"no H-infinity state feedback: {what}")
         return V, mu, rep
 
@@ -546,7 +548,29 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     gamma_opt = None
     if gamma is None:
         T_bal = prob.T
-        V, mu, rep = minimise()
+        try:
+            V, mu, rep = minimise()
+        except ConvergenceError:
+            if not extended:
+                raise
+            # The slack-variable problem is numerically harder near the edge of
+            # feasibility: solve the standard one (feasible => the extended one
+            # is too) and restart the extended one in coordinates where its X ~ I.
+            # Its level also scales z so that the extended level is <= 1.
+            prob.extended = False
+            try:
+                Vs, mu_s, rep_s = minimise()
+                solves.append(rep_s.as_dict())
+                ok = np.isfinite(prob.recentre(Vs, _POLISH_REG)) and mu_s.value > 0
+            except (ConvergenceError, InfeasibleError):
+                ok = False
+            finally:
+                prob.extended = True
+            if not ok:
+                raise
+            b_min = 1.0 / float(np.sqrt(mu_s.value))
+            T_bal = prob.T
+            V, mu, rep = minimise()
         solves.append(rep.as_dict())
         T_sol = prob.T
         if rep.status != "optimal" and np.isfinite(prob.recentre(V, _POLISH_REG)):
@@ -560,7 +584,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
                 # both passed the certificate check: the lower level is nearer the infimum
                 if rep2.value < rep.value:
                     V, mu, rep, T_sol = V2, mu2, rep2, prob.T
-        gamma_opt = float(np.sqrt(max(mu.value, 0.0))) / prob.a
+        gamma_opt = float(np.sqrt(max(mu.value, 0.0))) / (prob.a * b_min)
         gamma_fix = gamma_opt * (1.0 + backoff)
         prob._transform(T_sol)
         _, X_opt = prob.gain(V)
