@@ -322,7 +322,8 @@ def make_figures(out: Path, res, designs: list[Design], path) -> list[Path]:
             ax.grid(alpha=0.3)
         ax_start.legend(loc="upper right", fontsize=8)
         ax_u0.legend(loc="lower right", fontsize=8)
-        fig.suptitle(f"Path following at {ov} % overload (controllers designed for 0 %){note}")
+        fig.suptitle(f"Path following at {ov} % overload (controllers designed for 0 %)"
+                     + (f"\n{note.strip()}" if note else ""))
         f = out / f"response_{ov}.png"
         fig.savefig(f, dpi=110)
         plt.close(fig)
@@ -350,7 +351,7 @@ def make_figures(out: Path, res, designs: list[Design], path) -> list[Path]:
         axes[0].legend(loc="upper right", fontsize=8, ncol=3)
         axes[-1].set_xlabel("time [s]")
         fig.suptitle(f"Path-following errors x - x_ref at {ov} % overload "
-                     f"(their MSEs are f1..f4, tracking measure){note}")
+                     "(their MSEs are f1..f4, tracking measure)" + (f"\n{note.strip()}" if note else ""))
         f = out / f"errors_{ov}.png"
         fig.savefig(f, dpi=110)
         plt.close(fig)
