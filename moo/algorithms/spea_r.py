@@ -268,6 +268,10 @@ class SPEAR(GeneticAlgorithm):
         pymoo operators (defaults: uniform sampling and the paper's SBX / PM).
     eliminate_duplicates : bool
         Remove duplicate offspring (pymoo's mechanism).
+    n_offsprings : int, optional
+        Offspring per generation (default ``pop_size``).
+    output : pymoo Output, optional
+        Progress display (default pymoo's multi-objective output).
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, pop_size: int | None = None, k_mating: int = 20,
