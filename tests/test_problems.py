@@ -15,6 +15,9 @@ import control
 import numpy as np
 import pytest
 import scipy.linalg
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 
 import robustctl as rc
 from moo.problems.generic import GenericRLQRProblem
@@ -408,3 +411,31 @@ def test_applied_bad_population(applied_short):
         applied_short.decode(np.ones((3, 5)))
     with pytest.raises(ValueError, match="K must have shape"):
         applied_short.mse(np.zeros((2, 1, 4)))
+
+
+# ------------------------------------------------------------ both, property --
+def _boxed(n_var, high):
+    """Populations of 1-6 designs in [0, high]^n_var, often with entries on the bounds."""
+    value = st.one_of(st.just(0.0), st.just(high), st.floats(0.0, high))
+    return st.integers(1, 6).flatmap(lambda b: arrays(np.float64, (b, n_var), elements=value))
+
+
+@settings(max_examples=25, deadline=None)
+@given(z=_boxed(5, 200.0))
+def test_generic_any_population_in_the_box_gives_finite_objectives(generic, z):
+    f = generic.evaluate(z)
+    assert f.shape == (z.shape[0], 3)
+    assert np.all(np.isfinite(f)) and np.all(f >= 1.0) and np.all(f <= 2 * generic.penalty)
+
+
+@pytest.fixture(scope="module")
+def applied_tiny():
+    return AppliedRLQRProblem(path=default_route(duration=10.0))
+
+
+@settings(max_examples=25, deadline=None)
+@given(z=_boxed(7, 500.0))
+def test_applied_any_population_in_the_box_gives_finite_objectives(applied_tiny, z):
+    f = applied_tiny.evaluate(np.maximum(z, 1e-6))
+    assert f.shape == (z.shape[0], 4)
+    assert np.all(np.isfinite(f)) and np.all(f > 0) and np.all(f <= 2 * applied_tiny.penalty)
