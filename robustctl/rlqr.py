@@ -90,6 +90,7 @@ _DEFAULT_TOL = 1e-10
 _DEFAULT_MAX_ITER = 10_000
 _MU_MIN = 1e-100  # smallest accepted penalty (mu^-1 enters products with P)
 _DIVERGED = 1e250  # |P| beyond this: the recursion is diverging
+_STABILITY_MARGIN = 1e-9  # accepted closed loops have rho(L) < 1 - margin
 
 
 # --------------------------------------------------------------------------- #
@@ -233,8 +234,9 @@ def _sda(d: _Data, tol: float, max_steps: int = 64) -> tuple[np.ndarray, np.ndar
 
     solved by the structure-preserving doubling algorithm (Chu, Fan & Lin
     2005, Linear Algebra Appl. 396, 55-80): ``H_k -> X`` quadratically.
-    Returns ``(X, steps)``; designs whose iteration blows up come back
-    non-finite/huge (the caller falls back to the plain recursion).
+    Returns ``(X, steps, converged)``. If ``H_k`` blows up or keeps changing
+    after ``max_steps`` doublings (``2**64`` recursion steps), the recursion
+    has no stabilising fixed point: ``converged`` is False.
     """
     B = d.EF.shape[0]
     n = d.F.shape[0]
@@ -248,6 +250,7 @@ def _sda(d: _Data, tol: float, max_steps: int = 64) -> tuple[np.ndarray, np.ndar
     H = _sym(d.Q + EFT @ Gam @ d.EF)
     Gs = _sym(d.G @ (Rinv - np.swapaxes(EGR, 1, 2) @ Gam @ EGR) @ d.G.T + d.S)
     steps = np.zeros(B, dtype=int)
+    converged = np.zeros(B, dtype=bool)
     active = _healthy(H) & _healthy(Gs)
     eye = np.eye(n)
     for _ in range(max_steps):
@@ -264,8 +267,9 @@ def _sda(d: _Data, tol: float, max_steps: int = 64) -> tuple[np.ndarray, np.ndar
         change = np.full(idx.size, np.inf)
         ok = _healthy(h_new)
         change[ok] = _relchange(h_new[ok], h[ok])
+        converged[idx[change < tol]] = True
         active[idx[(change < tol) | ~ok]] = False
-    return H, steps
+    return H, steps, converged
 
 
 def _steady_state(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerate: bool):
@@ -275,15 +279,17 @@ def _steady_state(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerat
     Riccati equation; ``False``: the paper's recursion from ``P0``. Either way
     one more recursion step gives ``K``, ``L`` and the residual.
 
-    Returns ``(P, K, L, iterations, residual, stable)``. A design is
-    acceptable iff ``residual < tol`` and ``stable`` (``rho(L) < 1``), which
-    singles out the stabilising solution. Diverging designs come back with
-    ``residual = inf`` and NaN ``K``, ``L``.
+    Returns ``(P, K, L, iterations, residual, stable, settled)``. A design is
+    acceptable iff ``residual < tol`` and ``stable`` (``rho(L) < 1 - 1e-9``),
+    which singles out the stabilising solution. ``settled``: the iteration
+    itself converged (False: it blew up or never settled, so no stabilising
+    fixed point exists). Diverging designs come back with ``residual = inf``
+    and NaN ``K``, ``L``.
     """
     B = d.EF.shape[0]
     n, m = d.G.shape
     if accelerate:  # doubling converges quadratically: run it well past tol
-        P, iterations = _sda(d, min(1e-3 * tol, 1e-13))
+        P, iterations, settled = _sda(d, min(1e-3 * tol, 1e-13))
     else:
         P = np.broadcast_to(P0, (B, n, n)).copy()
         iterations = np.zeros(B, dtype=int)
@@ -297,6 +303,7 @@ def _steady_state(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerat
             active[idx[(change < tol) | ~_healthy(P_new)]] = False  # converged, or diverging
             if not active.any():
                 break
+        settled = ~active & _healthy(P)
     K = np.full((B, m, n), np.nan)
     L = np.full((B, n, n), np.nan)
     residual = np.full(B, np.inf)
@@ -307,8 +314,8 @@ def _steady_state(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerat
         P_new, K[idx], L[idx] = _step(P[idx], d_sub(d, good))
         residual[idx] = _relchange(P_new, P[idx])
         P[idx] = P_new
-        stable[idx] = _spectral_radius(L[idx]) < 1.0
-    return P, K, L, iterations, residual, stable
+        stable[idx] = _spectral_radius(L[idx]) < 1.0 - _STABILITY_MARGIN
+    return P, K, L, iterations, residual, stable, settled
 
 
 def d_sub(d: _Data, mask: np.ndarray) -> _Data:
@@ -316,6 +323,31 @@ def d_sub(d: _Data, mask: np.ndarray) -> _Data:
     if mask.all():
         return d
     return _Data(d.F, d.G, d.Q, d.R, d.EF[mask], d.EG[mask], d.S[mask], d.lam_inv[mask], d.soft)
+
+
+def _design_batch(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerate: bool):
+    """Steady state of every design with its verdict.
+
+    Returns ``(P, K, L, iterations, residual, reason)``, ``reason`` in
+    ``{"ok", "diverged", "not converged"}``. Designs on which doubling settled
+    but missed the acceptance test (ill-conditioned ones, residual at the
+    rounding floor) are redone with the plain recursion, the reference path.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        P, K, L, it, res, stable, settled = _steady_state(d, P0, tol, max_iter, accelerate)
+        retry = settled & _healthy(P) & ~((res < tol) & stable)
+        if accelerate and retry.any():
+            sub = np.flatnonzero(retry)
+            it_sda = it[sub].copy()
+            out = _steady_state(d_sub(d, retry), P0, tol, max_iter, accelerate=False)
+            for arr, new in zip((P, K, L, it, res, stable, settled), out):
+                arr[sub] = new
+            it[sub] += it_sda
+    diverged = ~_healthy(P) | ~np.isfinite(K).all(axis=(1, 2))
+    reason = np.full(len(P), "ok", dtype="<U13")
+    reason[diverged] = "diverged"
+    reason[~diverged & ~((res < tol) & stable)] = "not converged"
+    return P, K, L, it, res, reason
 
 
 # --------------------------------------------------------------------------- #
@@ -580,19 +612,8 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
     if rank_ok.any():
         d = _make_data(plant.F, plant.G, Q, R, H, EF[rank_ok], EG[rank_ok], mu[rank_ok], alpha)
         idx = np.flatnonzero(rank_ok)
-        with np.errstate(over="ignore", invalid="ignore"):
-            Pk, Kk, Lk, it, res, stable = _steady_state(d, P0, tol, int(max_iter), accelerate=True)
-            retry = _healthy(Pk) & ~((res < tol) & stable)
-            if retry.any():  # doubling failed: the plain recursion, the reference path
-                sub = np.flatnonzero(retry)
-                out = _steady_state(d_sub(d, retry), P0, tol, int(max_iter), accelerate=False)
-                for arr, new in zip((Pk, Kk, Lk, it, res, stable), out):
-                    arr[sub] = new
-                it[sub] += out[3]
-        P[idx], K[idx], L[idx], iterations[idx], residual[idx] = Pk, Kk, Lk, it, res
-        diverged = ~_healthy(Pk) | ~np.isfinite(Kk).all(axis=(1, 2))
-        reason[idx[diverged]] = "diverged"
-        reason[idx[~diverged & ~((res < tol) & stable)]] = "not converged"
+        P[idx], K[idx], L[idx], iterations[idx], residual[idx], reason[idx] = _design_batch(
+            d, P0, tol, int(max_iter), accelerate=True)
     ok = reason == "ok"
     K[~ok], P[~ok], L[~ok] = np.nan, np.nan, np.nan
     stabilizing = np.zeros(B, dtype=bool)
@@ -707,8 +728,8 @@ def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DE
 
     with np.errstate(over="ignore", invalid="ignore"):
         if implementation == "kkt":
-            Ps, K, L, it, res, _ = _steady_state(d, P_N, tol, int(max_iter), accelerate)
-            P, K, L, it, res = Ps[0], K[0], L[0], int(it[0]), float(res[0])
+            Ps, Ks, Ls, its, ress, reasons = _design_batch(d, P_N, tol, int(max_iter), accelerate)
+            P, K, L, it, res, verdict = Ps[0], Ks[0], Ls[0], int(its[0]), float(ress[0]), reasons[0]
         else:
             P, it, res = P_N, 0, np.inf
             for it in range(1, int(max_iter) + 1):
@@ -721,13 +742,19 @@ def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DE
                 P = P_new
                 if res < tol or not np.abs(P).max() < _DIVERGED:
                     break
-    if not (np.abs(P).max() < _DIVERGED and np.isfinite(K).all()):
+            if not (np.abs(P).max() < _DIVERGED and np.isfinite(K).all()):
+                verdict = "diverged"
+            elif res < tol and _spectral_radius(L[None])[0] < 1.0 - _STABILITY_MARGIN:
+                verdict = "ok"
+            else:
+                verdict = "not converged"
+    if verdict == "diverged":
         why = (" At mu = inf the gain must satisfy EF + EG K = 0; the closed loop F + G K it forces "
                "may be unstable." if np.isinf(mu) else "")
-        raise ConvergenceError(f"the RLQR recursion diverged (P grows without bound) after {it} "
-                               f"steps: no stabilising steady state for this plant and uncertainty.{why}")
-    if not res < tol:
-        raise ConvergenceError(f"the RLQR recursion did not converge in max_iter={max_iter} steps "
-                               f"(relative change of P {res:.3g} >= tol={tol:g})")
+        raise ConvergenceError(f"the RLQR recursion diverged (P grows without bound): no stabilising "
+                               f"steady state for this plant and uncertainty.{why}")
+    if verdict != "ok":
+        raise ConvergenceError(f"the RLQR recursion did not reach a stabilising steady state in "
+                               f"max_iter={max_iter} steps (relative change of P {res:.3g}, tol={tol:g})")
     info.update(P=P, L=L, iterations=it, residual=res)
     return Controller(K, "rlqr", plant, info)

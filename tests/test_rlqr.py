@@ -185,7 +185,7 @@ def test_errors_single_design(generic_plant):
     with pytest.raises(rc.ConvergenceError, match="diverged"):
         rc.design("rlqr", rc.Plant(np.diag([1.5, 0.5, 0.2]), [[1.0], [0.0], [0.0]], 0.1),
                   [[0.0, 1.0, 0.0]], [[1.0]], np.inf)
-    with pytest.raises(rc.ConvergenceError, match="did not converge in max_iter=3"):
+    with pytest.raises(rc.ConvergenceError, match="did not reach a stabilising steady state in max_iter=3"):
         rc.design("rlqr", generic_plant, EF, EG, 10.0, accelerate=False, max_iter=3)
 
 
