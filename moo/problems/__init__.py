@@ -8,8 +8,9 @@ carrying two reference points:
 
 ``generic`` and ``applied`` (3 and 4 objectives) come from
 :mod:`moo.problems.generic` and :mod:`moo.problems.applied`, imported on first
-use; they set their own reference points (the paper's HV points
-``[25, 25, 25]`` and ``[5000, 10000, 5000, 5000]``, see those modules).
+use; they set their own reference points from the scale of our objectives
+(the paper's HV points ``[25, 25, 25]`` and ``[5000, 10000, 5000, 5000]`` are in
+its own units, not ours; see those modules).
 
 ZDT1-6 (2 objectives) and DTLZ1-7 (``n_obj`` objectives, default 3) are pymoo's,
 with Deb et al.'s numbers of variables: ZDT 30 (ZDT4, ZDT6: 10), DTLZ
