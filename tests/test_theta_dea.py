@@ -381,3 +381,19 @@ def test_bench_moeas_smoke(tmp_path, monkeypatch):
                 if line.startswith("| ")}
     assert verdicts["not-yet"] == "missing"
     assert verdicts["theta-dea"].startswith("fails: ") and "DTLZ1" in verdicts["theta-dea"]   # 184 evals: far off
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), M=st.sampled_from([2, 3, 5]))
+def test_normalization_is_invariant_to_positive_affine_maps(seed, M):
+    # normalising F and a * F + b (a > 0 per objective) over two updates must give the same result:
+    # ideal, ASF extremes (scale-free through s = z_nad - z*), intercepts and fallbacks all commute with the map
+    rng = np.random.default_rng(seed)
+    a, b = np.exp(rng.uniform(-3, 3, M)), rng.uniform(-10, 10, M)
+    F1, F2 = rng.random((30, M)) ** 2, rng.random((30, M)) ** 2
+    n, m = HyperplaneNormalization(M), HyperplaneNormalization(M)
+    for F in (F1, F2):
+        n.update(F)
+        m.update(a * F + b)
+    np.testing.assert_allclose(m.normalize(a * F2 + b), n.normalize(F2), rtol=1e-7, atol=1e-9)
+    assert n.hyperplane_ok == m.hyperplane_ok
