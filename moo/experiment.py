@@ -51,6 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
+from moo._validation import check_int
 from moo.algorithms import ALGORITHMS
 
 __all__ = ["RunSpec", "ExperimentReport", "plan", "run_seeds", "run_experiment", "load_records",
@@ -105,18 +106,10 @@ def problem_dir(problem: str, n_obj: int | None) -> str:
     return f"{key}-m{n_obj}" if (n_obj is not None and key.startswith("dtlz")) else key
 
 
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
-
-
 def run_seeds(runs: int, base_seed: int = 0) -> list[int]:
     """The integer seeds of runs ``0 .. runs-1`` (see the module docstring)."""
-    runs = _check_int(runs, "runs", 1)
-    base_seed = _check_int(base_seed, "base_seed", 0)
+    runs = check_int(runs, "runs", 1)
+    base_seed = check_int(base_seed, "base_seed", 0)
     return [int(child.generate_state(1)[0]) for child in np.random.SeedSequence(base_seed).spawn(runs)]
 
 
@@ -167,12 +160,12 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
     if not isinstance(problem, str) or problem.lower() not in PROBLEMS:
         raise ValueError(f"unknown problem {problem!r}; valid: {', '.join(PROBLEMS)}")
     names = _algorithms(algorithms)
-    evals = _check_int(evals, "evals", 1)
-    pop_size = _check_int(pop_size, "pop_size", 4)
+    evals = check_int(evals, "evals", 1)
+    pop_size = check_int(pop_size, "pop_size", 4)
     if n_obj is not None:
-        n_obj = _check_int(n_obj, "n_obj", 2)
+        n_obj = check_int(n_obj, "n_obj", 2)
     if max_leaders is not None:
-        max_leaders = _check_int(max_leaders, "max_leaders", 1)
+        max_leaders = check_int(max_leaders, "max_leaders", 1)
     variants = [bool(v) for v in variants]
     if not variants:
         raise ValueError("variants must hold at least one of False (plain), True (MO-LSP)")
@@ -292,7 +285,7 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
     """
     specs = plan(problem, algorithms, runs=runs, evals=evals, n_obj=n_obj, base_seed=base_seed,
                  pop_size=pop_size, max_leaders=max_leaders, variants=variants)
-    workers = _check_int(workers, "workers", 1)
+    workers = check_int(workers, "workers", 1)
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out must be a directory, {str(out)!r} is a file")

@@ -30,6 +30,7 @@ import numpy as np
 from pymoo.core.callback import Callback
 from pymoo.core.population import Population
 
+from moo._validation import check_int
 from moo.algorithms import make_algorithm
 from moo.indicators import hypervolume
 from moo.molsp import molsp as add_molsp
@@ -140,14 +141,6 @@ class _HVHistory(Callback):
             self.progress(n_eval, self.budget)
 
 
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
-
-
 def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,
         molsp: bool = False, pop_size: int = 92, max_leaders: int | None = None,
         progress: Callable[[int, int], None] | None = None) -> RunResult:
@@ -179,11 +172,11 @@ def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | Non
     -------
     RunResult
     """
-    seed = _check_int(seed, "seed", 0)
-    evals = _check_int(evals, "evals", 1)
-    pop_size = _check_int(pop_size, "pop_size", 4)
+    seed = check_int(seed, "seed", 0)
+    evals = check_int(evals, "evals", 1)
+    pop_size = check_int(pop_size, "pop_size", 4)
     if max_leaders is not None:
-        max_leaders = _check_int(max_leaders, "max_leaders", 1)
+        max_leaders = check_int(max_leaders, "max_leaders", 1)
         if not molsp:
             raise ValueError("max_leaders needs molsp=True")
     prob = make_problem(problem, n_obj)

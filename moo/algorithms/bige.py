@@ -86,6 +86,7 @@ from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
+from .._validation import check_int
 from .operators import POP_SIZE, paper_crossover, paper_mutation
 
 __all__ = ["BiGE", "BiGESurvival", "bige_estimation", "make_bige", "niche_radius"]
@@ -93,11 +94,8 @@ __all__ = ["BiGE", "BiGESurvival", "bige_estimation", "make_bige", "niche_radius
 
 def niche_radius(pop_size: int, n_obj: int) -> float:
     """BiGE niche radius ``r = 1 / N^(1/m)`` (Li, Yang & Liu 2015, Eq. 3)."""
-    for name, val, low in (("pop_size", pop_size, 1), ("n_obj", n_obj, 1)):
-        if isinstance(val, bool) or not isinstance(val, (int, np.integer)):
-            raise TypeError(f"{name} must be an integer, got {type(val).__name__}")
-        if val < low:
-            raise ValueError(f"{name} must be >= {low}, got {val}")
+    pop_size = check_int(pop_size, "pop_size", 1)
+    n_obj = check_int(n_obj, "n_obj", 1)
     return float(pop_size) ** (-1.0 / float(n_obj))
 
 

@@ -69,7 +69,6 @@ Readings where the paper leaves room
 
 from __future__ import annotations
 
-import numbers
 from typing import Literal
 
 import numpy as np
@@ -82,6 +81,7 @@ from pymoo.util.display.multi import MultiObjectiveOutput
 
 from robustctl._validation import as_matrix, check_positive_scalar
 
+from .._validation import check_choice, check_int
 from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
 
@@ -90,20 +90,6 @@ __all__ = ["EFRRR", "EFRRRSurvival", "maximum_ranking", "make_efr_rr"]
 _ZERO_WEIGHT = 1e-6
 _SCALARIZINGS = ("tchebycheff", "pbi")
 _MATINGS = ("random", "tournament")
-
-
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
-
-
-def _check_choice(value, name: str, choices: tuple[str, ...]) -> str:
-    if not isinstance(value, str) or value.lower() not in choices:
-        raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
-    return value.lower()
 
 
 def perpendicular_distances(F: np.ndarray, W: np.ndarray) -> np.ndarray:
@@ -155,10 +141,10 @@ def maximum_ranking(
     if np.any(W < 0) or np.any(W.sum(axis=1) <= 0):
         raise ValueError("ref_dirs must be non-negative with a positive sum in every row")
     n, nw = F.shape[0], W.shape[0]
-    k = _check_int(n_neighbors, "n_neighbors", 1)
+    k = check_int(n_neighbors, "n_neighbors", 1)
     if k > nw:
         raise ValueError(f"n_neighbors must be <= the number of weight vectors ({nw}), got {k}")
-    scalarizing = _check_choice(scalarizing, "scalarizing", _SCALARIZINGS)
+    scalarizing = check_choice(scalarizing, "scalarizing", _SCALARIZINGS)
 
     d2 = perpendicular_distances(F, W)
     nearest = np.argsort(d2, axis=1, kind="stable")[:, :k]          # B(x), (n, K)
@@ -278,14 +264,14 @@ class EFRRR(GeneticAlgorithm):
             raise ValueError(f"ref_dirs must have >= 2 columns (objectives), got shape {ref_dirs.shape}")
         if np.any(ref_dirs < 0) or np.any(ref_dirs.sum(axis=1) <= 0):
             raise ValueError("ref_dirs must be non-negative with a positive sum in every row")
-        pop_size = _check_int(pop_size, "pop_size", 2)
-        n_neighbors = _check_int(n_neighbors, "n_neighbors", 1)
+        pop_size = check_int(pop_size, "pop_size", 2)
+        n_neighbors = check_int(n_neighbors, "n_neighbors", 1)
         if n_neighbors > len(ref_dirs):
             raise ValueError(f"n_neighbors must be <= the number of weight vectors "
                              f"({len(ref_dirs)}), got {n_neighbors}")
-        scalarizing = _check_choice(scalarizing, "scalarizing", _SCALARIZINGS)
+        scalarizing = check_choice(scalarizing, "scalarizing", _SCALARIZINGS)
         theta = check_positive_scalar(theta, "theta")
-        mating = _check_choice(mating, "mating", _MATINGS)
+        mating = check_choice(mating, "mating", _MATINGS)
         self.ref_dirs = ref_dirs
         self.n_neighbors = n_neighbors
         super().__init__(
@@ -318,7 +304,7 @@ def make_efr_rr(*, n_obj: int, pop_size: int = POP_SIZE, n_neighbors: int = 2,
     in the paper, ``K = 2`` nearest weight vectors, normalised modified
     Tchebycheff fitness, random mating.
     """
-    n_obj = _check_int(n_obj, "n_obj", 2)
-    pop_size = _check_int(pop_size, "pop_size", 2)
+    n_obj = check_int(n_obj, "n_obj", 2)
+    pop_size = check_int(pop_size, "pop_size", 2)
     return EFRRR(reference_directions(n_obj, pop_size), pop_size=pop_size, n_neighbors=n_neighbors,
                  scalarizing=scalarizing, theta=theta, mating=mating)

@@ -79,7 +79,6 @@ Readings where the paper leaves room
 
 from __future__ import annotations
 
-import numbers
 from typing import Literal
 
 import numpy as np
@@ -93,6 +92,7 @@ from scipy.spatial.distance import cdist
 
 from robustctl._validation import as_matrix
 
+from .._validation import check_choice, check_int
 from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, paper_crossover, paper_mutation
 
@@ -109,20 +109,6 @@ __all__ = [
 
 _FC_FLOOR = 1e-6
 _CHOICES = ("roulette", "best")
-
-
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
-
-
-def _check_choice(value, name: str, choices: tuple[str, ...]) -> str:
-    if not isinstance(value, str) or value.lower() not in choices:
-        raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
-    return value.lower()
 
 
 def favorable_convergence(F: np.ndarray) -> np.ndarray:
@@ -192,12 +178,12 @@ def select_by_dd_fc(
     fc = np.asarray(fc, dtype=float)
     if fc.shape != (c,):
         raise ValueError(f"fc must have shape ({c},) (one per candidate), got shape {fc.shape}")
-    n_select = _check_int(n_select, "n_select", 0)
+    n_select = check_int(n_select, "n_select", 0)
     if n_select > c:
         raise ValueError(f"n_select must be <= the number of candidates ({c}), got {n_select}")
-    k = _check_int(n_neighbors, "n_neighbors", 1)
-    L = _check_int(n_candidates, "n_candidates", 1)
-    candidate_choice = _check_choice(candidate_choice, "candidate_choice", _CHOICES)
+    k = check_int(n_neighbors, "n_neighbors", 1)
+    L = check_int(n_candidates, "n_candidates", 1)
+    candidate_choice = check_choice(candidate_choice, "candidate_choice", _CHOICES)
     if candidate_choice == "roulette" and random_state is None:
         raise ValueError("random_state is required with candidate_choice='roulette'")
 
@@ -347,11 +333,11 @@ class MaOEADDFC(GeneticAlgorithm):
     def __init__(self, n_obj: int, *, pop_size: int = POP_SIZE, n_neighbors: int = 5,
                  n_candidates: int = 3, candidate_choice: str = "roulette", sampling=None,
                  crossover=None, mutation=None, eliminate_duplicates: bool = True, output=None):
-        self.n_obj = _check_int(n_obj, "n_obj", 2)
-        pop_size = _check_int(pop_size, "pop_size", 2)
-        n_neighbors = _check_int(n_neighbors, "n_neighbors", 1)
-        n_candidates = _check_int(n_candidates, "n_candidates", 1)
-        candidate_choice = _check_choice(candidate_choice, "candidate_choice", _CHOICES)
+        self.n_obj = check_int(n_obj, "n_obj", 2)
+        pop_size = check_int(pop_size, "pop_size", 2)
+        n_neighbors = check_int(n_neighbors, "n_neighbors", 1)
+        n_candidates = check_int(n_candidates, "n_candidates", 1)
+        candidate_choice = check_choice(candidate_choice, "candidate_choice", _CHOICES)
         super().__init__(
             pop_size=pop_size,
             sampling=sampling if sampling is not None else FloatRandomSampling(),

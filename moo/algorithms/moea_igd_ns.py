@@ -67,8 +67,6 @@ resolve doubts, nothing ported).
 
 from __future__ import annotations
 
-import numbers
-
 import numpy as np
 from moocore import is_nondominated
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
@@ -80,6 +78,7 @@ from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
+from .._validation import check_int
 from .operators import POP_SIZE, paper_crossover, paper_mutation
 
 __all__ = [
@@ -92,14 +91,6 @@ __all__ = [
     "truncate_by_angle",
     "update_archive",
 ]
-
-
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
 
 
 def _as_points(value, name: str, n_obj: int | None = None) -> np.ndarray:
@@ -223,7 +214,7 @@ def reduce_by_igd_ns(F, reference, n_keep: int) -> np.ndarray:
     """
     F = _as_points(F, "F")
     R = _as_points(reference, "reference", F.shape[1])
-    n_keep = _check_int(n_keep, "n_keep", 0)
+    n_keep = check_int(n_keep, "n_keep", 0)
     n = len(F)
     if n_keep >= n:
         return np.arange(n)
@@ -257,7 +248,7 @@ def truncate_by_angle(F, max_size: int, random_state=None) -> np.ndarray:
     taken from the ideal point ``min(F)``. Returns indices in selection order.
     """
     F = _as_points(F, "F")
-    max_size = _check_int(max_size, "max_size", 1)
+    max_size = check_int(max_size, "max_size", 1)
     n = len(F)
     if n <= max_size:
         return np.arange(n)
@@ -304,7 +295,7 @@ class IGDNSSurvival(Survival):
 
     def __init__(self, archive_size: int) -> None:
         super().__init__(filter_infeasible=True)
-        self.archive_size = _check_int(archive_size, "archive_size", 1)
+        self.archive_size = check_int(archive_size, "archive_size", 1)
         self.archive: Population | None = None
 
     def reset(self) -> None:
@@ -353,7 +344,7 @@ class MOEAIGDNS(GeneticAlgorithm):
 
     def __init__(self, *, pop_size: int = POP_SIZE, archive_size: int | None = None, sampling=None,
                  crossover=None, mutation=None, eliminate_duplicates: bool = True) -> None:
-        pop_size = _check_int(pop_size, "pop_size", 2)
+        pop_size = check_int(pop_size, "pop_size", 2)
         if archive_size is None:
             archive_size = 5 * pop_size
         super().__init__(
@@ -385,5 +376,5 @@ def make_moea_igd_ns(*, n_obj: int, pop_size: int = POP_SIZE, archive_size: int 
     archive_size : int, optional
         Bound of the external archive (default ``5 * pop_size``).
     """
-    _check_int(n_obj, "n_obj", 2)
+    check_int(n_obj, "n_obj", 2)
     return MOEAIGDNS(pop_size=pop_size, archive_size=archive_size)

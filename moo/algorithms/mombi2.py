@@ -81,8 +81,6 @@ doubts, nothing ported). Where those differ:
 
 from __future__ import annotations
 
-import numbers
-
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
@@ -90,6 +88,7 @@ from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.operators.selection.tournament import TournamentSelection
 from pymoo.util.display.multi import MultiObjectiveOutput
 
+from .._validation import check_int, check_real
 from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
 
 __all__ = [
@@ -106,27 +105,6 @@ __all__ = [
 ZERO_WEIGHT = 1e-6
 #: Smallest range z_max - z_min used in the normalisation (avoids 0/0).
 _TINY_RANGE = 1e-12
-
-
-def _check_real(value, name: str, *, positive: bool) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    x = float(value)
-    if not np.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {x}")
-    if positive and x <= 0:
-        raise ValueError(f"{name} must be > 0, got {x}")
-    if not positive and x < 0:
-        raise ValueError(f"{name} must be >= 0, got {x}")
-    return x
-
-
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
 
 
 def _check_weights(weights) -> np.ndarray:
@@ -276,9 +254,9 @@ class R2RankingSurvival(Survival):
                  record_size: int = 5) -> None:
         super().__init__(filter_infeasible=True)
         self.weights = _check_weights(weights)
-        self.alpha = _check_real(alpha, "alpha", positive=False)
-        self.epsilon = _check_real(epsilon, "epsilon", positive=False)
-        self.record_size = _check_int(record_size, "record_size", 1)
+        self.alpha = check_real(alpha, "alpha", positive=False)
+        self.epsilon = check_real(epsilon, "epsilon", positive=False)
+        self.record_size = check_int(record_size, "record_size", 1)
         self.reset()
 
     def reset(self) -> None:
@@ -381,7 +359,7 @@ class MOMBI2(GeneticAlgorithm):
         ref_dirs = _check_weights(ref_dirs)
         if pop_size is None:
             pop_size = len(ref_dirs)
-        pop_size = _check_int(pop_size, "pop_size", 2)
+        pop_size = check_int(pop_size, "pop_size", 2)
         self.ref_dirs = ref_dirs
         super().__init__(
             pop_size=pop_size,
@@ -419,7 +397,7 @@ def make_mombi2(*, n_obj: int, pop_size: int = POP_SIZE, alpha: float = 0.5, eps
     record_size : int
         Number of past nadir candidates kept (5).
     """
-    n_obj = _check_int(n_obj, "n_obj", 2)
-    pop_size = _check_int(pop_size, "pop_size", 2)
+    n_obj = check_int(n_obj, "n_obj", 2)
+    pop_size = check_int(pop_size, "pop_size", 2)
     return MOMBI2(reference_directions(n_obj, pop_size), pop_size=pop_size, alpha=alpha,
                   epsilon=epsilon, record_size=record_size)

@@ -39,7 +39,8 @@ from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
 from robustctl.simulate import DEFAULT_BOUND, simulate
 
-from .generic import (_as_population, _check_aggregate, _check_int, _check_penalty, _check_ref_point, _decode,
+from .._validation import check_int
+from .generic import (_as_population, _check_aggregate, _check_penalty, _check_ref_point, _decode,
                       _penalise, _spectral_radius, _weights)
 
 __all__ = ["AppliedRLQRProblem"]
@@ -159,7 +160,7 @@ class AppliedRLQRProblem(Problem):
         Q_default, R_default = truck.lqr_weights(doubled=True)
         self.Q, self.R = _weights(Q_default if Q is None else Q, R_default if R is None else R, n, m)
         self.alpha = check_positive_scalar(alpha, "alpha")
-        self.max_iter = _check_int(max_iter, "max_iter", 1)
+        self.max_iter = check_int(max_iter, "max_iter", 1)
         if path is None:
             path = default_route()
         elif not isinstance(path, ReferencePath):

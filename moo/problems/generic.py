@@ -29,7 +29,6 @@ discrete-time state-space systems", ACC 2009 (the RLQR).
 
 from __future__ import annotations
 
-import numbers
 from typing import Literal
 
 import numpy as np
@@ -37,6 +36,8 @@ from pymoo.core.problem import Problem
 
 import robustctl as rc
 from robustctl._validation import as_matrix, check_positive_scalar, check_spd
+
+from .._validation import check_int
 
 __all__ = ["GenericRLQRProblem"]
 
@@ -111,14 +112,6 @@ def _check_aggregate(aggregate) -> str:
     if aggregate not in ("mean", "max"):
         raise ValueError(f"aggregate must be 'mean' or 'max', got {aggregate!r}")
     return aggregate
-
-
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
 
 
 def _weights(Q, R, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
@@ -273,9 +266,9 @@ class GenericRLQRProblem(Problem):
         self.EG_true = EG_TRUE.copy()
         self.Q, self.R = _weights(Q, R, n, m)
         self.alpha = check_positive_scalar(alpha, "alpha")
-        self.max_iter = _check_int(max_iter, "max_iter", 1)
+        self.max_iter = check_int(max_iter, "max_iter", 1)
         if deltas is None:
-            n_deltas = _check_int(n_deltas, "n_deltas", 2)
+            n_deltas = check_int(n_deltas, "n_deltas", 2)
             rng = np.random.default_rng(seed)
             deltas = np.concatenate([[-1.0, 1.0], rng.uniform(-1.0, 1.0, n_deltas - 2)])
         else:
@@ -286,7 +279,7 @@ class GenericRLQRProblem(Problem):
         x0 = np.eye(n) if initial_states is None else as_matrix(
             initial_states, "initial_states", cols=n, cols_what="the number of states")
         self.initial_states = x0
-        self.horizon = _check_int(horizon, "horizon", 1)
+        self.horizon = check_int(horizon, "horizon", 1)
         self.aggregate = _check_aggregate(aggregate)
         self.penalty = _check_penalty(penalty)
         self.hv_ref_point = _check_ref_point(hv_ref_point, "hv_ref_point", self._HV_REF)
