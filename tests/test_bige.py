@@ -17,11 +17,11 @@ from pymoo.problems import get_problem
 from pymoo.util.ref_dirs import get_reference_directions
 
 from moo.algorithms import make_algorithm
+from moo.algorithms._base import BinaryTournament
 from moo.algorithms.bige import (
     BiGE,
     BiGESurvival,
     _bige_tournament,
-    _BinaryTournament,
     bige_estimation,
     make_bige,
     niche_radius,
@@ -215,7 +215,8 @@ def test_mating_selection_is_a_binary_tournament_with_replacement():
     # Goals as above: p0 is dominated by p1 and p2, which are mutually non-dominated.
     # Pairs uniform with replacement from 3: p0 wins only (0, 0): 1/9;
     # p1 wins (1,1), (0,1), (1,0) and half of (1,2), (2,1): (1 + 2 + 1)/9 = 4/9; p2 likewise 4/9.
-    S = _BinaryTournament().do(_Dummy(), _pop(FRONT), 9000, 2, to_pop=False, random_state=np.random.default_rng(0))
+    S = BinaryTournament(_bige_tournament).do(_Dummy(), _pop(FRONT), 9000, 2,
+                                              to_pop=False, random_state=np.random.default_rng(0))
     assert S.shape == (9000, 2)
     freq = np.bincount(S.ravel(), minlength=3) / S.size
     np.testing.assert_allclose(freq, [1 / 9, 4 / 9, 4 / 9], atol=0.015)

@@ -21,10 +21,10 @@ from pymoo.util.ref_dirs import get_reference_directions
 from scipy.spatial.distance import cdist
 
 from moo.algorithms import make_algorithm
+from moo.algorithms._base import BinaryTournament
 from moo.algorithms.spea2_sde import (
     SPEA2SDE,
     SPEA2SDESurvival,
-    _BinaryTournament,
     _sde_tournament,
     make_spea2_sde,
     sde_fitness,
@@ -315,7 +315,8 @@ def test_mating_selection_is_a_binary_tournament_with_replacement():
     #   P(worst chosen) = P(pair = (3, 3)) = 1/16   (a permutation-based tournament gives 0)
     pop = _pop(np.zeros((4, 2)))
     pop.set("sde_fitness", np.array([0.1, 0.2, 0.3, 0.4]))
-    S = _BinaryTournament().do(_Dummy(), pop, 8000, 2, to_pop=False, random_state=np.random.default_rng(0))
+    S = BinaryTournament(_sde_tournament).do(_Dummy(), pop, 8000, 2,
+                                             to_pop=False, random_state=np.random.default_rng(0))
     assert S.shape == (8000, 2)
     freq = np.bincount(S.ravel(), minlength=4) / S.size
     np.testing.assert_allclose(freq, [7 / 16, 5 / 16, 3 / 16, 1 / 16], atol=0.015)

@@ -78,16 +78,14 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
-from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.termination.default import DefaultMultiObjectiveTermination
-from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import check_int
-from .operators import POP_SIZE, paper_crossover, paper_mutation
+from ._base import BinaryTournament, paper_operators
+from .operators import POP_SIZE
 
 __all__ = ["BiGE", "BiGESurvival", "bige_estimation", "make_bige", "niche_radius"]
 
@@ -238,15 +236,6 @@ def _bige_tournament(pop, P, random_state=None, **kwargs):
     return winner[:, None].astype(int)
 
 
-class _BinaryTournament(Selection):
-    """Binary tournament with replacement; the goals are estimated once per call on the population."""
-
-    def _do(self, problem, pop, n_select, n_parents, *args, random_state=None, **kwargs):
-        rng = random_state if random_state is not None else np.random.default_rng()
-        P = rng.integers(0, len(pop), size=(n_select * n_parents, 2))
-        return _bige_tournament(pop, P, random_state=rng).reshape(n_select, n_parents)
-
-
 class BiGE(GeneticAlgorithm):
     """BiGE as a pymoo algorithm.
 
@@ -265,13 +254,10 @@ class BiGE(GeneticAlgorithm):
                  eliminate_duplicates: bool = True, output=None):
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else FloatRandomSampling(),
-            selection=_BinaryTournament(),
-            crossover=crossover if crossover is not None else paper_crossover(),
-            mutation=mutation if mutation is not None else paper_mutation(),
+            **paper_operators(sampling, crossover, mutation, output),
+            selection=BinaryTournament(_bige_tournament),
             survival=BiGESurvival(),
             eliminate_duplicates=eliminate_duplicates,
-            output=output if output is not None else MultiObjectiveOutput(),
         )
         self.termination = DefaultMultiObjectiveTermination()
 

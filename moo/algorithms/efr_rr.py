@@ -75,15 +75,14 @@ import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.operators.selection.rnd import RandomSelection
-from pymoo.util.display.multi import MultiObjectiveOutput
 
 from robustctl._validation import as_matrix, check_positive_scalar
 
 from .._validation import check_choice, check_int
 from ._normalize import HyperplaneNormalization
-from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
+from ._base import NormalizationForwarding, paper_operators
+from .operators import POP_SIZE, reference_directions
 
 __all__ = ["EFRRR", "EFRRRSurvival", "maximum_ranking", "make_efr_rr"]
 
@@ -167,7 +166,7 @@ def maximum_ranking(
     return ranks.min(axis=1)
 
 
-class EFRRRSurvival(Survival):
+class EFRRRSurvival(NormalizationForwarding, Survival):
     """Environmental selection of EFR-RR: normalise, rank, select by levels of ``R_g``.
 
     Sets the attribute ``"rank"`` (the global rank ``R_g`` within the population
@@ -182,22 +181,6 @@ class EFRRRSurvival(Survival):
         self.scalarizing = scalarizing
         self.theta = theta
         self.norm = HyperplaneNormalization(self.ref_dirs.shape[1])
-
-    @property
-    def ideal_point(self) -> np.ndarray:
-        return self.norm.ideal_point
-
-    @property
-    def nadir_point(self) -> np.ndarray | None:
-        return self.norm.nadir_point
-
-    def normalize(self, F: np.ndarray) -> np.ndarray:
-        """``(F - z*) / (z^nad - z*)`` with the current estimates (update first)."""
-        return self.norm.normalize(F)
-
-    def reset(self) -> None:
-        """Forget the normalisation state (a new run starts)."""
-        self.norm.reset()
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
         F = pop.get("F").astype(float)
@@ -276,14 +259,11 @@ class EFRRR(GeneticAlgorithm):
         self.n_neighbors = n_neighbors
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else FloatRandomSampling(),
+            **paper_operators(sampling, crossover, mutation, output),
             selection=RandomSelection() if mating == "random" else RankTournament(),
-            crossover=crossover if crossover is not None else paper_crossover(),
-            mutation=mutation if mutation is not None else paper_mutation(),
             survival=EFRRRSurvival(ref_dirs, n_neighbors=n_neighbors,
                                    scalarizing=scalarizing, theta=theta),
             eliminate_duplicates=eliminate_duplicates,
-            output=output if output is not None else MultiObjectiveOutput(),
             advance_after_initial_infill=True,
         )
 

@@ -85,8 +85,6 @@ import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
@@ -94,7 +92,8 @@ from robustctl._validation import as_matrix
 
 from .._validation import check_choice, check_int
 from ._normalize import HyperplaneNormalization
-from .operators import POP_SIZE, paper_crossover, paper_mutation
+from ._base import NormalizationForwarding, paper_operators
+from .operators import POP_SIZE
 
 __all__ = [
     "MaOEADDFC",
@@ -223,7 +222,7 @@ def select_by_dd_fc(
     return picked
 
 
-class DDFCSurvival(Survival):
+class DDFCSurvival(NormalizationForwarding, Survival):
     """Environmental selection of MaOEA-DDFC (non-dominated fronts, then DD/FC tournaments)."""
 
     def __init__(self, n_obj: int, *, n_neighbors: int = 5, n_candidates: int = 3,
@@ -233,22 +232,6 @@ class DDFCSurvival(Survival):
         self.n_candidates = n_candidates
         self.candidate_choice = candidate_choice
         self.norm = HyperplaneNormalization(n_obj)
-
-    @property
-    def ideal_point(self) -> np.ndarray:
-        return self.norm.ideal_point
-
-    @property
-    def nadir_point(self) -> np.ndarray | None:
-        return self.norm.nadir_point
-
-    def normalize(self, F: np.ndarray) -> np.ndarray:
-        """``(F - z*) / (z^nad - z*)`` with the current estimates."""
-        return self.norm.normalize(F)
-
-    def reset(self) -> None:
-        """Forget the normalisation state (a new run starts)."""
-        self.norm.reset()
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
         F = pop.get("F").astype(float)
@@ -340,14 +323,11 @@ class MaOEADDFC(GeneticAlgorithm):
         candidate_choice = check_choice(candidate_choice, "candidate_choice", _CHOICES)
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else FloatRandomSampling(),
+            **paper_operators(sampling, crossover, mutation, output),
             selection=DDFCMatingSelection(),
-            crossover=crossover if crossover is not None else paper_crossover(),
-            mutation=mutation if mutation is not None else paper_mutation(),
             survival=DDFCSurvival(self.n_obj, n_neighbors=n_neighbors, n_candidates=n_candidates,
                                   candidate_choice=candidate_choice),
             eliminate_duplicates=eliminate_duplicates,
-            output=output if output is not None else MultiObjectiveOutput(),
             advance_after_initial_infill=True,
         )
 

@@ -72,14 +72,13 @@ from moocore import is_nondominated
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.population import Population
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.operators.selection.rnd import RandomSelection
-from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import check_int
-from .operators import POP_SIZE, paper_crossover, paper_mutation
+from ._base import paper_operators
+from .operators import POP_SIZE
 
 __all__ = [
     "IGDNSSurvival",
@@ -349,13 +348,10 @@ class MOEAIGDNS(GeneticAlgorithm):
             archive_size = 5 * pop_size
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else FloatRandomSampling(),
+            **paper_operators(sampling, crossover, mutation),
             selection=RandomSelection(),
-            crossover=crossover if crossover is not None else paper_crossover(),
-            mutation=mutation if mutation is not None else paper_mutation(),
             survival=IGDNSSurvival(archive_size),
             eliminate_duplicates=eliminate_duplicates,
-            output=MultiObjectiveOutput(),
             advance_after_initial_infill=True,
         )
 

@@ -84,12 +84,11 @@ from __future__ import annotations
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.operators.selection.tournament import TournamentSelection
-from pymoo.util.display.multi import MultiObjectiveOutput
 
 from .._validation import check_int, check_real
-from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
+from ._base import paper_operators
+from .operators import POP_SIZE, reference_directions
 
 __all__ = [
     "MOMBI2",
@@ -363,13 +362,10 @@ class MOMBI2(GeneticAlgorithm):
         self.ref_dirs = ref_dirs
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else FloatRandomSampling(),
+            **paper_operators(sampling, crossover, mutation),
             selection=TournamentSelection(func_comp=_compare_in_population),
-            crossover=crossover if crossover is not None else paper_crossover(),
-            mutation=mutation if mutation is not None else paper_mutation(),
             survival=R2RankingSurvival(ref_dirs, alpha=alpha, epsilon=epsilon, record_size=record_size),
             eliminate_duplicates=eliminate_duplicates,
-            output=MultiObjectiveOutput(),
             advance_after_initial_infill=True,
         )
 

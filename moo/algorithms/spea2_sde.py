@@ -70,13 +70,11 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
-from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.termination.default import DefaultMultiObjectiveTermination
-from pymoo.util.display.multi import MultiObjectiveOutput
 
-from .operators import POP_SIZE, paper_crossover, paper_mutation
+from ._base import BinaryTournament, paper_operators
+from .operators import POP_SIZE
 
 __all__ = [
     "SPEA2SDE",
@@ -353,15 +351,6 @@ def _sde_tournament(pop, P, random_state=None, **kwargs):
     return winner[:, None].astype(int)
 
 
-class _BinaryTournament(Selection):
-    """Binary tournament *with replacement* on the archive (Zitzler et al. 2001, Step 5)."""
-
-    def _do(self, problem, pop, n_select, n_parents, *args, random_state=None, **kwargs):
-        rng = random_state if random_state is not None else np.random.default_rng()
-        P = rng.integers(0, len(pop), size=(n_select * n_parents, 2))
-        return _sde_tournament(pop, P, random_state=rng).reshape(n_select, n_parents)
-
-
 class SPEA2SDE(GeneticAlgorithm):
     """SPEA2+SDE as a pymoo algorithm (archive = ``pop``, offspring = population).
 
@@ -382,13 +371,10 @@ class SPEA2SDE(GeneticAlgorithm):
                  normalize: bool = True, eliminate_duplicates: bool = True, output=None):
         super().__init__(
             pop_size=pop_size,
-            sampling=sampling if sampling is not None else FloatRandomSampling(),
-            selection=_BinaryTournament(),
-            crossover=crossover if crossover is not None else paper_crossover(),
-            mutation=mutation if mutation is not None else paper_mutation(),
+            **paper_operators(sampling, crossover, mutation, output),
+            selection=BinaryTournament(_sde_tournament),   # with replacement (Zitzler et al. 2001, Step 5)
             survival=SPEA2SDESurvival(normalize=normalize),
             eliminate_duplicates=eliminate_duplicates,
-            output=output if output is not None else MultiObjectiveOutput(),
             advance_after_initial_infill=True,
         )
         self.termination = DefaultMultiObjectiveTermination()

@@ -1,0 +1,89 @@
+"""Pieces shared by the pymoo algorithm classes of :mod:`moo.algorithms`.
+
+- :func:`paper_operators`: the paper's default variation operators and
+  output, filled in where a constructor argument is ``None``.
+- :class:`NormalizationForwarding`: a survival's public view of the
+  :class:`~moo.algorithms._normalize.HyperplaneNormalization` it holds.
+- :class:`BinaryTournament`: binary tournament *with replacement*, decided by
+  a comparison function.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+from pymoo.core.selection import Selection
+from pymoo.operators.sampling.rnd import FloatRandomSampling
+from pymoo.util.display.multi import MultiObjectiveOutput
+
+from .operators import paper_crossover, paper_mutation
+
+if TYPE_CHECKING:
+    from ._normalize import HyperplaneNormalization
+
+__all__ = ["BinaryTournament", "NormalizationForwarding", "paper_operators"]
+
+
+def paper_operators(sampling=None, crossover=None, mutation=None, output=None) -> dict:
+    """Keyword arguments ``sampling``, ``crossover``, ``mutation``, ``output`` of a pymoo algorithm.
+
+    Each one given is kept; each ``None`` becomes the paper's default: uniform
+    random sampling in the box, :func:`~moo.algorithms.operators.paper_crossover`
+    (SBX, pc = 1, eta 20), :func:`~moo.algorithms.operators.paper_mutation`
+    (polynomial, 0.5 expected mutations, eta 20) and pymoo's
+    ``MultiObjectiveOutput``.
+    """
+    return {
+        "sampling": sampling if sampling is not None else FloatRandomSampling(),
+        "crossover": crossover if crossover is not None else paper_crossover(),
+        "mutation": mutation if mutation is not None else paper_mutation(),
+        "output": output if output is not None else MultiObjectiveOutput(),
+    }
+
+
+class NormalizationForwarding:
+    """Mixin for a survival holding a :class:`HyperplaneNormalization` in ``self.norm``.
+
+    Exposes its ideal and nadir estimates, its ``normalize`` and its ``reset``.
+    """
+
+    norm: HyperplaneNormalization
+
+    @property
+    def ideal_point(self) -> np.ndarray:
+        return self.norm.ideal_point
+
+    @property
+    def nadir_point(self) -> np.ndarray | None:
+        return self.norm.nadir_point
+
+    def normalize(self, F: np.ndarray) -> np.ndarray:
+        """``(F - z*) / (z^nad - z*)`` with the current estimates (update first)."""
+        return self.norm.normalize(F)
+
+    def reset(self) -> None:
+        """Forget the normalisation state (a new run starts)."""
+        self.norm.reset()
+
+
+class BinaryTournament(Selection):
+    """Binary tournament *with replacement*: ``n_select * n_parents`` pairs drawn uniformly.
+
+    Parameters
+    ----------
+    compare : callable
+        ``compare(pop, P, random_state=rng) -> (n, 1) int array``: the winner of
+        each pair ``P[t] = (a, b)`` of population indices. It sees all pairs
+        of a call at once (so estimates over the population are made once).
+    """
+
+    def __init__(self, compare: Callable[..., np.ndarray]) -> None:
+        super().__init__()
+        self.compare = compare
+
+    def _do(self, problem, pop, n_select, n_parents, *args, random_state=None, **kwargs):
+        rng = random_state if random_state is not None else np.random.default_rng()
+        P = rng.integers(0, len(pop), size=(n_select * n_parents, 2))
+        return self.compare(pop, P, random_state=rng).reshape(n_select, n_parents)
