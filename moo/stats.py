@@ -47,7 +47,7 @@ import math
 import os
 import warnings
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
@@ -329,8 +329,14 @@ def to_csv(rows: Sequence[Comparison] | Sequence[RunIndicators], path: str | os.
     return text
 
 
-def _cell(mean: float, std: float) -> str:
-    return "n/a" if not np.isfinite(mean) else f"{mean:.4E} ± {std:.2E}"
+def _markdown_cell(mean: float, std: float, bold: bool, marks: str) -> str:
+    text = "n/a" if not np.isfinite(mean) else f"{mean:.4E} ± {std:.2E}"
+    return (f"**{text}**" if bold else text) + (f"^{marks}" if marks else "")
+
+
+def _latex_cell(mean: float, std: float, bold: bool, marks: str) -> str:
+    text = "n/a" if not np.isfinite(mean) else f"{mean:.4E} $\\pm$ {std:.2E}"
+    return (rf"\textbf{{{text}}}" if bold else text) + (f"$^{{{marks}}}$" if marks else "")
 
 
 def _layout(rows: Sequence[Comparison]):
@@ -363,6 +369,26 @@ def _marks(c: Comparison, molsp: bool, best: dict) -> tuple[bool, str]:
     return is_better, ",".join(marks)
 
 
+def _rows(table: dict, best: dict, problem: str, cell: Callable[[float, float, bool, str], str]):
+    """``(algorithm, molsp, cell texts)`` of each MOEA of ``problem``: its MO-LSP row, then its plain row.
+
+    ``cell(mean, std, bold, marks)`` writes one cell; a missing indicator is ``""``.
+    """
+    for (p, alg), cs in table.items():
+        if p != problem:
+            continue
+        for molsp in (True, False):
+            cells = []
+            for name in INDICATORS:
+                c = cs.get(name)
+                if c is None:
+                    cells.append("")
+                    continue
+                mean, std = (c.mean_molsp, c.std_molsp) if molsp else (c.mean_plain, c.std_plain)
+                cells.append(cell(mean, std, *_marks(c, molsp, best)))
+            yield alg, molsp, cells
+
+
 def to_markdown(rows: Sequence[Comparison]) -> str:
     """The paper's layout: per MOEA a ``/MO-LSP`` row and a plain row, five indicator columns.
 
@@ -376,20 +402,8 @@ def to_markdown(rows: Sequence[Comparison]) -> str:
         lines += [f"**{problem}**", "",
                   "| MOEA | " + " | ".join(_LABELS[n] for n in INDICATORS) + " |",
                   "|---|" + "---|" * len(INDICATORS)]
-        for (p, alg), cs in table.items():
-            if p != problem:
-                continue
-            for molsp in (True, False):
-                cells = []
-                for name in INDICATORS:
-                    c = cs.get(name)
-                    if c is None:
-                        cells.append("")
-                        continue
-                    text = _cell(*((c.mean_molsp, c.std_molsp) if molsp else (c.mean_plain, c.std_plain)))
-                    bold, marks = _marks(c, molsp, best)
-                    cells.append((f"**{text}**" if bold else text) + (f"^{marks}" if marks else ""))
-                lines.append(f"| {alg}{'/MO-LSP' if molsp else ''} | " + " | ".join(cells) + " |")
+        for alg, molsp, cells in _rows(table, best, problem, _markdown_cell):
+            lines.append(f"| {alg}{'/MO-LSP' if molsp else ''} | " + " | ".join(cells) + " |")
         lines.append("")
     return "\n".join(lines)
 
@@ -401,21 +415,8 @@ def to_latex(rows: Sequence[Comparison]) -> str:
     for problem in dict.fromkeys(p for p, _ in table):
         out += [f"% {problem}", r"\begin{tabular}{l" + "c" * len(INDICATORS) + "}", r"\hline",
                 "MOEA & " + " & ".join(_LABELS[n] for n in INDICATORS) + r" \\", r"\hline"]
-        for (p, alg), cs in table.items():
-            if p != problem:
-                continue
-            for molsp in (True, False):
-                cells = []
-                for name in INDICATORS:
-                    c = cs.get(name)
-                    if c is None:
-                        cells.append("")
-                        continue
-                    mean, std = (c.mean_molsp, c.std_molsp) if molsp else (c.mean_plain, c.std_plain)
-                    text = "n/a" if not np.isfinite(mean) else f"{mean:.4E} $\\pm$ {std:.2E}"
-                    bold, marks = _marks(c, molsp, best)
-                    cells.append((rf"\textbf{{{text}}}" if bold else text) + (f"$^{{{marks}}}$" if marks else ""))
-                name = alg.replace("_", r"\_") + ("/MO-LSP" if molsp else "")
-                out.append(f"{name} & " + " & ".join(cells) + r" \\")
+        for alg, molsp, cells in _rows(table, best, problem, _latex_cell):
+            name = alg.replace("_", r"\_") + ("/MO-LSP" if molsp else "")
+            out.append(f"{name} & " + " & ".join(cells) + r" \\")
         out += [r"\hline", r"\end{tabular}", ""]
     return "\n".join(out)
