@@ -31,7 +31,6 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pymoo.core.problem import Problem
 
 import robustctl as rc
 from robustctl._validation import check_positive_scalar
@@ -40,8 +39,8 @@ from robustctl.path import ReferencePath, default_route
 from robustctl.simulate import DEFAULT_BOUND, simulate
 
 from .._validation import check_int
-from .generic import (_as_population, _check_aggregate, _check_penalty, _check_ref_point, _decode,
-                      _penalise, _spectral_radius, _weights)
+from .generic import (_as_population, _check_aggregate, _check_penalty, _check_ref_point, _penalise,
+                      _RLQRTuningProblem, _spectral_radius, _weights)
 
 __all__ = ["AppliedRLQRProblem"]
 
@@ -50,7 +49,7 @@ Z_LOWER = 1e-6
 Z_UPPER = 500.0
 
 
-class AppliedRLQRProblem(Problem):
+class AppliedRLQRProblem(_RLQRTuningProblem):
     r"""Truck path-following RLQR tuning problem: 7 variables in ``(0, 500]``, 4 objectives.
 
     For each decision vector ``z`` (one row of the population):
@@ -185,17 +184,6 @@ class AppliedRLQRProblem(Problem):
         super().__init__(n_var=n + m + 1, n_obj=4, xl=Z_LOWER, xu=Z_UPPER, vtype=float)
 
     # -- public helpers -----------------------------------------------------
-    def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(EF (B, 1, 4), EG (B, 1, 2), mu (B,))`` of a population ``z`` (B, 7) or one ``z`` (7,)."""
-        z = _as_population(z, self.n_var)
-        return _decode(z, self.plant.n, self.plant.m)
-
-    def gains(self, z) -> "rc.RLQRBatch":
-        """The batched RLQR design of a population ``z`` (B, 7)."""
-        EF, EG, mu = self.decode(z)
-        return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
-                             max_iter=self.max_iter)
-
     def closed_loop_radius(self, K: np.ndarray) -> np.ndarray:
         """Spectral radius (B, S) of ``F_s + G_s [1 1] K`` at each scenario payload (NaN for non-finite K)."""
         K = self._check_K(K)

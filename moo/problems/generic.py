@@ -136,7 +136,37 @@ EF_TRUE = np.array([[0.1, 0.2, 0.2]])
 EG_TRUE = np.array([[0.1]])
 
 
-class GenericRLQRProblem(Problem):
+class _RLQRTuningProblem(Problem):
+    """What the RLQR tuning problems share: ``z = (E_F, E_G, (log10 mu)^2)`` -> batched RLQR gains.
+
+    A subclass sets ``plant`` (``n`` states, ``m`` inputs), ``H``, ``Q``, ``R``,
+    ``alpha`` and ``max_iter``, and has ``n_var = n + m + 1``.
+    """
+
+    plant: rc.Plant
+    H: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    alpha: float
+    max_iter: int
+
+    # -- public helpers -----------------------------------------------------
+    def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(EF (B, 1, n), EG (B, 1, m), mu (B,))`` of a population ``z`` (B, n + m + 1) or one ``z``.
+
+        ``(n, m)`` is ``(3, 1)`` for the generic problem and ``(4, 2)`` for the applied one.
+        """
+        z = _as_population(z, self.n_var)
+        return _decode(z, self.plant.n, self.plant.m)
+
+    def gains(self, z) -> "rc.RLQRBatch":
+        """The batched RLQR design of a population ``z`` (B, n + m + 1)."""
+        EF, EG, mu = self.decode(z)
+        return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
+                             max_iter=self.max_iter)
+
+
+class GenericRLQRProblem(_RLQRTuningProblem):
     r"""Generic RLQR tuning problem: 5 variables in ``[0, 200]``, 3 objectives.
 
     Decision vector ``z = (E_F1, E_F2, E_F3, E_G, (log10 mu)^2)``. For each ``z`` the
@@ -290,17 +320,6 @@ class GenericRLQRProblem(Problem):
         super().__init__(n_var=n + m + 1, n_obj=n, xl=0.0, xu=200.0, vtype=float)
 
     # -- public helpers -----------------------------------------------------
-    def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(EF (B, 1, 3), EG (B, 1, 1), mu (B,))`` of a population ``z`` (B, 5) or one ``z`` (5,)."""
-        z = _as_population(z, self.n_var)
-        return _decode(z, self.plant.n, self.plant.m)
-
-    def gains(self, z) -> "rc.RLQRBatch":
-        """The batched RLQR design of a population ``z`` (B, 5)."""
-        EF, EG, mu = self.decode(z)
-        return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
-                             max_iter=self.max_iter)
-
     def regulation_errors(self, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Raw errors of gains ``K`` (B, 1, 3): ``(e (B, S, 3), rho (B, S))``.
 
