@@ -1,9 +1,8 @@
-"""Scalar argument checks shared by the ``moo`` modules.
+"""Argument checks shared by the ``moo`` modules.
 
 Each helper raises ``TypeError`` for a value of the wrong kind and
-``ValueError`` for one out of range; both messages name the argument, e.g.
-``"pop_size must be >= 2, got 1"``. Array checks live in
-``robustctl._validation`` (used by :mod:`moo.problems`).
+``ValueError`` for one out of range or of the wrong shape; both messages name
+the argument (and the shape), e.g. ``"pop_size must be >= 2, got 1"``.
 """
 
 from __future__ import annotations
@@ -12,7 +11,7 @@ import numbers
 
 import numpy as np
 
-__all__ = ["check_choice", "check_int", "check_real"]
+__all__ = ["as_objectives", "check_choice", "check_int", "check_real"]
 
 
 def check_int(value, name: str, minimum: int) -> int:
@@ -43,3 +42,18 @@ def check_real(value, name: str, *, positive: bool) -> float:
     if not positive and x < 0:
         raise ValueError(f"{name} must be >= 0, got {x}")
     return x
+
+
+def as_objectives(F, name: str = "F") -> np.ndarray:
+    """``F`` as a finite, non-empty float64 array of shape ``(n_individuals, n_obj)``."""
+    if isinstance(F, (str, bytes)) or F is None:
+        raise TypeError(f"{name} must be a 2-D array of objective values, got {type(F).__name__}")
+    try:
+        arr = np.asarray(F, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be a 2-D array of real numbers ({exc})") from None
+    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
+        raise ValueError(f"{name} must be a non-empty 2-D array (n_individuals, n_obj), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must have finite entries (found NaN or inf)")
+    return arr

@@ -83,7 +83,7 @@ from pymoo.termination.default import DefaultMultiObjectiveTermination
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
-from .._validation import check_int
+from .._validation import as_objectives, check_int
 from ._base import BinaryTournament, paper_operators
 from .operators import POP_SIZE
 
@@ -95,20 +95,6 @@ def niche_radius(pop_size: int, n_obj: int) -> float:
     pop_size = check_int(pop_size, "pop_size", 1)
     n_obj = check_int(n_obj, "n_obj", 1)
     return float(pop_size) ** (-1.0 / float(n_obj))
-
-
-def _as_objectives(F) -> np.ndarray:
-    if isinstance(F, (str, bytes)) or F is None:
-        raise TypeError(f"F must be a 2-D array of objective values, got {type(F).__name__}")
-    try:
-        arr = np.asarray(F, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"F must be a 2-D array of real numbers ({exc})") from None
-    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
-        raise ValueError(f"F must be a non-empty 2-D array (n_individuals, n_obj), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError("F must have finite entries (found NaN or inf)")
-    return arr
 
 
 def bige_estimation(F, radius: float, random_state: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -138,7 +124,7 @@ def bige_estimation(F, radius: float, random_state: np.random.Generator) -> tupl
     ----------
     Li, Yang & Liu (2015), Artificial Intelligence 228, Secs. 3.2-3.3.
     """
-    F = _as_objectives(F)
+    F = as_objectives(F)
     if isinstance(radius, bool) or not isinstance(radius, (int, float, np.integer, np.floating)):
         raise TypeError(f"radius must be a real number, got {type(radius).__name__}")
     if not (np.isfinite(radius) and radius > 0):

@@ -73,6 +73,7 @@ from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 
+from .._validation import as_objectives
 from ._base import BinaryTournament, paper_operators
 from .operators import POP_SIZE
 
@@ -86,20 +87,6 @@ __all__ = [
 ]
 
 _FITNESS = "sde_fitness"
-
-
-def _as_objectives(F, name: str = "F") -> np.ndarray:
-    if isinstance(F, (str, bytes)) or F is None:
-        raise TypeError(f"{name} must be a 2-D array of objective values, got {type(F).__name__}")
-    try:
-        arr = np.asarray(F, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name} must be a 2-D array of real numbers ({exc})") from None
-    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
-        raise ValueError(f"{name} must be a non-empty 2-D array (n_individuals, n_obj), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must have finite entries (found NaN or inf)")
-    return arr
 
 
 def _normalise(F: np.ndarray, nondominated: np.ndarray) -> np.ndarray:
@@ -132,7 +119,7 @@ def shifted_distances(F) -> np.ndarray:
         (Li, Yang & Liu 2014, Sec. III: ``j`` shifted to ``max(F[j], F[i])``),
         ``inf`` on the diagonal. Row ``i`` is the neighbourhood seen from ``i``.
     """
-    F = _as_objectives(F)
+    F = as_objectives(F)
     n, m = F.shape
     D = np.zeros((n, n))
     for k in range(m):                      # a loop over objectives keeps memory at O(n^2)
@@ -199,7 +186,7 @@ def sde_fitness(F, *, normalize: bool = True) -> tuple[np.ndarray, np.ndarray, n
     ----------
     Zitzler, Laumanns & Thiele (2001), Sec. 3.1; Li, Yang & Liu (2014), Sec. III.
     """
-    F = _as_objectives(F)
+    F = as_objectives(F)
     if not isinstance(normalize, (bool, np.bool_)):
         raise TypeError(f"normalize must be a bool, got {type(normalize).__name__}")
     return _fitness(F, bool(normalize))[:3]
