@@ -171,21 +171,26 @@ def test_generic_slowly_converging_design_is_penalised(generic):
     np.testing.assert_array_equal(f, np.full((1, 3), 2 * generic.penalty))
 
 
-def test_generic_not_computable_designs_get_finite_penalties(generic, monkeypatch):
-    """A design the RLQR reports as failed (ok False, NaN gain) gets 2 * penalty, the others are untouched."""
-    z = GENERIC_Z[:3]
+def _rlqr_failing_at(row):
+    """``rc.rlqr_gains`` reporting design ``row`` of the batch as failed (ok False, NaN gain)."""
     real = rc.rlqr_gains
 
     def failing(plant, EF, EG, mu, **kw):
         b = real(plant, EF, EG, mu, **kw)
         K = np.array(b.K, copy=True)
         ok = np.array(b.ok, copy=True)
-        K[1] = np.nan
-        ok[1] = False
+        K[row] = np.nan
+        ok[row] = False
         return type("Batch", (), {"K": K, "ok": ok, "P": b.P, "iterations": b.iterations})()
 
+    return failing
+
+
+def test_generic_not_computable_designs_get_finite_penalties(generic, monkeypatch):
+    """A design the RLQR reports as failed (ok False, NaN gain) gets 2 * penalty, the others are untouched."""
+    z = GENERIC_Z[:3]
     good = generic.evaluate(z)
-    monkeypatch.setattr(rc, "rlqr_gains", failing)
+    monkeypatch.setattr(rc, "rlqr_gains", _rlqr_failing_at(1))
     f = generic.evaluate(z)
     np.testing.assert_array_equal(f[1], np.full(3, 2 * generic.penalty))
     np.testing.assert_allclose(f[[0, 2]], good[[0, 2]], rtol=1e-12)
@@ -353,18 +358,8 @@ def test_applied_paper_optimum_is_finite_and_sensible():
 
 def test_applied_not_computable_designs_get_finite_penalties(applied_short, monkeypatch):
     z = APPLIED_Z[[0, 1, 3]]
-    real = rc.rlqr_gains
-
-    def failing(plant, EF, EG, mu, **kw):
-        b = real(plant, EF, EG, mu, **kw)
-        K = np.array(b.K, copy=True)
-        ok = np.array(b.ok, copy=True)
-        K[0] = np.nan
-        ok[0] = False
-        return type("Batch", (), {"K": K, "ok": ok, "P": b.P, "iterations": b.iterations})()
-
     good = applied_short.evaluate(z)
-    monkeypatch.setattr(rc, "rlqr_gains", failing)
+    monkeypatch.setattr(rc, "rlqr_gains", _rlqr_failing_at(0))
     f = applied_short.evaluate(z)
     np.testing.assert_array_equal(f[0], np.full(4, 2 * applied_short.penalty))
     np.testing.assert_allclose(f[1:], good[1:], rtol=1e-12)
