@@ -87,13 +87,13 @@ from pymoo.core.mutation import Mutation
 from pymoo.core.sampling import Sampling
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
+from .._validation import check_int
+from ._base import paper_operators
 from ._normalize import front_bounds
-from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
+from .operators import POP_SIZE, reference_directions
 from .theta_dea import _check_reference_directions, finite_first, select_by_fronts, theta_nondominated_ranks
 
 __all__ = [
@@ -225,9 +225,7 @@ class NeighbourMatingSelection(Selection):
 
     def __init__(self, k: int = 20):
         super().__init__()
-        if not isinstance(k, (int, np.integer)) or k < 1:
-            raise ValueError(f"k must be a positive integer, got {k!r}")
-        self.k = int(k)
+        self.k = check_int(k, "k", 1)
 
     def _do(self, problem, pop, n_select, n_parents, random_state=None, **kwargs):
         if n_parents != 2:
@@ -279,21 +277,16 @@ class SPEAR(GeneticAlgorithm):
                  mutation: Mutation | None = None, eliminate_duplicates: bool = True,
                  n_offsprings: int | None = None, output: Output | None = None):
         ref_dirs = _check_reference_directions(ref_dirs)
-        pop_size = len(ref_dirs) if pop_size is None else pop_size
-        if not isinstance(pop_size, (int, np.integer)) or pop_size < 2:
-            raise ValueError(f"pop_size must be an integer >= 2, got {pop_size!r}")
+        pop_size = check_int(len(ref_dirs) if pop_size is None else pop_size, "pop_size", 2)
         self.ref_dirs = ref_dirs
         super().__init__(
-            pop_size=int(pop_size),
-            sampling=FloatRandomSampling() if sampling is None else sampling,
-            selection=NeighbourMatingSelection(k_mating),
-            crossover=paper_crossover() if crossover is None else crossover,
-            mutation=paper_mutation() if mutation is None else mutation,
+            pop_size=pop_size,
+            selection=NeighbourMatingSelection(check_int(k_mating, "k_mating", 1)),
             survival=SPEARSurvival(ref_dirs),
             eliminate_duplicates=eliminate_duplicates,
             n_offsprings=n_offsprings,
-            output=MultiObjectiveOutput() if output is None else output,
             advance_after_initial_infill=True,
+            **paper_operators(sampling, crossover, mutation, output),
         )
 
     def _setup(self, problem, **kwargs):
@@ -308,8 +301,7 @@ def make_spea_r(*, n_obj: int, pop_size: int = POP_SIZE, k_mating: int = 20) -> 
     (91 for 3 objectives, 84 for 4); population ``pop_size`` (92);
     ``k_mating`` random candidates in the restricted mating selection.
     """
-    if not isinstance(n_obj, (int, np.integer)) or n_obj < 2:
-        raise ValueError(f"n_obj must be an integer >= 2, got {n_obj!r}")
-    if not isinstance(k_mating, (int, np.integer)) or k_mating < 1:
-        raise ValueError(f"k_mating must be a positive integer, got {k_mating!r}")
-    return SPEAR(reference_directions(n_obj, pop_size), pop_size=pop_size, k_mating=int(k_mating))
+    n_obj = check_int(n_obj, "n_obj", 2)
+    pop_size = check_int(pop_size, "pop_size", 2)
+    k_mating = check_int(k_mating, "k_mating", 1)
+    return SPEAR(reference_directions(n_obj, pop_size), pop_size=pop_size, k_mating=k_mating)

@@ -70,14 +70,14 @@ from pymoo.core.population import Population
 from pymoo.core.sampling import Sampling
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
-from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
+from .._validation import check_int, check_real
+from ._base import NormalizationForwarding, paper_operators
 from ._normalize import HyperplaneNormalization
-from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
+from .operators import POP_SIZE, reference_directions
 
 __all__ = [
     "ThetaDEA",
@@ -212,11 +212,12 @@ class RandomFeasibleSelection(Selection):
         return winner.reshape(n_select, n_parents)
 
 
-class ThetaSurvival(Survival):
+class ThetaSurvival(NormalizationForwarding, Survival):
     """theta-DEA environmental selection (steps 2-6 of the module docstring).
 
     Keeps its own :class:`~moo.algorithms._normalize.HyperplaneNormalization`
-    (ideal point, extreme points, nadir) across calls, so it may be called
+    (ideal point, extreme points, nadir; exposed as ``ideal_point``,
+    ``nadir_point``, ``normalize`` and ``reset``) across calls, so it may be called
     any number of times per generation on populations of any size.
     Individuals with non-finite objectives are ranked last (:func:`finite_first`).
     After a call the survivors carry ``rank`` (Pareto front), ``theta_rank``,
@@ -226,9 +227,7 @@ class ThetaSurvival(Survival):
     def __init__(self, ref_dirs: np.ndarray, theta: float = 5.0):
         super().__init__(filter_infeasible=True)
         self.ref_dirs = _check_reference_directions(ref_dirs)
-        if not (np.isfinite(theta) and theta >= 0):
-            raise ValueError(f"theta must be a finite number >= 0, got {theta!r}")
-        self.theta = float(theta)
+        self.theta = check_real(theta, "theta", positive=False)
         self.norm = HyperplaneNormalization(self.ref_dirs.shape[1])
 
     def _do(self, problem, pop, n_survive=None, random_state=None, **kwargs):
@@ -277,28 +276,23 @@ class ThetaDEA(GeneticAlgorithm):
                  mutation: Mutation | None = None, eliminate_duplicates: bool = True,
                  n_offsprings: int | None = None, output: Output | None = None):
         ref_dirs = _check_reference_directions(ref_dirs)
-        pop_size = len(ref_dirs) if pop_size is None else pop_size
-        if not isinstance(pop_size, (int, np.integer)) or pop_size < 2:
-            raise ValueError(f"pop_size must be an integer >= 2, got {pop_size!r}")
+        pop_size = check_int(len(ref_dirs) if pop_size is None else pop_size, "pop_size", 2)
         self.ref_dirs = ref_dirs
-        self.theta = float(theta)
+        self.theta = check_real(theta, "theta", positive=False)
         super().__init__(
-            pop_size=int(pop_size),
-            sampling=FloatRandomSampling() if sampling is None else sampling,
+            pop_size=pop_size,
             selection=RandomFeasibleSelection(),
-            crossover=paper_crossover() if crossover is None else crossover,
-            mutation=paper_mutation() if mutation is None else mutation,
-            survival=ThetaSurvival(ref_dirs, theta=theta),
+            survival=ThetaSurvival(ref_dirs, theta=self.theta),
             eliminate_duplicates=eliminate_duplicates,
             n_offsprings=n_offsprings,
-            output=MultiObjectiveOutput() if output is None else output,
             advance_after_initial_infill=True,
+            **paper_operators(sampling, crossover, mutation, output),
         )
 
     def _setup(self, problem, **kwargs):
         if self.ref_dirs.shape[1] != problem.n_obj:
             raise ValueError(f"ref_dirs has {self.ref_dirs.shape[1]} columns but the problem has {problem.n_obj} objectives")
-        self.survival.norm.reset()
+        self.survival.reset()
 
 
 def make_theta_dea(*, n_obj: int, pop_size: int = POP_SIZE, theta: float = 5.0) -> ThetaDEA:
@@ -307,8 +301,7 @@ def make_theta_dea(*, n_obj: int, pop_size: int = POP_SIZE, theta: float = 5.0) 
     Directions: :func:`~moo.algorithms.operators.reference_directions`
     (91 for 3 objectives, 84 for 4); population ``pop_size`` (92).
     """
-    if not isinstance(n_obj, (int, np.integer)) or n_obj < 2:
-        raise ValueError(f"n_obj must be an integer >= 2, got {n_obj!r}")
-    if not (isinstance(theta, (int, float, np.floating)) and np.isfinite(theta) and theta >= 0):
-        raise ValueError(f"theta must be a finite number >= 0, got {theta!r}")
-    return ThetaDEA(reference_directions(n_obj, pop_size), theta=float(theta), pop_size=pop_size)
+    n_obj = check_int(n_obj, "n_obj", 2)
+    pop_size = check_int(pop_size, "pop_size", 2)
+    theta = check_real(theta, "theta", positive=False)
+    return ThetaDEA(reference_directions(n_obj, pop_size), theta=theta, pop_size=pop_size)
