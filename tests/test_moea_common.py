@@ -1,7 +1,7 @@
 """Run-level checks that hold for every MOEA of the registry ``moo.algorithms.ALGORITHMS``.
 
-Same seed -> identical run, other seed -> other run; a reused algorithm object
-repeats its run (state is reset at setup); the algorithm runs wrapped by MO-LSP
+Same seed -> identical run, other seed -> other run; setting an algorithm up
+again resets its survival's state; the algorithm runs wrapped by MO-LSP
 and stays deterministic; the factories reject bad ``n_obj``/``pop_size``.
 Algorithm-specific checks (hand-made cases, quality against NSGA-III, DTLZ1
 convergence) stay in each algorithm's own test file.
@@ -40,15 +40,35 @@ def test_same_seed_same_result_different_seed_differs(name):
     assert F0.shape == F2.shape and not np.array_equal(F0, F2)
 
 
+def _same_state(a, b) -> bool:
+    """Recursive equality of two objects' state (arrays compared exactly, NaN equal to NaN)."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.shape == b.shape
+                and np.array_equal(a, b, equal_nan=a.dtype.kind == "f" and b.dtype.kind == "f"))
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, (list, tuple)):
+        return len(a) == len(b) and all(_same_state(x, y) for x, y in zip(a, b))
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_same_state(a[k], b[k]) for k in a)
+    if hasattr(a, "__dict__"):
+        return _same_state(vars(a), vars(b))
+    return bool(a == b)
+
+
 @pytest.mark.parametrize("n_obj, pop_size, n_eval", [(3, 92, 400), (2, 20, 300)])
-@pytest.mark.parametrize("name", NAMES)
-def test_reused_algorithm_starts_fresh(name, n_obj, pop_size, n_eval):
-    # any state (normalisation, archive, nadir record) is reset at setup: a reused object repeats its run
+@pytest.mark.parametrize("name", [name for name in NAMES if name != "nsga3"])
+def test_setup_resets_the_survival_state(name, n_obj, pop_size, n_eval):
+    # Any state of the survival (normalisation, archive, nadir record) is reset at setup, so a
+    # reused object starts fresh. (Running minimize twice on one object with copy_algorithm=False
+    # does not test this: pymoo 0.6.2 sets up only an algorithm without a problem, so the second
+    # call returns the finished run.) pymoo's own NSGA-III keeps its ideal/nadir across setups.
     problem = get_problem("dtlz2", n_obj=n_obj)
     alg = _factory(name)(n_obj=n_obj, pop_size=pop_size)
-    a = minimize(problem, alg, ("n_eval", n_eval), seed=0, copy_algorithm=False).pop.get("F")
-    b = minimize(problem, alg, ("n_eval", n_eval), seed=0, copy_algorithm=False).pop.get("F")
-    np.testing.assert_array_equal(a, b)
+    fresh = _factory(name)(n_obj=n_obj, pop_size=pop_size)
+    minimize(problem, alg, ("n_eval", n_eval), seed=0, copy_algorithm=False)
+    alg.setup(problem, termination=("n_eval", n_eval), seed=0)
+    assert _same_state(vars(alg.survival), vars(fresh.survival))
 
 
 @pytest.mark.parametrize("name", NAMES)
