@@ -11,7 +11,11 @@ import numbers
 
 import numpy as np
 
-__all__ = ["as_objectives", "check_choice", "check_int", "check_real"]
+# Generic array checks (no control code) are shared with robustctl: this is the
+# one import of robustctl in moo outside moo/problems/.
+from robustctl._validation import as_matrix, check_positive_scalar
+
+__all__ = ["as_matrix", "as_objectives", "check_choice", "check_int", "check_positive_scalar", "check_real"]
 
 
 def check_int(value, name: str, minimum: int) -> int:

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.distance import cdist
 
-from robustctl._validation import as_matrix
+from ._validation import as_matrix
 
 __all__ = ["igd", "spacing", "hypervolume", "pure_diversity", "spread"]
 

@@ -94,7 +94,7 @@ from pymoo.core.termination import MultipleCriteria
 from pymoo.termination.max_eval import MaximumFunctionCallTermination
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from robustctl._validation import as_matrix
+from ._validation import as_matrix
 
 __all__ = ["MOLSP", "molsp", "candidates", "leader_scores", "mutation_steps", "build_mutants",
            "repair_bounds", "propose"]

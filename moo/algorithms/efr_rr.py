@@ -77,9 +77,7 @@ from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.selection.rnd import RandomSelection
 
-from robustctl._validation import as_matrix, check_positive_scalar
-
-from .._validation import check_choice, check_int
+from .._validation import as_matrix, check_choice, check_int, check_positive_scalar
 from ._normalize import HyperplaneNormalization
 from ._base import NormalizationForwarding, paper_operators
 from .operators import POP_SIZE, reference_directions
