@@ -89,7 +89,6 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import as_matrix, check_choice, check_int
-
 from ._normalize import HyperplaneNormalization
 from ._base import NormalizationForwarding, paper_operators
 from .operators import POP_SIZE
