@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pytest
 
-cp = pytest.importorskip("cvxpy")
+import cvxpy as cp  # noqa: E402  (a dependency: never skip)
 
 from robustctl import _cvx  # noqa: E402
 from robustctl.errors import InfeasibleError  # noqa: E402

@@ -252,7 +252,7 @@ def test_constrained_problem_returns_feasible_points():
 
 
 def test_runs_wrapped_in_molsp():
-    molsp = pytest.importorskip("moo.molsp").molsp
+    from moo.molsp import molsp
     p = get_problem("dtlz2", n_obj=3)
     res = _run(molsp(make_spea_r(n_obj=3), ref_point=[1.5, 1.5, 1.5]), p, 1500, 3)
     assert res.algorithm.evaluator.n_eval <= 1500 + 92
