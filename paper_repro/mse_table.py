@@ -372,7 +372,7 @@ def run(out: Path, *, z=truck.RLQR_MOP_Z, uncertainty: str = "printed", measure:
     t0 = time.perf_counter()
     out.mkdir(parents=True, exist_ok=True)
     path = default_route() if duration is None else default_route(duration=duration)
-    log(f"[1/4] designing controllers (nominal payload) ...")
+    log("[1/4] designing controllers (nominal payload) ...")
     designs = design_controllers(z, uncertainty, controllers)
     names = [d.name for d in designs]
     with open(out / "designs.txt", "w") as fh:

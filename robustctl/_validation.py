@@ -12,7 +12,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar"]
+__all__ = ["as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
+           "check_performance"]
 
 
 def _to_float_array(value, name: str) -> np.ndarray:
@@ -113,3 +114,17 @@ def check_positive_scalar(value, name: str, *, allow_inf: bool = False) -> float
     if x <= 0:
         raise ValueError(f"{name} must be > 0, got {x}")
     return x
+
+
+def check_performance(n: int, m: int, Bw, Cz, Dzu, Dzw):
+    """Disturbance and performance channels of ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u``.
+
+    Returns float arrays ``(Bw, Cz, Dzu, Dzw)``; ``Dzw=None`` is zero.
+    """
+    Bw = as_matrix(Bw, "Bw", rows=n, cols=1 if np.ndim(Bw) == 1 else None, rows_what="the number of states")
+    Cz = as_matrix(Cz, "Cz", cols=n, cols_what="the number of states")
+    p, q = Cz.shape[0], Bw.shape[1]
+    Dzu = as_matrix(Dzu, "Dzu", rows=p, cols=m, rows_what="rows of Cz", cols_what="the number of inputs")
+    Dzw = np.zeros((p, q)) if Dzw is None else as_matrix(
+        Dzw, "Dzw", rows=p, cols=q, rows_what="rows of Cz", cols_what="columns of Bw")
+    return Bw, Cz, Dzu, Dzw

@@ -104,7 +104,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _cvx
-from ._validation import as_matrix, check_positive_scalar
+from ._validation import check_performance, check_positive_scalar
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .plant import Plant
@@ -171,17 +171,6 @@ def _vertices(plant: Plant, vertices) -> list[Plant]:
             raise ValueError(f"vertices[{i}] must have the sampling time of plant (dt={plant.dt}), got dt={v.dt}")
         plants.append(v)
     return plants
-
-
-def _performance(plant: Plant, Bw, Cz, Dzu, Dzw):
-    n, m = plant.n, plant.m
-    Bw = as_matrix(Bw, "Bw", rows=n, cols=1 if np.ndim(Bw) == 1 else None, rows_what="the number of states")
-    Cz = as_matrix(Cz, "Cz", cols=n, cols_what="the number of states")
-    p, q = Cz.shape[0], Bw.shape[1]
-    Dzu = as_matrix(Dzu, "Dzu", rows=p, cols=m, rows_what="rows of Cz", cols_what="the number of inputs")
-    Dzw = np.zeros((p, q)) if Dzw is None else as_matrix(
-        Dzw, "Dzw", rows=p, cols=q, rows_what="rows of Cz", cols_what="columns of Bw")
-    return Bw, Cz, Dzu, Dzw
 
 
 def _u_max(u_max, m: int) -> np.ndarray:
@@ -278,7 +267,7 @@ class _Problem:
         self.d = d
         # Only z'z matters: replace [Cz Dzu Dzw] by a full-row-rank factor R
         # with R'R = [Cz Dzu Dzw]'[Cz Dzu Dzw] when that has fewer rows.
-        n, m, q = Cz.shape[1], Dzu.shape[1], Dzw.shape[1]
+        n, m = Cz.shape[1], Dzu.shape[1]
         CD = np.hstack([Cz, Dzu, Dzw])
         _, sv, Vt = np.linalg.svd(CD, full_matrices=False)
         r = int(np.sum(sv > 1e-13 * max(1.0, sv[0] if sv.size else 0.0)))
@@ -347,7 +336,7 @@ class _Problem:
         ``X <= x_upper I``.
         """
         cp = self.cp
-        n, p = self.n, self.p
+        p = self.p
         Ip = np.eye(p)
         Cz, Dzu, Dzw = b * self.Cz, b * self.Dzu, b * self.Dzw
         # The disturbance block (the constant I) is eliminated by a Schur
@@ -504,7 +493,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     if not isinstance(plant, Plant):
         raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
     plants = _vertices(plant, vertices)
-    Bw, Cz, Dzu, Dzw = _performance(plant, Bw, Cz, Dzu, Dzw)
+    Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
     if gamma is not None:
         gamma = check_positive_scalar(gamma, "gamma")
     if u_max is not None:

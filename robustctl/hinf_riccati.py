@@ -51,7 +51,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
 
-from ._validation import as_matrix, check_positive_scalar
+from ._validation import check_performance, check_positive_scalar
 from .errors import InfeasibleError
 from .plant import Plant
 
@@ -88,13 +88,7 @@ class RiccatiHinf:
 def _data(plant, Bw, Cz, Dzu, Dzw):
     if not isinstance(plant, Plant):
         raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    n, m = plant.n, plant.m
-    Bw = as_matrix(Bw, "Bw", rows=n, cols=1 if np.ndim(Bw) == 1 else None, rows_what="the number of states")
-    Cz = as_matrix(Cz, "Cz", cols=n, cols_what="the number of states")
-    p, q = Cz.shape[0], Bw.shape[1]
-    Dzu = as_matrix(Dzu, "Dzu", rows=p, cols=m, rows_what="rows of Cz", cols_what="the number of inputs")
-    Dzw = np.zeros((p, q)) if Dzw is None else as_matrix(
-        Dzw, "Dzw", rows=p, cols=q, rows_what="rows of Cz", cols_what="columns of Bw")
+    Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
     return plant.F, plant.G, Bw, Cz, Dzu, Dzw
 
 
@@ -139,7 +133,6 @@ def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
 
 def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     n, m = G.shape
-    q = Bw.shape[1]
     if np.linalg.norm(Dzw, 2) >= gamma:
         return None
     B, Q, R, S = _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma)

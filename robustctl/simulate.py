@@ -327,7 +327,7 @@ def simulate_linear(K, F, G, x_ref, *, u_ff=None, w=None, x0=None, u_limit=None,
         Keff = Kb
     else:
         M = as_batch(np.atleast_2d(np.asarray(input_map, dtype=float)), "input_map", (p, m),
-                     (f"the plant's inputs, from G", "the controller's inputs, from K"))
+                     ("the plant's inputs, from G", "the controller's inputs, from K"))
         Keff = np.einsum("pm,bmn->bpn", M, Kb)
     lim = None
     if u_limit is not None:
@@ -500,7 +500,6 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParam
         raise ValueError(f"K must have 4 columns (the truck's states), got shape {np.shape(K)}")
     T = path.T
     scen = _scenarios(overloads, T)
-    S = len(scen)
     # discretise each distinct overload once
     values = np.unique(np.concatenate([np.atleast_1d(s) for s in scen]))
     Fu, Gu, Gku = _truck.discretise(values, params=p)

@@ -25,7 +25,7 @@ W3 = np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]])
 
 def brute_force_ranks(F, W, k, scalarizing="tchebycheff", theta=5.0):
     """Global ranks by explicit loops over solutions and weight vectors."""
-    n, nw = len(F), len(W)
+    n = len(F)
     near = []
     for x in F:
         d = []

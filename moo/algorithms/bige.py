@@ -131,7 +131,6 @@ def bige_estimation(F, radius: float, random_state: np.random.Generator) -> tupl
         raise ValueError(f"radius must be finite and > 0, got {radius}")
     if not isinstance(random_state, np.random.Generator):
         raise TypeError(f"random_state must be a numpy.random.Generator, got {type(random_state).__name__}")
-    n = F.shape[0]
     fmin = F.min(axis=0)
     span = F.max(axis=0) - fmin
     G = (F - fmin) / np.where(span > 0, span, 1.0)

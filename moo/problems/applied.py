@@ -32,7 +32,6 @@ from typing import Literal
 
 import numpy as np
 
-import robustctl as rc
 from robustctl._validation import check_positive_scalar
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
