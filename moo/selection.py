@@ -1,0 +1,534 @@
+"""Monte Carlo design selection: pick one design of a Pareto front (Morais et al. 2022, Secs. 4.4.1, 4.5.1).
+
+A MOEA returns a whole front of RLQR uncertainty models ``z``; the controller
+needs one. The paper picks it by simulation: every candidate design (the
+front's decision vectors plus a few baselines) is run on the same ``S``
+random realisations of the uncertainty, ``Delta ~ U(-1, 1)``; in each
+simulation the design with the least cumulative error wins, and the design
+that wins most often is the selected ``z*``. The paper ran ``S = 1000`` and
+shows the win counts as a histogram (its Figs. "fl-generic", "fl-applied").
+
+This module has three layers:
+
+* :func:`monte_carlo_selection` - the counting rule on a (designs x
+  simulations) array of cumulative errors (problem independent);
+* the problem-specific samplers that produce that array for all designs and
+  scenarios in one batched computation (no Python loop over designs):
+  :func:`generic_errors` (the generic MOP of Section 4.4) and
+  :func:`applied_errors` (the truck of Section 4.5);
+* :func:`build_designs` (front + the paper's extra designs) and
+  :func:`select_design` (everything in one call).
+
+Design sets (the paper's order). Generic: the ``N`` front designs, then the
+*nominal* design, then a *random* one (``N + 2`` designs, 94 in the paper).
+Applied: the front, *nominal*, *RLQR^A*, *random* (``N + 3``, 95 in the paper).
+
+* *nominal*: the controller designed with no uncertainty, i.e. the LQR with
+  the problem's ``Q``, ``R`` on its design plant (:func:`robustctl.lqr`; for the
+  truck the doubled steering column ``[G G]`` with ``R = 2 r I``, whose
+  summed steering gain is the plain truck's LQR gain).
+* *random*: the RLQR of a ``z`` drawn uniformly from the problem's bounds.
+* *RLQR^A*: the RLQR with the appendix's printed algebraic uncertainty
+  (:func:`robustctl.models.truck.algebraic_uncertainty`, ``H = 1``, ``mu = 1e9``),
+  with the problem's ``Q``, ``R`` and ``alpha``; its ``z`` is recorded as
+  ``[EF (4), EG (2), 81]`` (outside the MOP's bounds: EF, EG are negative).
+
+References
+----------
+D. C. Morais et al., "Robust path-following control design of heavy vehicles
+based on multiobjective evolutionary optimization", Expert Systems with
+Applications 192 (2022) 116304, Sections 4.4.1 and 4.5.1.
+A. M. Barbosa et al., "Robust path-following control for articulated heavy-duty
+vehicles", Control Engineering Practice 85 (2019) (RLQR^A, the doubled column).
+
+Notes
+-----
+Layering: apart from :mod:`moo.problems`, this is the one ``moo`` module that
+imports ``robustctl`` (the LQR, the truck model and the batched simulator):
+like the problems it is specific to the control-design MOPs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+import robustctl as rc
+from robustctl.models import truck
+from robustctl.path import ReferencePath, default_route
+from robustctl.simulate import simulate
+
+from ._validation import as_matrix, check_int
+from .problems.applied import AppliedRLQRProblem
+from .problems.generic import GenericRLQRProblem
+
+__all__ = [
+    "SelectionResult", "DesignSet", "DesignSelection", "monte_carlo_selection", "draw_deltas",
+    "overload_from_delta", "generic_errors", "applied_errors", "build_designs", "select_design",
+    "MAX_OVERLOAD", "BRYSON_SCALES",
+]
+
+#: Largest payload overload of the paper's robustness study [%] (Section 4.5.2: 0 to 300 %).
+MAX_OVERLOAD = 300.0
+#: Default error scales of :func:`applied_errors`, in the objectives' order
+#: (``rho`` [m], ``psidot`` [rad/s], ``ydot`` [m/s], ``theta`` [rad]): Bryson's
+#: acceptable errors :data:`robustctl.models.truck.MAX_ERRORS`, from which the
+#: designs' state weight ``Q`` is built.
+BRYSON_SCALES = tuple(float(truck.MAX_ERRORS[i]) for i in truck.OBJECTIVE_STATES)
+#: Scenarios simulated together by :func:`applied_errors` (bounds the memory of the disturbance arrays).
+_SCENARIO_CHUNK = 250
+
+
+# ---------------------------------------------------------------------------
+# the counting rule
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False, repr=False)
+class SelectionResult:
+    """Outcome of :func:`monte_carlo_selection` on ``D`` designs and ``S`` simulations.
+
+    Attributes
+    ----------
+    winners : (S,) int ndarray
+        Index of the design with the least error in each simulation (ties: the
+        lowest index); ``-1`` where no design has a finite error.
+    counts : (D,) int ndarray
+        Number of simulations each design won; ``counts.sum() == S - n_no_winner``.
+    best : int
+        The most frequent winner (ties: the lowest index), the selected design.
+    """
+
+    winners: np.ndarray
+    counts: np.ndarray
+    best: int
+
+    @property
+    def n_designs(self) -> int:
+        return int(self.counts.size)
+
+    @property
+    def n_simulations(self) -> int:
+        return int(self.winners.size)
+
+    @property
+    def n_no_winner(self) -> int:
+        """Simulations in which every design's error was infinite."""
+        return int(np.count_nonzero(self.winners < 0))
+
+    def ranking(self) -> np.ndarray:
+        """Design indices by decreasing win count (equal counts: increasing index)."""
+        return np.argsort(-self.counts, kind="stable")
+
+    def __repr__(self) -> str:
+        return (f"SelectionResult(D={self.n_designs}, S={self.n_simulations}, best={self.best}, "
+                f"wins={int(self.counts[self.best])}, no_winner={self.n_no_winner})")
+
+
+def _as_errors(errors) -> np.ndarray:
+    if isinstance(errors, (str, bytes)) or errors is None:
+        raise TypeError(f"errors must be a (designs, simulations) array of numbers, got {type(errors).__name__}")
+    try:
+        arr = np.asarray(errors, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError("errors must be a (designs, simulations) array of real numbers") from None
+    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
+        raise ValueError(f"errors must be a non-empty 2-D array (designs, simulations), got shape {arr.shape}")
+    if np.any(np.isnan(arr)) or np.any(arr == -np.inf):
+        raise ValueError("errors must not contain NaN or -inf (+inf marks a design that cannot win)")
+    return arr
+
+
+def monte_carlo_selection(errors) -> SelectionResult:
+    r"""Count how often each design has the least cumulative error; select the most frequent winner.
+
+    With ``E[d, s]`` the cumulative error of design ``d`` in simulation ``s``,
+
+    .. math::
+
+        w_s = \min \arg\min_d E[d, s], \qquad
+        c_d = \#\{s : w_s = d\}, \qquad
+        d^* = \min \arg\max_d c_d,
+
+    i.e. ties within a simulation go to the lowest design index, and so do ties
+    between win counts. ``+inf`` marks a design that cannot win a simulation
+    (e.g. unstable there); a simulation in which every design is ``+inf`` has
+    no winner (``winners[s] = -1``) and counts for nobody.
+
+    Parameters
+    ----------
+    errors : (D, S) array_like
+        Cumulative errors, lower is better; finite or ``+inf``.
+
+    Returns
+    -------
+    SelectionResult
+
+    Raises
+    ------
+    ValueError
+        ``errors`` not 2-D or empty, containing NaN or ``-inf``, or no
+        simulation has a winner.
+
+    References
+    ----------
+    Morais et al. (2022), Section 4.4.1: "The control design with less
+    cumulative error is assigned as the winner for each simulation [...] the
+    selection criterium is to choose [...] the most frequent individual".
+    """
+    E = _as_errors(errors)
+    D = E.shape[0]
+    winners = np.argmin(E, axis=0)                       # first minimum: lowest index on ties
+    winners[~np.isfinite(E.min(axis=0))] = -1
+    counts = np.bincount(winners[winners >= 0], minlength=D)
+    if counts.sum() == 0:
+        raise ValueError("errors: no design has a finite error in any simulation; nothing to select")
+    return SelectionResult(winners=winners, counts=counts, best=int(np.argmax(counts)))
+
+
+# ---------------------------------------------------------------------------
+# scenarios and the problem-specific samplers
+# ---------------------------------------------------------------------------
+
+def draw_deltas(n_sims: int, seed=None) -> np.ndarray:
+    """``n_sims`` realisations ``Delta ~ U(-1, 1)`` from ``np.random.default_rng(seed)``."""
+    n_sims = check_int(n_sims, "n_sims", 1)
+    return np.random.default_rng(seed).uniform(-1.0, 1.0, n_sims)
+
+
+def _as_deltas(deltas) -> np.ndarray:
+    d = as_matrix(deltas, "deltas", rows=1, rows_what="a 1-D array of realisations").ravel()
+    if np.any(np.abs(d) > 1.0):
+        raise ValueError(f"deltas must lie in [-1, 1] (||Delta|| <= 1), got min {d.min():g}, max {d.max():g}")
+    return d
+
+
+def overload_from_delta(deltas) -> np.ndarray:
+    r"""Payload overload [%] of each realisation: ``150 (1 + Delta)``, so ``Delta in [-1, 1] -> [0, 300] %``.
+
+    The truck's uncertainty is its payload, and the model refuses negative
+    overloads (less than the nominal payload) by design, so ``Delta`` cannot be
+    read as a symmetric deviation around the nominal payload. We map it
+    affinely onto the paper's robustness range instead: the MSE table
+    (Section 4.5.2) tests 0, 100, 200 and 300 % overload, so ``Delta = -1`` is
+    the nominal payload, ``Delta = 0`` 150 % and ``Delta = 1`` 300 % (four times
+    the payload). ``Delta ~ U(-1, 1)`` thus gives overloads ``~ U(0, 300)``.
+    """
+    return MAX_OVERLOAD / 2.0 * (1.0 + _as_deltas(deltas))
+
+
+def _as_gains(K, n: int, ms: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """(D, m, n) float gains (non-finite rows zeroed) and the (D,) mask of finite rows."""
+    if isinstance(K, (str, bytes)) or K is None:
+        raise TypeError(f"K must be a (D, m, {n}) array of gains, got {type(K).__name__}")
+    try:
+        arr = np.array(K, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"K must be a (D, m, {n}) array of real numbers") from None
+    if arr.ndim != 3 or arr.shape[0] < 1 or arr.shape[1] not in ms or arr.shape[2] != n:
+        want = " or ".join(f"(D, {m}, {n})" for m in ms)
+        raise ValueError(f"K must have shape {want} (one gain per design), got shape {arr.shape}")
+    ok = np.all(np.isfinite(arr), axis=(1, 2))
+    arr[~ok] = 0.0
+    return arr, ok
+
+
+def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> np.ndarray:
+    r"""Cumulative regulation errors (D, S) of gains ``K`` on the generic plant, one column per ``Delta``.
+
+    For design ``d`` and realisation ``delta_s`` (held constant over the run, as
+    in :class:`~moo.problems.generic.GenericRLQRProblem`) the closed loop is
+    ``A_{d,s} = F + H delta_s E_F^true + (G + H delta_s E_G^true) K_d`` and
+
+    .. math::
+
+        E[d, s] = \sum_{j=1}^{3} e_{j}
+                = \sum_{i=1}^{n_0} \sum_{k=0}^{N} \big\| A_{d,s}^k x_{0,i} \big\|^2 ,
+
+    the sum over the three states of the problem's regulation errors
+    (:meth:`~moo.problems.generic.GenericRLQRProblem.regulation_errors`), with
+    the problem's initial states ``x_{0,i}`` (default the unit vectors, so
+    ``E`` is the trace of the finite-horizon Gramian) and horizon ``N``. A
+    closed loop that is not Schur-stable at ``delta_s`` (infinite regulation
+    error), or a non-finite gain, gets ``+inf``.
+
+    Parameters
+    ----------
+    K : (D, 1, 3) array_like
+        Gains ``u = K x``; rows with NaN (failed designs) are allowed.
+    deltas : (S,) array_like
+        Realisations in ``[-1, 1]`` (see :func:`draw_deltas`).
+    problem : GenericRLQRProblem, optional
+        Source of the initial states and horizon (default: the default problem).
+
+    Returns
+    -------
+    (D, S) ndarray
+        All designs and realisations in one stacked recursion.
+    """
+    if problem is None:
+        problem = GenericRLQRProblem()
+    elif not isinstance(problem, GenericRLQRProblem):
+        raise TypeError(f"problem must be a GenericRLQRProblem, got {type(problem).__name__}")
+    Kb, ok = _as_gains(K, problem.plant.n, (problem.plant.m,))
+    mc = GenericRLQRProblem(deltas=_as_deltas(deltas), initial_states=problem.initial_states,
+                            horizon=problem.horizon)
+    e, _ = mc.regulation_errors(np.where(ok[:, None, None], Kb, np.nan))
+    E = e.sum(axis=2)
+    E[~ok] = np.inf
+    return E
+
+
+def _as_scales(scales) -> np.ndarray:
+    if scales is None:
+        return np.array(BRYSON_SCALES)
+    s = as_matrix(scales, "scales", rows=1, cols=4, cols_what="one per objective: rho, psidot, ydot, theta").ravel()
+    if np.any(s <= 0):
+        raise ValueError(f"scales must be positive, got {s}")
+    return s
+
+
+def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None) -> np.ndarray:
+    r"""Cumulative normalised tracking errors (D, S) of truck gains ``K``, one column per ``Delta``.
+
+    Each ``Delta_s`` is a payload overload ``150 (1 + Delta_s)`` % held over the
+    run (:func:`overload_from_delta`); every design drives the true truck at
+    that payload along ``path`` (:func:`robustctl.simulate.simulate`: nominal
+    reference states and feedforward, 0.45 rad steering limit, 1 m initial
+    offset), and
+
+    .. math::
+
+        E[d, s] = \sum_{k=0}^{T-1} \sum_{i=1}^{4} \Big(\frac{e_i[k]}{\sigma_i}\Big)^2,
+
+    with ``e`` the tracking errors of the four objectives' states (``rho``,
+    ``psidot``, ``ydot``, ``theta``; ``x - x_ref`` as in the MOP's
+    objectives) and ``sigma`` the error scales. The default scales are
+    Bryson's acceptable errors ``[0.25 m, 0.1 rad/s, 0.5 m/s, 0.05 rad]``
+    (:data:`BRYSON_SCALES`), so that ``E`` is the quadratic state cost
+    ``sum_k e[k]^T Q e[k]`` of the weight ``Q`` every truck design uses
+    (:func:`robustctl.models.truck.lqr_weights`): the objectives are added in
+    the units the designs trade them in. ``E = T * sum_i f_i / sigma_i^2``
+    with ``f_i`` the MOP's per-scenario MSEs. A gain with non-finite entries
+    gets ``+inf``; a run that diverges is frozen by the simulator at its bound
+    (a huge finite error, see :mod:`robustctl.simulate`).
+
+    Parameters
+    ----------
+    K : (D, 2, 4) or (D, 1, 4) array_like
+        Gains ``u = K e`` (doubled column, steering ``u1 + u2``, or plain truck).
+    deltas : (S,) array_like
+        Realisations in ``[-1, 1]``.
+    path : ReferencePath, optional
+        Default :func:`robustctl.path.default_route` (540 s); a shorter one
+        (``ReferencePath.truncated``) makes the selection cheaper.
+    scales : (4,) array_like, optional
+        ``sigma``; e.g. ``np.sqrt(AppliedRLQRProblem().hv_ref_point)`` weights
+        the objectives by the problem's hypervolume reference point instead.
+
+    Returns
+    -------
+    (D, S) ndarray
+        All designs and scenarios in one batched simulation (scenarios in
+        chunks of 250 to bound memory; no loop over designs).
+    """
+    Kb, ok = _as_gains(K, 4, (1, 2))
+    overloads = overload_from_delta(deltas)
+    sigma = _as_scales(scales)
+    if path is None:
+        path = default_route()
+    elif not isinstance(path, ReferencePath):
+        raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
+    obj = list(truck.OBJECTIVE_STATES)
+    E = np.empty((Kb.shape[0], overloads.size))
+    for start in range(0, overloads.size, _SCENARIO_CHUNK):
+        chunk = overloads[start:start + _SCENARIO_CHUNK]
+        res = simulate(Kb, path, tuple(chunk.tolist()), keep_trajectories=False)
+        E[:, start:start + chunk.size] = (res.sq_error_sum[..., obj] / sigma**2).sum(axis=2)
+    E[~ok] = np.inf
+    return E
+
+
+# ---------------------------------------------------------------------------
+# the design set
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False, repr=False)
+class DesignSet:
+    """Candidate designs of a selection: the front, then the paper's extra designs.
+
+    Attributes
+    ----------
+    K : (D, m, n) ndarray
+        Gains ``u = K x`` (NaN rows where an RLQR design failed).
+    z : (D, n_var) ndarray
+        Decision vector of each design (NaN row for the nominal LQR).
+    labels : tuple of str
+        ``"1"`` .. ``"N"`` for the front, then ``"nominal"``, [``"RLQR^A"``,] ``"random"``.
+    kinds : tuple of str
+        ``"front"``, ``"nominal"``, ``"rlqr_a"`` or ``"random"`` per design.
+    ok : (D,) bool ndarray
+        The design was computed (finite gain).
+    """
+
+    K: np.ndarray
+    z: np.ndarray
+    labels: tuple[str, ...]
+    kinds: tuple[str, ...]
+    ok: np.ndarray
+
+    def __len__(self) -> int:
+        return self.K.shape[0]
+
+    @property
+    def n_front(self) -> int:
+        return self.kinds.count("front")
+
+    def index(self, kind: str) -> int:
+        """Index of the (single) extra design of ``kind`` (``"nominal"``, ``"rlqr_a"``, ``"random"``)."""
+        if kind == "front" or kind not in self.kinds:
+            raise ValueError(f"kind must be one of the extra designs {sorted(set(self.kinds) - {'front'})}, "
+                             f"got {kind!r}")
+        return self.kinds.index(kind)
+
+    def __repr__(self) -> str:
+        extras = [lab for lab, k in zip(self.labels, self.kinds) if k != "front"]
+        return (f"DesignSet(D={len(self)}, front={self.n_front}, extras={extras}, "
+                f"failed={int((~self.ok).sum())})")
+
+
+def _check_problem(problem) -> None:
+    if not isinstance(problem, (GenericRLQRProblem, AppliedRLQRProblem)):
+        raise TypeError(f"problem must be a GenericRLQRProblem or an AppliedRLQRProblem, "
+                        f"got {type(problem).__name__}")
+
+
+def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, seed=None) -> DesignSet:
+    """The candidate designs: the front's decision vectors plus the paper's extra designs.
+
+    Generic: ``[front (N), nominal, random]``; applied: ``[front (N), nominal,
+    RLQR^A, random]`` (the paper's order, see the module docstring). The front
+    and random designs are computed in one batched RLQR call
+    (:meth:`problem.gains`), with the problem's ``Q``, ``R``, ``alpha`` and
+    ``max_iter``; a design that fails keeps NaN gains (``ok`` False) and can
+    never win.
+
+    Parameters
+    ----------
+    problem : GenericRLQRProblem or AppliedRLQRProblem
+    X_front : (N, n_var) array_like
+        Decision vectors of the front (N >= 1), e.g. ``moo.runner.run(...).X``.
+    seed : int or numpy Generator-compatible seed
+        Seed of the random design, drawn from ``U(problem.xl, problem.xu)``.
+    """
+    _check_problem(problem)
+    X = as_matrix(X_front, "X_front", cols=problem.n_var, cols_what="the problem's number of variables")
+    if np.any(X[:, -1] < 0):
+        raise ValueError(f"X_front's last variable, (log10 mu)^2, must be >= 0, got {X[:, -1].min():g}")
+    rng = np.random.default_rng(seed)
+    z_random = rng.uniform(problem.xl, problem.xu)
+    batch = problem.gains(np.vstack([X, z_random]))
+    K_rlqr = np.where(batch.ok[:, None, None], batch.K, np.nan)
+    K_nom = rc.lqr(problem.plant, Q=problem.Q, R=problem.R).K
+    N = X.shape[0]
+    Ks = [K_rlqr[:N], K_nom[None]]
+    zs = [X, np.full((1, problem.n_var), np.nan)]
+    labels = [str(i + 1) for i in range(N)] + ["nominal"]
+    kinds = ["front"] * N + ["nominal"]
+    if isinstance(problem, AppliedRLQRProblem):
+        u = truck.algebraic_uncertainty("printed")
+        a = rc.rlqr_gains(problem.plant, u.EF, u.EG, np.array([u.mu]), Q=problem.Q, R=problem.R, H=u.H,
+                          alpha=problem.alpha, max_iter=problem.max_iter)
+        Ks.append(np.where(a.ok[:, None, None], a.K, np.nan))
+        zs.append(np.concatenate([u.EF.ravel(), u.EG.ravel(), [np.log10(u.mu) ** 2]])[None])
+        labels.append("RLQR^A")
+        kinds.append("rlqr_a")
+    Ks.append(K_rlqr[N:])
+    zs.append(z_random[None])
+    labels.append("random")
+    kinds.append("random")
+    K = np.concatenate(Ks)
+    return DesignSet(K=K, z=np.concatenate(zs), labels=tuple(labels), kinds=tuple(kinds),
+                     ok=np.all(np.isfinite(K), axis=(1, 2)))
+
+
+# ---------------------------------------------------------------------------
+# everything in one call
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False, repr=False)
+class DesignSelection:
+    """Outcome of :func:`select_design`.
+
+    Attributes
+    ----------
+    designs : DesignSet
+    deltas : (S,) ndarray
+        The realisations ``Delta_s``.
+    errors : (D, S) ndarray
+        Cumulative errors (see :func:`generic_errors`, :func:`applied_errors`).
+    result : SelectionResult
+    """
+
+    designs: DesignSet
+    deltas: np.ndarray
+    errors: np.ndarray
+    result: SelectionResult
+
+    @property
+    def best(self) -> int:
+        return self.result.best
+
+    @property
+    def label(self) -> str:
+        """Label of the selected design (``"49"``, ``"nominal"``, ...)."""
+        return self.designs.labels[self.best]
+
+    @property
+    def z(self) -> np.ndarray:
+        """Decision vector ``z*`` of the selected design (NaN for the nominal LQR)."""
+        return self.designs.z[self.best].copy()
+
+    def __repr__(self) -> str:
+        return (f"DesignSelection(D={len(self.designs)}, S={self.deltas.size}, winner={self.label!r}, "
+                f"wins={int(self.result.counts[self.best])})")
+
+
+def select_design(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, n_sims: int = 1000,
+                  seed=None, path: ReferencePath | None = None, scales=None) -> DesignSelection:
+    """The paper's Monte Carlo selection of ``z*`` from a front, in one call.
+
+    Builds the design set (:func:`build_designs`), draws ``n_sims`` realisations
+    ``Delta ~ U(-1, 1)`` (:func:`draw_deltas`), computes the cumulative errors
+    (:func:`generic_errors` or :func:`applied_errors`) and counts the winners
+    (:func:`monte_carlo_selection`).
+
+    Parameters
+    ----------
+    problem : GenericRLQRProblem or AppliedRLQRProblem
+        The problem the front was computed on (its ``Q``, ``R``, ``alpha`` design
+        the gains; the generic one also gives initial states and horizon).
+    X_front : (N, n_var) array_like
+    n_sims : int
+        ``S`` (the paper: 1000).
+    seed : int or numpy Generator-compatible seed
+        ``np.random.default_rng(seed)`` is split (``Generator.spawn``) into two
+        independent streams: the random design and the realisations.
+    path : ReferencePath, optional
+        Applied problem only: the simulated path (default ``problem.path``).
+    scales : (4,) array_like, optional
+        Applied problem only: see :func:`applied_errors`.
+    """
+    _check_problem(problem)
+    n_sims = check_int(n_sims, "n_sims", 1)
+    generic = isinstance(problem, GenericRLQRProblem)
+    if generic and (path is not None or scales is not None):
+        raise ValueError("path and scales apply to the applied problem only; give None for the generic one")
+    design_rng, delta_rng = np.random.default_rng(seed).spawn(2)
+    designs = build_designs(problem, X_front, seed=design_rng)
+    deltas = draw_deltas(n_sims, delta_rng)
+    if generic:
+        errors = generic_errors(designs.K, deltas, problem=problem)
+    else:
+        errors = applied_errors(designs.K, deltas, path=problem.path if path is None else path, scales=scales)
+    return DesignSelection(designs=designs, deltas=deltas, errors=errors, result=monte_carlo_selection(errors))
