@@ -101,7 +101,7 @@ def histogram(sel: DesignSelection, title: str, out: Path) -> None:
         if k != "front":
             ax.plot(i + 1, 0, marker="^", ms=8, color=EXTRA_COLORS[k], clip_on=False, zorder=3)
             handles.append(Line2D([], [], ls="", marker="^", ms=8, color=EXTRA_COLORS[k],
-                                  label=f"{i + 1}: {d.labels[i]} ({int(counts[i])} wins)"))
+                                  label=f"{i + 1}: {d.labels[i].replace('^A', '$^A$')} ({int(counts[i])} wins)"))
     ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.9)
     ax.annotate(f"z* = design {d.labels[sel.best]}: {int(counts[sel.best])} wins",
                 (sel.best + 1, counts[sel.best]), textcoords="offset points", xytext=(8, 4),
