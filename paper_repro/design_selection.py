@@ -23,7 +23,7 @@
 regulation horizon N steps instead of 200; applied: the first N samples of
 the route, N * 0.1 s, instead of 5400); the MOEA always uses the problem's
 defaults. The default settings take well under a minute on 2 cores
-(generic about 5 s, applied about 15 s).
+(measured: generic about 3 s, applied about 8 s in all, MOEA included).
 
 Writes ``DIR/selection.json`` (settings, z*, win counts of every design, the
 front's objectives, timings) and ``DIR/selection_histogram.png`` (default
