@@ -190,10 +190,19 @@ def monte_carlo_selection(errors) -> SelectionResult:
 # scenarios and the problem-specific samplers
 # ---------------------------------------------------------------------------
 
+def _rng(seed) -> np.random.Generator:
+    """``np.random.default_rng(seed)``, with an error that names ``seed``."""
+    try:
+        return np.random.default_rng(seed)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"seed must be None, a non-negative integer, a SeedSequence or a Generator "
+                        f"({exc})") from None
+
+
 def draw_deltas(n_sims: int, seed=None) -> np.ndarray:
     """``n_sims`` realisations ``Delta ~ U(-1, 1)`` from ``np.random.default_rng(seed)``."""
     n_sims = check_int(n_sims, "n_sims", 1)
-    return np.random.default_rng(seed).uniform(-1.0, 1.0, n_sims)
+    return _rng(seed).uniform(-1.0, 1.0, n_sims)
 
 
 def _as_deltas(deltas) -> np.ndarray:
@@ -425,8 +434,7 @@ def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     X = as_matrix(X_front, "X_front", cols=problem.n_var, cols_what="the problem's number of variables")
     if np.any(X[:, -1] < 0):
         raise ValueError(f"X_front's last variable, (log10 mu)^2, must be >= 0, got {X[:, -1].min():g}")
-    rng = np.random.default_rng(seed)
-    z_random = rng.uniform(problem.xl, problem.xu)
+    z_random = _rng(seed).uniform(problem.xl, problem.xu)
     batch = problem.gains(np.vstack([X, z_random]))
     K_rlqr = np.where(batch.ok[:, None, None], batch.K, np.nan)
     K_nom = rc.lqr(problem.plant, Q=problem.Q, R=problem.R).K
@@ -524,7 +532,7 @@ def select_design(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     generic = isinstance(problem, GenericRLQRProblem)
     if generic and (path is not None or scales is not None):
         raise ValueError("path and scales apply to the applied problem only; give None for the generic one")
-    design_rng, delta_rng = np.random.default_rng(seed).spawn(2)
+    design_rng, delta_rng = _rng(seed).spawn(2)
     designs = build_designs(problem, X_front, seed=design_rng)
     deltas = draw_deltas(n_sims, delta_rng)
     if generic:

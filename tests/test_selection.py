@@ -305,6 +305,10 @@ def test_bad_arguments_name_the_argument(generic, applied):
         build_designs(generic, np.ones((1, 7)))
     with pytest.raises(ValueError, match="X_front"):
         build_designs(generic, [[1.0, 1.0, 1.0, 1.0, -1.0]])
+    with pytest.raises(ValueError, match="seed"):
+        draw_deltas(3, -1)
+    with pytest.raises(TypeError, match="seed"):
+        select_design(generic, X, n_sims=3, seed="one")
     with pytest.raises(ValueError, match="path and scales"):
         select_design(generic, X, path=applied.path)
 
