@@ -9,11 +9,11 @@
 2. The candidate designs are the front's decision vectors, sorted by the first
    objective (design 1 has the smallest f1), then the paper's extra designs:
    *nominal* (LQR with the same Q, R), [*RLQR^A* (appendix, applied problem only),]
-   *random* (a uniformly random z); see :mod:`moo.selection`.
+   *random* (a uniformly random z); see :mod:`moo.problems.selection`.
 3. ``--sims`` realisations ``Delta ~ U(-1, 1)`` (default 1000 generic, 200
    applied; the paper used 1000 for both): every design is simulated on every
    realisation and the one with the least cumulative error wins
-   (:func:`moo.selection.select_design`). Generic: ``Delta`` is the plant's
+   (:func:`moo.problems.selection.select_design`). Generic: ``Delta`` is the plant's
    uncertainty, the error the summed regulation error of the three states.
    Applied: ``Delta`` is the payload overload ``150 (1 + Delta)`` in [0, 300] %,
    the error the Bryson-weighted squared tracking error summed over time.
@@ -48,7 +48,7 @@ from moo.algorithms import ALGORITHMS  # noqa: E402
 from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
 from moo.problems.generic import GenericRLQRProblem  # noqa: E402
 from moo.runner import run as run_moea  # noqa: E402
-from moo.selection import BRYSON_SCALES, DesignSelection, select_design  # noqa: E402
+from moo.problems.selection import BRYSON_SCALES, DesignSelection, select_design  # noqa: E402
 
 DEFAULT_SIMS = {"generic": 1000, "applied": 200}
 PAPER = {"generic": "paper: design 49 of 92 won 222/1000; random 1, nominal 0",

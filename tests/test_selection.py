@@ -1,4 +1,4 @@
-"""moo.selection (the paper's Monte Carlo design selection) and paper_repro/design_selection.py.
+"""moo.problems.selection (the paper's Monte Carlo design selection) and paper_repro/design_selection.py.
 
 References are independent of the code under test: a brute-force counting
 loop, a per-design per-Delta numpy recursion written here from the paper's
@@ -15,10 +15,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-import moo.selection as selection
+import moo.problems.selection as selection
 from moo.problems.applied import AppliedRLQRProblem
 from moo.problems.generic import GenericRLQRProblem
-from moo.selection import (BRYSON_SCALES, applied_errors, build_designs, draw_deltas, generic_errors,
+from moo.problems.selection import (BRYSON_SCALES, applied_errors, build_designs, draw_deltas, generic_errors,
                            monte_carlo_selection, overload_from_delta, select_design)
 from paper_repro import design_selection
 from robustctl.models import truck

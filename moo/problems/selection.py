@@ -43,9 +43,9 @@ vehicles", Control Engineering Practice 85 (2019) (RLQR^A, the doubled column).
 
 Notes
 -----
-Layering: apart from :mod:`moo.problems`, this is the one ``moo`` module that
-imports ``robustctl`` (the LQR, the truck model and the batched simulator):
-like the problems it is specific to the control-design MOPs.
+Layering: it lives in :mod:`moo.problems` because, like the problems, it is
+specific to the control-design MOPs and imports ``robustctl`` (the LQR, the
+truck model and the batched simulator).
 """
 
 from __future__ import annotations
@@ -59,9 +59,9 @@ from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
 from robustctl.simulate import simulate
 
-from ._validation import as_matrix, check_int
-from .problems.applied import AppliedRLQRProblem
-from .problems.generic import GenericRLQRProblem
+from .._validation import as_matrix, check_int
+from .applied import AppliedRLQRProblem
+from .generic import GenericRLQRProblem
 
 __all__ = [
     "SelectionResult", "DesignSet", "DesignSelection", "monte_carlo_selection", "draw_deltas",
