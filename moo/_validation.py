@@ -15,7 +15,8 @@ import numpy as np
 # one import of robustctl in moo outside moo/problems/.
 from robustctl._validation import as_matrix, check_positive_scalar
 
-__all__ = ["as_matrix", "as_objectives", "check_choice", "check_int", "check_positive_scalar", "check_real"]
+__all__ = ["as_matrix", "as_objectives", "check_choice", "check_directions", "check_int",
+           "check_positive_scalar", "check_real"]
 
 
 def check_int(value, name: str, minimum: int) -> int:
@@ -61,3 +62,14 @@ def as_objectives(F, name: str = "F") -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must have finite entries (found NaN or inf)")
     return arr
+
+
+def check_directions(W, name: str = "ref_dirs") -> np.ndarray:
+    """Weight / reference-direction vectors: a finite, non-negative ``(n_dirs, n_obj)`` array,
+    ``n_obj >= 2``, every row with a positive sum."""
+    W = np.asarray(W, dtype=float)
+    if W.ndim != 2 or W.shape[0] < 1 or W.shape[1] < 2:
+        raise ValueError(f"{name} must be a 2-D array (n_dirs, n_obj) with n_obj >= 2, got shape {W.shape}")
+    if not np.all(np.isfinite(W)) or np.any(W < 0) or np.any(W.sum(axis=1) <= 0):
+        raise ValueError(f"{name} must be finite, non-negative and each row must have a positive sum")
+    return W

@@ -86,7 +86,7 @@ from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
 from pymoo.operators.selection.tournament import TournamentSelection
 
-from .._validation import check_int, check_real
+from .._validation import check_directions, check_int, check_real
 from ._base import paper_operators
 from .operators import POP_SIZE, reference_directions
 
@@ -104,15 +104,6 @@ __all__ = [
 ZERO_WEIGHT = 1e-6
 #: Smallest range z_max - z_min used in the normalisation (avoids 0/0).
 _TINY_RANGE = 1e-12
-
-
-def _check_weights(weights) -> np.ndarray:
-    W = np.asarray(weights, dtype=float)
-    if W.ndim != 2 or W.shape[0] < 1 or W.shape[1] < 2:
-        raise ValueError(f"weights must be a 2-D array (n_weights, n_obj) with n_obj >= 2, got shape {W.shape}")
-    if not np.all(np.isfinite(W)) or np.any(W < 0) or np.any(W.sum(axis=1) <= 0):
-        raise ValueError("weights must be finite, non-negative and each row must have a positive sum")
-    return W
 
 
 def asf_matrix(F_norm: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -163,7 +154,7 @@ def r2_ranking(F: np.ndarray, weights: np.ndarray, ideal: np.ndarray, nadir: np.
         Euclidean norm of the normalised objective vectors.
     """
     F = np.asarray(F, dtype=float)
-    W = _check_weights(weights)
+    W = check_directions(weights, "weights")
     if F.ndim != 2 or F.shape[1] != W.shape[1]:
         raise ValueError(f"F must have shape (N, {W.shape[1]}) to match weights {W.shape}, got shape {F.shape}")
     ideal = np.asarray(ideal, dtype=float)
@@ -252,7 +243,7 @@ class R2RankingSurvival(Survival):
     def __init__(self, weights: np.ndarray, *, alpha: float = 0.5, epsilon: float = 1e-3,
                  record_size: int = 5) -> None:
         super().__init__(filter_infeasible=True)
-        self.weights = _check_weights(weights)
+        self.weights = check_directions(weights, "weights")
         self.alpha = check_real(alpha, "alpha", positive=False)
         self.epsilon = check_real(epsilon, "epsilon", positive=False)
         self.record_size = check_int(record_size, "record_size", 1)
@@ -355,7 +346,7 @@ class MOMBI2(GeneticAlgorithm):
     def __init__(self, ref_dirs: np.ndarray, *, pop_size: int | None = None, alpha: float = 0.5,
                  epsilon: float = 1e-3, record_size: int = 5, sampling=None, crossover=None,
                  mutation=None, eliminate_duplicates: bool = True) -> None:
-        ref_dirs = _check_weights(ref_dirs)
+        ref_dirs = check_directions(ref_dirs)
         if pop_size is None:
             pop_size = len(ref_dirs)
         pop_size = check_int(pop_size, "pop_size", 2)

@@ -90,11 +90,11 @@ from pymoo.core.survival import Survival
 from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
-from .._validation import check_int
+from .._validation import check_directions, check_int
 from ._base import paper_operators
 from ._normalize import front_bounds
 from .operators import POP_SIZE, reference_directions
-from .theta_dea import _check_reference_directions, finite_first, select_by_fronts, theta_nondominated_ranks
+from .theta_dea import finite_first, select_by_fronts, theta_nondominated_ranks
 
 __all__ = [
     "SPEAR",
@@ -126,7 +126,7 @@ def largest_neighbour_angle(ref_dirs: np.ndarray) -> float:
 
     pi/2 for a single direction.
     """
-    W = _check_reference_directions(ref_dirs)
+    W = check_directions(ref_dirs)
     if len(W) == 1:
         return float(np.pi / 2)
     U = W / np.linalg.norm(W, axis=1, keepdims=True)
@@ -138,7 +138,7 @@ def largest_neighbour_angle(ref_dirs: np.ndarray) -> float:
 def associate_by_angle(Fn: np.ndarray, ref_dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Subregion (direction of smallest angle, lowest index on ties) and that angle, for each row."""
     Fn = np.asarray(Fn, dtype=float)
-    W = _check_reference_directions(ref_dirs)
+    W = check_directions(ref_dirs)
     U = W / np.linalg.norm(W, axis=1, keepdims=True)
     norms = np.linalg.norm(Fn, axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -194,7 +194,7 @@ class SPEARSurvival(Survival):
 
     def __init__(self, ref_dirs: np.ndarray):
         super().__init__(filter_infeasible=True)
-        self.ref_dirs = _check_reference_directions(ref_dirs)
+        self.ref_dirs = check_directions(ref_dirs)
         self.theta_bar = largest_neighbour_angle(self.ref_dirs)
 
     def _do(self, problem, pop, n_survive=None, random_state=None, **kwargs):
@@ -276,7 +276,7 @@ class SPEAR(GeneticAlgorithm):
                  sampling: Sampling | None = None, crossover: Crossover | None = None,
                  mutation: Mutation | None = None, eliminate_duplicates: bool = True,
                  n_offsprings: int | None = None, output: Output | None = None):
-        ref_dirs = _check_reference_directions(ref_dirs)
+        ref_dirs = check_directions(ref_dirs)
         pop_size = check_int(len(ref_dirs) if pop_size is None else pop_size, "pop_size", 2)
         self.ref_dirs = ref_dirs
         super().__init__(

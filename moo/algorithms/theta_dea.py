@@ -74,7 +74,7 @@ from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from .._validation import check_int, check_real
+from .._validation import check_directions, check_int, check_real
 from ._base import NormalizationForwarding, paper_operators
 from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, reference_directions
@@ -91,15 +91,6 @@ __all__ = [
 ]
 
 AXIS_THETA = 1.0e6
-
-
-def _check_reference_directions(ref_dirs: np.ndarray) -> np.ndarray:
-    W = np.asarray(ref_dirs, dtype=float)
-    if W.ndim != 2 or W.shape[0] < 1 or W.shape[1] < 2:
-        raise ValueError(f"ref_dirs must be a 2-D array (n_dirs, n_obj >= 2), got shape {W.shape}")
-    if not np.all(np.isfinite(W)) or np.any(W < 0) or np.any(W.sum(axis=1) <= 0):
-        raise ValueError("ref_dirs must be finite, non-negative and have a positive entry in every row")
-    return W
 
 
 def theta_clustering(Fn: np.ndarray, ref_dirs: np.ndarray, theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -124,7 +115,7 @@ def theta_clustering(Fn: np.ndarray, ref_dirs: np.ndarray, theta: float) -> tupl
         ``F_j(x) = d1 + theta_j d2``.
     """
     Fn = np.asarray(Fn, dtype=float)
-    W = _check_reference_directions(ref_dirs)
+    W = check_directions(ref_dirs)
     U = W / np.linalg.norm(W, axis=1, keepdims=True)                     # (K, M)
     D1 = Fn @ U.T                                                         # (n, K)
     D2 = np.linalg.norm(Fn[:, None, :] - D1[:, :, None] * U[None, :, :], axis=2)
@@ -226,7 +217,7 @@ class ThetaSurvival(NormalizationForwarding, Survival):
 
     def __init__(self, ref_dirs: np.ndarray, theta: float = 5.0):
         super().__init__(filter_infeasible=True)
-        self.ref_dirs = _check_reference_directions(ref_dirs)
+        self.ref_dirs = check_directions(ref_dirs)
         self.theta = check_real(theta, "theta", positive=False)
         self.norm = HyperplaneNormalization(self.ref_dirs.shape[1])
 
@@ -275,7 +266,7 @@ class ThetaDEA(GeneticAlgorithm):
                  sampling: Sampling | None = None, crossover: Crossover | None = None,
                  mutation: Mutation | None = None, eliminate_duplicates: bool = True,
                  n_offsprings: int | None = None, output: Output | None = None):
-        ref_dirs = _check_reference_directions(ref_dirs)
+        ref_dirs = check_directions(ref_dirs)
         pop_size = check_int(len(ref_dirs) if pop_size is None else pop_size, "pop_size", 2)
         self.ref_dirs = ref_dirs
         self.theta = check_real(theta, "theta", positive=False)
