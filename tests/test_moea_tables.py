@@ -13,7 +13,10 @@ from paper_repro.paper_moea_values import CORRECTIONS, INDICATORS, PAPER_MOEA, p
 
 ALGS = ("nsga2", "nsga3", "theta-dea", "mombi2", "moea-igd-ns", "efr-rr", "maoea-ddfc", "spea-r",
         "spea2-sde", "bige")
-TEX = Path("/work/shared/paper/morais2022-robust-path-following.tex")
+_PAPER = Path("paper") / "morais2022-robust-path-following.tex"
+# shared/ sits beside the clone (CI and developers); /work/shared on the development machines
+TEX = next((p for p in (Path(__file__).resolve().parents[2] / "shared" / _PAPER, Path("/work/shared") / _PAPER)
+            if p.exists()), Path("/work/shared") / _PAPER)
 # The paper bolds the larger SP (see paper_moea_values); the others as usual.
 PAPER_HIGHER = {"igd": False, "sp": True, "hv": True, "pd": True, "spread": False}
 
