@@ -43,6 +43,12 @@ def paper_operators(sampling=None, crossover=None, mutation=None, output=None) -
     }
 
 
+def check_ref_dirs_fit(ref_dirs, problem) -> None:
+    """Raise ``ValueError`` unless ``ref_dirs`` has one column per objective of ``problem``."""
+    if ref_dirs.shape[1] != problem.n_obj:
+        raise ValueError(f"ref_dirs has {ref_dirs.shape[1]} columns but the problem has {problem.n_obj} objectives")
+
+
 class NormalizationForwarding:
     """Mixin for a survival holding a :class:`HyperplaneNormalization` in ``self.norm``.
 

@@ -87,7 +87,7 @@ from pymoo.core.survival import Survival
 from pymoo.operators.selection.tournament import TournamentSelection
 
 from .._validation import check_directions, check_int, check_real
-from ._base import paper_operators
+from ._base import check_ref_dirs_fit, paper_operators
 from .operators import POP_SIZE, reference_directions
 
 __all__ = [
@@ -361,9 +361,7 @@ class MOMBI2(GeneticAlgorithm):
         )
 
     def _setup(self, problem, **kwargs) -> None:
-        if self.ref_dirs.shape[1] != problem.n_obj:
-            raise ValueError(f"ref_dirs have {self.ref_dirs.shape[1]} columns but the problem has "
-                             f"{problem.n_obj} objectives")
+        check_ref_dirs_fit(self.ref_dirs, problem)
         self.survival.reset()
 
 

@@ -91,7 +91,7 @@ from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
 from .._validation import check_directions, check_int
-from ._base import paper_operators
+from ._base import check_ref_dirs_fit, paper_operators
 from ._normalize import front_bounds
 from .operators import POP_SIZE, reference_directions
 from .theta_dea import finite_first, select_by_fronts, theta_nondominated_ranks
@@ -290,8 +290,7 @@ class SPEAR(GeneticAlgorithm):
         )
 
     def _setup(self, problem, **kwargs):
-        if self.ref_dirs.shape[1] != problem.n_obj:
-            raise ValueError(f"ref_dirs has {self.ref_dirs.shape[1]} columns but the problem has {problem.n_obj} objectives")
+        check_ref_dirs_fit(self.ref_dirs, problem)
 
 
 def make_spea_r(*, n_obj: int, pop_size: int = POP_SIZE, k_mating: int = 20) -> SPEAR:

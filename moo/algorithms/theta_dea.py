@@ -75,7 +75,7 @@ from pymoo.util.misc import random_permutations
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from .._validation import check_directions, check_int, check_real
-from ._base import NormalizationForwarding, paper_operators
+from ._base import NormalizationForwarding, check_ref_dirs_fit, paper_operators
 from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, reference_directions
 
@@ -281,8 +281,7 @@ class ThetaDEA(GeneticAlgorithm):
         )
 
     def _setup(self, problem, **kwargs):
-        if self.ref_dirs.shape[1] != problem.n_obj:
-            raise ValueError(f"ref_dirs has {self.ref_dirs.shape[1]} columns but the problem has {problem.n_obj} objectives")
+        check_ref_dirs_fit(self.ref_dirs, problem)
         self.survival.reset()
 
 
