@@ -158,6 +158,22 @@ def test_survival_uses_bigoal_layers_on_the_critical_front():
     assert sorted(map(tuple, out.get("F"))) == sorted(map(tuple, FRONT[[1, 2]]))
 
 
+def test_survival_estimates_the_goals_on_the_critical_front_only():
+    # Pins the reading of Alg. 3 + Sec. 4 (goals of the critical front, normalised over it).
+    # A (3,8), B (7,6), C (9,1), D (5,0), E (8,3): front 1 = {A, D}, critical front {B, C, E};
+    # n_survive = 3 -> one slot; r = 3^(-1/2) = 0.577.
+    # Over the critical front (min (7,1), span (2,5)): B (0,1), C (1,0), E (0.5,0.4);
+    #   f_pr = [1, 1, 0.9]; d_BE = 0.781, d_CE = 0.640, d_BC = 1.414, all >= r -> f_cd = 0;
+    #   E (0.9, 0) dominates B and C (1, 0) -> E survives, whatever the seed.
+    # (Estimating over all five points instead -- min (3,0), span (6,8) -- would put E within r
+    #  of B (0.410) and C (0.300), give C (1.125, 0.240), E (1.208, 0.734), B (1.417, 0.435),
+    #  and keep C.)
+    F = np.array([[3.0, 8.0], [7.0, 6.0], [9.0, 1.0], [5.0, 0.0], [8.0, 3.0]])
+    for seed in range(5):
+        out = BiGESurvival().do(_Dummy(), _pop(F), n_survive=3, random_state=np.random.default_rng(seed))
+        assert sorted(map(tuple, out.get("F"))) == [(3.0, 8.0), (5.0, 0.0), (8.0, 3.0)]
+
+
 def test_survival_fills_the_last_layer_at_random():
     # n_survive = 4: FRONT fits, SECOND is critical with one slot. Normalised over SECOND it is
     # (0, 1), (1, 0): equal proximity, distance sqrt 2 > r = 0.5 -> both f_cd = 0, one layer of 2
