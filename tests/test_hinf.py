@@ -15,6 +15,8 @@ References used here, none of which shares code with the LMI synthesis:
 
 from __future__ import annotations
 
+import importlib
+
 import control
 import numpy as np
 import pytest
@@ -185,6 +187,40 @@ def test_backoff_keeps_the_gain_finite():
     assert backed.gamma == pytest.approx(1.01 * backed.gamma_opt, rel=1e-12)
     assert np.linalg.norm(backed.K) < 1e-3 * np.linalg.norm(at_opt.K)
     assert cl_norm(plant, backed.K, EX7_B1, EX7_C1, EX7_D12) <= backed.gamma
+
+
+def test_discrete_gain_is_certified_at_the_backed_off_level_without_a_second_solve():
+    """One plant, discrete time: the optimum's gain is kept with a Riccati-built certificate.
+
+    Checked independently of the LMI code: the returned X satisfies the
+    bounded-real Riccati *inequality* of the transposed closed loop (the
+    Schur complement of the LMI, written out here), and linfnorm <= gamma.
+    """
+    plant, Bw, Cz, Dzu, Dzw = random_case(5, 6, 2, 2, discrete=True, cross=True)
+    ctrl = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw)
+    assert ctrl.info["gain_from"] == "optimum-certified"
+    assert len(ctrl.info["solves"]) == 1
+    A, C = plant.F + plant.G @ ctrl.K, Cz + Dzu @ ctrl.K
+    X, g2 = ctrl.info["X"], ctrl.gamma**2
+    W = g2 * np.eye(Cz.shape[0]) - C @ X @ C.T - Dzw @ Dzw.T
+    assert np.linalg.eigvalsh(X).min() > 0 and np.linalg.eigvalsh(W).min() > 0
+    N = A @ X @ C.T + Bw @ Dzw.T
+    ric = A @ X @ A.T - X + Bw @ Bw.T + N @ np.linalg.solve(W, N.T)
+    assert np.linalg.eigvalsh(0.5 * (ric + ric.T)).max() < 0
+    assert cl_norm(plant, ctrl.K, Bw, Cz, Dzu, Dzw) <= ctrl.gamma
+
+
+def test_preconditioning_is_a_similarity(monkeypatch):
+    """The LQR coordinates change the solver's path, not the level: same gamma_opt without them."""
+    hinf_module = importlib.import_module("robustctl.hinf")  # robustctl.hinf is also the function
+
+    plant, Bw, Cz, Dzu, _ = random_case(2, 6, 2, 3, discrete=True)
+    with_pre = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    monkeypatch.setattr(hinf_module._Problem, "precondition", lambda self: False)
+    without = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    ref = hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, rtol=1e-9)
+    assert with_pre.gamma_opt == pytest.approx(ref.gamma, rel=RTOL)
+    assert without.gamma_opt == pytest.approx(ref.gamma, rel=RTOL)
 
 
 # ------------------------------------------------------------ fixed gamma

@@ -27,6 +27,25 @@ def test_margin_and_certificate_are_reported():
     assert rep.iterations > 0 and rep.solve_time >= 0
 
 
+def test_fast_attempt_agrees_with_the_refined_solve():
+    """fast=True (no iterative refinement first) gives the same optimum as the default path."""
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(6, 6))
+    A *= 0.9 / np.max(np.abs(np.linalg.eigvals(A)))
+    values = []
+    for fast in (False, True):
+        X, t = cp.Variable((6, 6), symmetric=True), cp.Variable()
+        # smallest t with A X A' - X + I <= 0 and X <= t I: t = lambda_max of the Lyapunov solution
+        lmis = [_cvx.LMI("lyap", X - A @ X @ A.T - np.eye(6)), _cvx.LMI("upper", t * np.eye(6) - X)]
+        rep = _cvx.solve_sdp(cp.Minimize(t), lmis, tol=1e-9, fast=fast)
+        values.append(rep.value)
+    import scipy.linalg
+
+    exact = np.linalg.eigvalsh(scipy.linalg.solve_discrete_lyapunov(A, np.eye(6))).max()
+    assert values[0] == pytest.approx(exact, rel=1e-7)
+    assert values[1] == pytest.approx(exact, rel=1e-7)
+
+
 def test_infeasible_lmi_raises_with_the_callers_message():
     X = cp.Variable((2, 2), symmetric=True)
     with pytest.raises(InfeasibleError, match="no X for the test"):
