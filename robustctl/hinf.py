@@ -138,9 +138,14 @@ _RECENTRE_REG = 1e-3
 _POLISH_REG = 1e-6
 # Upper bound of X in the centring problem, relative to lambda_max of the optimal X.
 _X_UPPER = 10.0
-# Solver tolerance of the gamma minimisation (gamma_opt then agrees with the
-# Riccati bisection to ~1e-8 relative; the gain is certified separately).
+# Solver tolerance of the gamma minimisation: 1e-8 in the LQR coordinates of
+# one plant (gamma_opt then agrees with the Riccati bisection to ~1e-8
+# relative, and the first attempt skips iterative refinement); 1e-10
+# otherwise (several vertices, e.g. the truck polytope with an input bound,
+# are badly conditioned: a looser first solve there ends 1e-3 above the level
+# that the tighter one and its polish reach).
 _MIN_TOL = 1e-8
+_MIN_TOL_GENERAL = 1e-10
 # Solver tolerance of the centring problem (its optimum need not be exact).
 _CENTRE_TOL = 1e-7
 # u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that solver rounding cannot
@@ -558,8 +563,8 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         only): less conservative with ``vertices``, equal without.
     solver : str, default "CLARABEL"
         cvxpy SDP solver. Clarabel is run with explicit tolerances (1e-8 for
-        the level, 1e-7 for centring); other solvers use their defaults and
-        may not reach 1e-5 accuracy.
+        the level of one plant, 1e-10 with vertices, 1e-7 for centring);
+        other solvers use their defaults and may not reach 1e-5 accuracy.
 
     Returns
     -------
@@ -632,8 +637,9 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     def minimise():
         V = prob.variables()
         mu = cp.Variable(name="mu")
-        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0, b=b_min), solver=solver, tol=_MIN_TOL,
-                             infeasible_msg=f"no H-infinity state feedback: {what}", fast=True)
+        rep = _cvx.solve_sdp(cp.Minimize(mu), prob.lmis(V, mu, 0.0, b=b_min), solver=solver,
+                             tol=_MIN_TOL if preconditioned else _MIN_TOL_GENERAL,
+                             infeasible_msg=f"no H-infinity state feedback: {what}", fast=preconditioned)
         return V, mu, rep
 
     # 1. minimise mu = gamma^2 (scaled level a * gamma)
@@ -646,6 +652,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
                 if not preconditioned:
                     raise
                 prob._transform(T_bal)  # the LQR coordinates may not suit this problem
+                preconditioned = False
                 V, mu, rep = minimise()
         except ConvergenceError:
             if not extended:
