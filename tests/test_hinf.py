@@ -89,6 +89,25 @@ def test_riccati_reference_rejects_levels_below_the_optimum():
     assert cl_norm(plant, K, Bw, Cz, Dzu) < 1.01 * ref.gamma
 
 
+def test_riccati_reference_gain_meets_its_level_on_a_larger_plant():
+    """Just below the optimum scipy's DARE still returns a matrix (residual 1e-9..1e-7, not ~1e-14).
+
+    On this n = 20 plant (the benchmark's second one) a 1e-7 residual
+    tolerance let the bisection settle 8e-6 below the level its own gain
+    reaches; linfnorm (SLICOT) of that gain is the independent check.
+    """
+    rng = np.random.default_rng(1)
+    F = rng.normal(size=(20, 20))
+    F *= 1.05 / np.max(np.abs(np.linalg.eigvals(F)))
+    G, Bw = rng.normal(size=(20, 2)), rng.normal(size=(20, 2))
+    Cz = np.vstack([rng.normal(size=(2, 20)), np.zeros((2, 20))])
+    Dzu = np.vstack([np.zeros((2, 2)), np.eye(2)])
+    plant = Plant(F, G, 0.1)
+    ref = hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, rtol=1e-10)
+    assert cl_norm(plant, ref.K, Bw, Cz, Dzu) <= ref.gamma * (1 + 1e-7)
+    assert hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu).gamma_opt == pytest.approx(ref.gamma, rel=1e-6)
+
+
 def test_discrete_scalar_against_brute_force():
     """x+ = a x + w + b u, z = [x; rho u]: ||T|| = sqrt(1 + rho^2 k^2) / (1 - |a + b k|)."""
     a, b, rho = 1.2, 0.5, 0.3
