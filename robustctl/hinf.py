@@ -322,8 +322,9 @@ class _Problem:
         ``1e-9`` of their norm). In coordinates where ``P^-1 ~ I`` (then
         scaled so that ``||Bw|| = 1`` again) the optimum is usually well
         conditioned: fewer interior-point iterations, rarely
-        ``optimal_inaccurate``. A similarity: levels and input bounds are unchanged. Returns ``False``
-        (coordinates unchanged) if the Riccati solve fails.
+        ``optimal_inaccurate``. A similarity: levels and input bounds are
+        unchanged. Returns ``False`` (coordinates unchanged) if the Riccati
+        solve fails.
         """
         import scipy.linalg
 
