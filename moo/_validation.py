@@ -13,9 +13,9 @@ import numpy as np
 
 # Generic array checks (no control code) are shared with robustctl: this is the
 # one import of robustctl in moo outside moo/problems/.
-from robustctl._validation import as_matrix, check_positive_scalar
+from robustctl._validation import as_float_array, as_matrix, check_positive_scalar
 
-__all__ = ["as_matrix", "as_objectives", "check_choice", "check_directions", "check_int",
+__all__ = ["as_float_array", "as_matrix", "as_objectives", "check_choice", "check_directions", "check_int",
            "check_positive_scalar", "check_real"]
 
 
@@ -51,12 +51,7 @@ def check_real(value, name: str, *, positive: bool) -> float:
 
 def as_objectives(F, name: str = "F") -> np.ndarray:
     """``F`` as a finite, non-empty float64 array of shape ``(n_individuals, n_obj)``."""
-    if isinstance(F, (str, bytes)) or F is None:
-        raise TypeError(f"{name} must be a 2-D array of objective values, got {type(F).__name__}")
-    try:
-        arr = np.asarray(F, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name} must be a 2-D array of real numbers ({exc})") from None
+    arr = as_float_array(F, name)
     if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
         raise ValueError(f"{name} must be a non-empty 2-D array (n_individuals, n_obj), got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):

@@ -12,11 +12,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
+__all__ = ["as_float_array", "as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
            "check_performance"]
 
 
-def _to_float_array(value, name: str) -> np.ndarray:
+def as_float_array(value, name: str) -> np.ndarray:
+    """``value`` as a real float64 array (any shape); ``TypeError`` naming ``name`` otherwise."""
     if isinstance(value, (str, bytes)) or value is None:
         raise TypeError(f"{name} must be an array of numbers, got {type(value).__name__}")
     try:
@@ -43,7 +44,7 @@ def as_matrix(
     Scalars become 1x1 and 1-D arrays become a single row, except when
     ``cols == 1`` (a 1-D array is then read as a column).
     """
-    arr = _to_float_array(value, name)
+    arr = as_float_array(value, name)
     if arr.ndim == 0:
         arr = arr.reshape(1, 1)
     elif arr.ndim == 1:
@@ -65,7 +66,7 @@ def as_matrix(
 
 def as_batch(value, name: str, shape: Sequence[int | None], what: Sequence[str] = ()) -> np.ndarray:
     """Return ``value`` as a finite float64 array of ``shape`` (``None`` = any size)."""
-    arr = _to_float_array(value, name)
+    arr = as_float_array(value, name)
     if arr.ndim != len(shape):
         raise ValueError(f"{name} must be a {len(shape)}-D array of shape "
                          f"{tuple('B' if s is None else s for s in shape)}, got shape {arr.shape}")

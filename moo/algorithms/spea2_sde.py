@@ -73,7 +73,7 @@ from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 
-from .._validation import as_objectives
+from .._validation import as_float_array, as_objectives
 from ._base import BinaryTournament, paper_operators
 from .operators import POP_SIZE
 
@@ -222,12 +222,7 @@ def sde_truncation(dist, n_keep: int) -> np.ndarray:
     remaining entries. Total ``O(n^2 log n)`` for the sort plus ``O(r n)``
     for ``r`` removals in the tie-free case.
     """
-    if isinstance(dist, (str, bytes)) or dist is None:
-        raise TypeError(f"dist must be a square matrix of numbers, got {type(dist).__name__}")
-    try:
-        D = np.array(dist, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"dist must be a square matrix of real numbers ({exc})") from None
+    D = as_float_array(dist, "dist")
     if D.ndim != 2 or D.shape[0] != D.shape[1] or D.shape[0] < 1:
         raise ValueError(f"dist must be a square (n, n) matrix, got shape {D.shape}")
     n = D.shape[0]
