@@ -69,8 +69,10 @@ Numerics
   ~27 ending ``optimal_inaccurate``). If that solve fails the balanced
   coordinates are used.
 * ``gamma_opt`` comes from minimising ``mu`` (non-strict LMIs: the
-  infimum) at tolerance 1e-8, first without Clarabel's iterative
-  refinement (see :func:`robustctl._cvx.solve_sdp`). If the solver reports
+  infimum): in the LQR coordinates of one plant at tolerance 1e-8, first
+  without Clarabel's iterative refinement (see
+  :func:`robustctl._cvx.solve_sdp`); otherwise at 1e-10 with refinement
+  (the truck polytope is badly conditioned). If the solver reports
   ``optimal_inaccurate`` the problem is solved again in coordinates where
   the optimal ``X`` is ~ I (a similarity) and the lower certified level is
   kept.
