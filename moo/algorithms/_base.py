@@ -6,6 +6,8 @@
   :class:`~moo.algorithms._normalize.HyperplaneNormalization` it holds.
 - :class:`BinaryTournament`: binary tournament *with replacement*, decided by
   a comparison function.
+- :func:`check_ref_dirs_fit`: reference directions must match the problem's
+  number of objectives.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from .operators import paper_crossover, paper_mutation
 if TYPE_CHECKING:
     from ._normalize import HyperplaneNormalization
 
-__all__ = ["BinaryTournament", "NormalizationForwarding", "paper_operators"]
+__all__ = ["BinaryTournament", "NormalizationForwarding", "check_ref_dirs_fit", "paper_operators"]
 
 
 def paper_operators(sampling=None, crossover=None, mutation=None, output=None) -> dict:
