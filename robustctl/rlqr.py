@@ -91,6 +91,7 @@ _DEFAULT_MAX_ITER = 10_000
 _MU_MIN = 1e-100  # smallest accepted penalty (mu^-1 enters products with P)
 _DIVERGED = 1e250  # |P| beyond this: the recursion is diverging
 _STABILITY_MARGIN = 1e-9  # accepted closed loops have rho(L) < 1 - margin
+_EIG_BATCH = 8  # stability of at most this many matrices: eigenvalues directly, no squaring certificate
 
 
 # --------------------------------------------------------------------------- #
@@ -200,9 +201,14 @@ def _stein(A: np.ndarray, Qc: np.ndarray, steps: int = 60) -> np.ndarray:
     return _sym(X)
 
 
+def _fro(X: np.ndarray) -> np.ndarray:
+    """Batched Frobenius norm (``np.linalg.norm(X, axis=(1, 2))`` without its Python overhead)."""
+    return np.sqrt(np.add.reduce(X * X, axis=(1, 2)))
+
+
 def _relchange(P_new: np.ndarray, P: np.ndarray) -> np.ndarray:
-    num = np.linalg.norm(P_new - P, axis=(1, 2))
-    den = np.maximum(np.linalg.norm(P_new, axis=(1, 2)), np.finfo(float).tiny)
+    num = _fro(P_new - P)
+    den = np.maximum(_fro(P_new), np.finfo(float).tiny)
     return num / den
 
 
@@ -220,13 +226,18 @@ def _schur_stable(A: np.ndarray, bound: float = 1.0, squarings: int = 10) -> np.
 
     Certificate first: ``rho(M) <= ||M^k||_F``, so if ``||(A/bound)^(2^j)||_F < 1``
     for some ``j <= squarings`` the matrix is stable (a few stacked matmuls).
-    Only the undecided matrices get an eigenvalue computation.
+    Only the undecided matrices get an eigenvalue computation, and small
+    batches go there directly (the squarings cost more than the eigenvalues).
     """
+    if A.shape[0] <= _EIG_BATCH:
+        return _spectral_radius(A) < bound
     M = A / bound
     stable = np.zeros(A.shape[0], dtype=bool)
     with np.errstate(over="ignore", invalid="ignore"):
         for _ in range(squarings):
-            stable |= np.linalg.norm(M, axis=(1, 2)) < 1.0
+            stable |= _fro(M) < 1.0
+            if stable.all():
+                return stable
             M = M @ M
     undecided = ~stable
     if undecided.any():
@@ -236,8 +247,7 @@ def _schur_stable(A: np.ndarray, bound: float = 1.0, squarings: int = 10) -> np.
 
 def _healthy(P: np.ndarray) -> np.ndarray:
     """Designs whose ``P`` is finite and not diverging."""
-    with np.errstate(invalid="ignore"):
-        return np.abs(P).max(axis=(1, 2)) < _DIVERGED
+    return np.abs(P).max(axis=(1, 2)) < _DIVERGED
 
 
 def _sda(d: _Data, tol: float, max_steps: int = 64) -> tuple[np.ndarray, np.ndarray]:
@@ -273,21 +283,20 @@ def _sda(d: _Data, tol: float, max_steps: int = 64) -> tuple[np.ndarray, np.ndar
     active = _healthy(H) & _healthy(Gs)
     eye = np.eye(n)
     for _ in range(max_steps):
-        idx = np.flatnonzero(active)
-        if idx.size == 0:
+        if not active.any():
             break
+        idx = slice(None) if active.all() else np.flatnonzero(active)  # no copies while all run
         a, g, h = A[idx], Gs[idx], H[idx]
         sol = _solve(eye + g @ h, np.concatenate([a, g], axis=2))     # W^-1 [A, G]
         WA, WG = sol[..., :n], sol[..., n:]
         aT = np.swapaxes(a, 1, 2)
         h_new = _sym(h + aT @ h @ WA)
+        ok = _healthy(h_new)
+        change = np.where(ok, _relchange(h_new, h), np.inf)
         A[idx], Gs[idx], H[idx] = a @ WA, _sym(g + a @ WG @ aT), h_new
         steps[idx] += 1
-        change = np.full(idx.size, np.inf)
-        ok = _healthy(h_new)
-        change[ok] = _relchange(h_new[ok], h[ok])
-        converged[idx[change < tol]] = True
-        active[idx[(change < tol) | ~ok]] = False
+        converged[idx] |= change < tol
+        active[idx] &= (change >= tol) & ok
     return H, steps, converged
 
 
@@ -337,6 +346,44 @@ def _steady_state(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerat
     return P, K, L, iterations, residual, stable, settled
 
 
+def _newton(d: _Data, P: np.ndarray, tol: float, steps: int = 3):
+    """Newton (Kleinman-Hewer) refinement of approximate fixed points ``P ~ f(P)``.
+
+    ``f``'s derivative at ``P`` is ``X -> L' X L`` (``L`` the closed loop of
+    the step at ``P``), so a Newton step solves the Stein equation
+    ``X = L' X L + (f(P) - P)`` and moves to ``P + X``; it needs ``L`` stable
+    and converges quadratically to the stabilising fixed point. ``steps``
+    corrections are made (the error of the doubling result, about 1e-8 on
+    ill-conditioned designs, reaches the rounding floor of ``f`` in one or
+    two) and the evaluation with the smallest residual is kept. Returns
+    ``(P, K, L, residual, stable, evaluations)`` as :func:`_steady_state`
+    (``P = f(P_best)``).
+    """
+    B = P.shape[0]
+    best = (np.full_like(P, np.nan), np.full((B,) + d.G.shape[::-1], np.nan), np.full_like(P, np.nan),
+            np.full(B, np.inf), np.zeros(B, dtype=bool))
+    evaluations = np.zeros(B, dtype=int)
+    active = np.ones(B, dtype=bool)
+    P = P.copy()
+    for k in range(steps + 1):
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        P_old = P[idx]
+        P_new, K, L = _step(P_old, d_sub(d, active))
+        res = _relchange(P_new, P_old)
+        stable = _schur_stable(L, 1.0 - _STABILITY_MARGIN)
+        evaluations[idx] += 1
+        better = res < best[3][idx]
+        for arr, new in zip(best, (P_new, K, L, res, stable)):
+            arr[idx[better]] = new[better]
+        refine = stable & _healthy(P_new) & (k < steps)
+        X = _stein(L[refine], P_new[refine] - P_old[refine])
+        P[idx[refine]] = _sym(P_old[refine] + X)
+        active[idx[~refine]] = False
+    return (*best, evaluations)
+
+
 def d_sub(d: _Data, mask: np.ndarray) -> _Data:
     """The designs of ``d`` selected by ``mask``."""
     if mask.all():
@@ -344,17 +391,27 @@ def d_sub(d: _Data, mask: np.ndarray) -> _Data:
     return _Data(d.F, d.G, d.Q, d.R, d.EF[mask], d.EG[mask], d.S[mask], d.lam_inv[mask], d.soft)
 
 
-def _design_batch(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerate: bool):
+def _design_batch(d: _Data, P0: np.ndarray, tol: float, max_iter: int, accelerate: bool,
+                  fallback: str = "recursion"):
     """Steady state of every design with its verdict.
 
     Returns ``(P, K, L, iterations, residual, reason)``, ``reason`` in
     ``{"ok", "diverged", "not converged"}``. Designs on which doubling settled
     but missed the acceptance test (ill-conditioned ones, residual at the
-    rounding floor) are redone with the plain recursion, the reference path.
+    rounding floor) are refined by Newton's method (``fallback="newton"``,
+    :func:`_newton`) and, where that misses the test too or
+    ``fallback="recursion"``, redone with the plain recursion, the reference path.
     """
     with np.errstate(over="ignore", invalid="ignore"):
         P, K, L, it, res, stable, settled = _steady_state(d, P0, tol, max_iter, accelerate)
         retry = settled & _healthy(P) & ~((res < tol) & stable)
+        if accelerate and fallback == "newton" and retry.any():
+            sub = np.flatnonzero(retry)
+            out = _newton(d_sub(d, retry), P[sub], tol)
+            for arr, new in zip((P, K, L, res, stable), out[:5]):
+                arr[sub] = new
+            it[sub] += out[5]
+            retry = settled & _healthy(P) & ~((res < tol) & stable)
         if accelerate and retry.any():
             sub = np.flatnonzero(retry)
             it_sda = it[sub].copy()
@@ -535,6 +592,11 @@ def _check_mu(mu, name: str = "mu") -> np.ndarray:
     return arr
 
 
+def _check_fallback(fallback) -> None:
+    if not isinstance(fallback, str) or fallback not in ("recursion", "newton"):
+        raise ValueError(f"fallback must be 'recursion' or 'newton', got {fallback!r}")
+
+
 def _common(plant, Q, R, H, alpha, l):
     if not isinstance(plant, Plant):
         raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
@@ -563,7 +625,8 @@ def _rank_ok(EG: np.ndarray, mu: np.ndarray, H: np.ndarray) -> np.ndarray:
 
 
 def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DEFAULT_ALPHA,
-               tol: float = _DEFAULT_TOL, max_iter: int = _DEFAULT_MAX_ITER, P0=None) -> RLQRBatch:
+               tol: float = _DEFAULT_TOL, max_iter: int = _DEFAULT_MAX_ITER, P0=None,
+               fallback: str = "recursion") -> RLQRBatch:
     """Steady-state RLQR gains for ``B`` uncertainty models at once (vectorised).
 
     Parameters
@@ -585,6 +648,18 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
     P0 : (n, n) array_like, optional
         Starting point of the plain recursion where it is needed (default
         ``Q``; the steady state does not depend on it).
+    fallback : {"recursion", "newton"}
+        What happens to designs on which doubling settles but misses the
+        acceptance test (ill-conditioned ones, e.g. the doubled steering
+        column with nearly equal ``EG`` entries, ``P`` near 1e15):
+        ``"recursion"`` (default) redoes them with the plain recursion from
+        ``P0``, so ``max_iter`` also decides which slowly converging designs
+        are flagged ``"not converged"``; ``"newton"`` first refines the doubling
+        result by Newton's method (a few Stein equations; about 20 times
+        cheaper on such designs and closer to the fixed point) and uses the
+        recursion only where that misses the test too. The acceptance test is
+        the same; ``"newton"`` accepts designs whose recursion would need more
+        than ``max_iter`` steps.
 
     Returns
     -------
@@ -619,6 +694,7 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
         raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
     P0 = Q if P0 is None else check_spd(as_matrix(P0, "P0", rows=plant.n, cols=plant.n), "P0",
                                          semidefinite=True)
+    _check_fallback(fallback)
 
     rank_ok = _rank_ok(EG, mu, H)
     n, m = plant.n, plant.m
@@ -632,7 +708,7 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
         d = _make_data(plant.F, plant.G, Q, R, H, EF[rank_ok], EG[rank_ok], mu[rank_ok], alpha)
         idx = np.flatnonzero(rank_ok)
         P[idx], K[idx], L[idx], iterations[idx], residual[idx], reason[idx] = _design_batch(
-            d, P0, tol, int(max_iter), accelerate=True)
+            d, P0, tol, int(max_iter), accelerate=True, fallback=fallback)
     ok = reason == "ok"
     K[~ok], P[~ok], L[~ok] = np.nan, np.nan, np.nan
     stabilizing = np.zeros(B, dtype=bool)
@@ -643,7 +719,7 @@ def rlqr_gains(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float
 def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DEFAULT_ALPHA,
          horizon: int | None = None, P_N=None, tol: float = _DEFAULT_TOL,
          max_iter: int = _DEFAULT_MAX_ITER, accelerate: bool = True,
-         implementation: str = "kkt") -> Controller | RLQRSchedule:
+         implementation: str = "kkt", fallback: str = "recursion") -> Controller | RLQRSchedule:
     """Robust LQR for ``[dF dG] = H Delta [EF EG]``, ``||Delta|| <= 1`` (paper Theorem 1).
 
     Parameters
@@ -677,6 +753,9 @@ def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DE
     implementation : {"kkt", "block"}
         Step formula: the penalty/KKT form (default) or the paper's block
         system (reference; plain recursion, needs ``Q`` and ``P_N`` PD).
+    fallback : {"recursion", "newton"}
+        With ``accelerate``: how a design on which doubling misses the
+        acceptance test is redone (see :func:`rlqr_gains`).
 
     Returns
     -------
@@ -708,6 +787,7 @@ def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DE
         raise ValueError(f"implementation must be 'kkt' or 'block', got {implementation!r}")
     if implementation == "block":
         check_spd(Q, "Q")
+    _check_fallback(fallback)
     tol = check_positive_scalar(tol, "tol")
     if not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
         raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
@@ -747,7 +827,8 @@ def rlqr(plant: Plant, EF, EG, mu, *, Q=None, R=None, H=None, alpha: float = _DE
 
     with np.errstate(over="ignore", invalid="ignore"):
         if implementation == "kkt":
-            Ps, Ks, Ls, its, ress, reasons = _design_batch(d, P_N, tol, int(max_iter), accelerate)
+            Ps, Ks, Ls, its, ress, reasons = _design_batch(d, P_N, tol, int(max_iter), accelerate,
+                                                              fallback)
             P, K, L, it, res, verdict = Ps[0], Ks[0], Ls[0], int(its[0]), float(ress[0]), reasons[0]
         else:
             P, it, res = P_N, 0, np.inf

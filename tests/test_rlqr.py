@@ -295,3 +295,70 @@ def test_rlqr_rejects_continuous_and_non_plants():
         rc.rlqr(rc.Plant(np.eye(2), np.ones((2, 1)), None), [[1.0, 0.0]], [[1.0]], 1.0)
     with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
         rc.rlqr_gains(np.eye(2), [[1.0, 0.0]], [[1.0]], 1.0)
+
+
+# ---------------------------------------------------------------------------- ill-conditioned designs
+def _ill_conditioned_truck_designs(count, seed=2026):
+    """The doubled-column truck with the applied MOP's weights; EG2 / EG1 = 1 +- 0.002 (nearly dependent
+    split of the steering column: P reaches 1e15 and doubling misses the acceptance test on ~1/4)."""
+    from robustctl.models.truck import lqr_weights, truck_plant
+
+    rng = np.random.default_rng(seed)
+    z = rng.uniform(0, 500, (count, 7))
+    z[:, 5] = z[:, 4] * (1 + rng.uniform(-0.002, 0.002, count))
+    Q, R = lqr_weights(doubled=True)
+    return truck_plant(0.0, doubled=True), z[:, None, :4], z[:, None, 4:6], 10 ** np.sqrt(z[:, 6]), Q, R
+
+
+def test_newton_fallback_on_ill_conditioned_designs_matches_the_recursion():
+    plant, EF, EG, mu, Q, R = _ill_conditioned_truck_designs(60)
+    kw = dict(Q=Q, R=R, max_iter=2000)
+    rec = rc.rlqr_gains(plant, EF, EG, mu, **kw)
+    new = rc.rlqr_gains(plant, EF, EG, mu, fallback="newton", **kw)
+    refined = rec.iterations > 30                      # the designs the recursion had to redo
+    assert refined.sum() >= 5
+    # doubling-accepted designs are untouched
+    np.testing.assert_array_equal(new.K[~refined], rec.K[~refined])
+    assert (new.iterations[refined] <= 30).all()     # a few Newton steps instead of hundreds of recursion steps
+    # same acceptance rule: residual of one more recursion step below tol, rho(L) < 1
+    assert new.ok[rec.ok].all() and (new.residual[new.ok] < 1e-10).all()
+    assert (np.abs(np.linalg.eigvals(new.L[new.ok])).max(axis=1) < 1).all()
+    # reference: the plain recursion run to 3e-12 (on a few designs that is below its rounding floor)
+    compared = 0
+    for i in np.flatnonzero(refined):
+        try:
+            ref = rc.rlqr(plant, EF[i], EG[i], mu[i], Q=Q, R=R, accelerate=False, tol=3e-12, max_iter=20_000)
+        except rc.ConvergenceError:
+            continue
+        compared += 1
+        assert _rel(new.P[i], ref.info["P"]) < 1e-9, i  # the recursion stopped at tol 1e-10 is only ~1e-8 close
+        assert _rel(new.K[i], ref.K) < 1e-6, i          # K = f(P) amplifies P's rounding by ~1e4 here
+        if rec.ok[i]:
+            assert _rel(rec.P[i], ref.info["P"]) < 1e-7, i
+    assert compared >= 0.75 * refined.sum()
+
+
+def test_newton_fallback_accepts_a_slow_design_the_capped_recursion_flags(generic_plant):
+    """mu ~ 7e10 on the generic plant: rho(L) = 0.9986, the recursion needs ~10^4 steps."""
+    z = np.array([47.8069, 103.7683, 181.5866, 53.6425, 117.4085])
+    args = (generic_plant, z[None, None, :3], z[None, None, 3:4], 10 ** np.sqrt(z[4:]))
+    assert list(rc.rlqr_gains(*args, max_iter=50).reason) == ["not converged"]
+    new = rc.rlqr_gains(*args, max_iter=50, fallback="newton")
+    ref = rc.rlqr(generic_plant, z[None, :3], z[None, 3:4], 10 ** np.sqrt(z[4]), accelerate=False,
+                  max_iter=50_000, tol=1e-13)
+    assert new.ok[0] and new.iterations[0] < 50
+    assert _rel(new.P[0], ref.info["P"]) < 1e-9 and _rel(new.K[0], ref.K) < 1e-9
+
+
+def test_newton_fallback_keeps_failures_flagged():
+    plant = rc.Plant(GENERIC_F, GENERIC_G, 0.1)
+    EF = np.array([[[0.1, 0.2, 0.2]], [[1.0, 1.0, 1.0]], [[0.1, 0.2, 0.3]]])
+    EG = np.array([[[0.1]], [[0.0]], [[-2.0]]])
+    mu = np.array([1e6, np.inf, np.inf])
+    for p, ef, eg, m in ((plant, EF, EG, mu),
+                         (rc.Plant(np.diag([1.5, 0.5, 0.2]), [[1.0], [0.0], [0.0]], 0.1), [[0.0, 1.0, 0.0]],
+                          [[1.0]], np.inf)):
+        rec, new = rc.rlqr_gains(p, ef, eg, m), rc.rlqr_gains(p, ef, eg, m, fallback="newton")
+        assert list(new.reason) == list(rec.reason)
+    with pytest.raises(ValueError, match="fallback must be 'recursion' or 'newton'"):
+        rc.rlqr_gains(plant, EF, EG, mu, fallback="fast")
