@@ -10,17 +10,19 @@ Sign convention everywhere: ``u = K x``.
 
 from .controller import Controller
 from .design import design
-from .errors import ConvergenceError, InfeasibleError, RankConditionError, RobustCtlError
+from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, RankConditionError, RobustCtlError
 from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .lqr import lqr
 from .plant import Plant
-from .rlqr import RLQRBatch, rlqr, rlqr_gains
+from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
+from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
 
 
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
-    "hinf", "HinfController",
-    "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError",
+    "rlqr_schedule", "RLQRSchedule", "hinf", "HinfController",
+    "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
+    "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
 ]
 __version__ = "0.1.0"

@@ -19,6 +19,7 @@ from ._validation import as_matrix, check_spd
 from .controller import Controller
 from .errors import ConvergenceError
 from .plant import Plant
+from .stability import check_stabilizable
 
 __all__ = ["lqr", "dare"]
 
@@ -41,7 +42,7 @@ def _residual(F, G, Q, R, P) -> float:
 
 
 def dare(F, G, Q, R) -> tuple[np.ndarray, str]:
-    """Stabilising solution of the DARE: slycot (via python-control) first, scipy as fallback.
+    """Stabilising solution of the DARE: slycot (via python-control) if installed, scipy otherwise or as fallback.
 
     Returns ``(P, backend)``; raises :class:`ConvergenceError` if neither
     backend gives a solution with relative residual below 1e-8.
@@ -81,13 +82,23 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     -------
     Controller
         ``info`` holds ``P`` (Riccati solution), ``residual`` (relative
-        Riccati residual) and ``backend`` (``"slycot"`` or ``"scipy"``).
+        Riccati residual) and ``backend`` (``"slycot"`` if the optional
+        ``robustctl[slycot]`` extra is installed and succeeds, else ``"scipy"``).
+
+    Raises
+    ------
+    NotStabilizableError
+        ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`),
+        as ``rlqr`` and ``hinf`` do.
+    ConvergenceError
+        No backend solves the Riccati equation (e.g. ``(F, Q)`` not detectable).
     """
     if not isinstance(plant, Plant):
         raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
     if not plant.is_discrete:
         raise ValueError("plant must be discrete-time (dt > 0) for lqr; discretise it first")
     Q, R = _weights(plant, Q, R)
+    check_stabilizable(plant)
     P, backend = dare(plant.F, plant.G, Q, R)
     G = plant.G
     K = -np.linalg.solve(R + G.T @ P @ G, G.T @ P @ plant.F)

@@ -164,18 +164,28 @@ def test_generic_model_printed_z_star_is_stabilising(generic_plant):
 def test_finite_horizon_schedule():
     rng = np.random.default_rng(11)
     plant, Q, R, EF, EG, H, steady = _stable_case(rng, 100.0)
-    sch = rc.rlqr(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=400)
+    sch = rc.rlqr_schedule(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=400)
     assert sch.K.shape == (400, plant.m, plant.n) and sch.P.shape == (401, plant.n, plant.n)
     np.testing.assert_allclose(sch.P[-1], Q)
     assert _rel(sch.K[0], steady.K) < 1e-8  # long horizon: K_0 -> steady state
-    blk = rc.rlqr(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5, implementation="block")
-    short = rc.rlqr(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5)
+    blk = rc.rlqr_schedule(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5, implementation="block")
+    short = rc.rlqr_schedule(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5)
     assert _rel(short.K, blk.K) < 1e-10 and _rel(short.L, blk.L) < 1e-10
     c3 = short.controller(3)
     np.testing.assert_array_equal(c3.K, short.K[3])
     # step 4 (the last) from P_N by hand with the block system
     L4, K4, P4 = rlqr_step_block(Q, plant.F, plant.G, EF, EG, Q, R, H, 100.0)
     assert _rel(short.K[4], K4) < 1e-10 and _rel(short.P[4], P4) < 1e-10
+
+
+def test_rlqr_with_horizon_is_deprecated_and_returns_the_schedule(generic_plant):
+    args = (generic_plant, [[0.1, 0.2, 0.2]], [[0.1]], 1e3)
+    with pytest.warns(DeprecationWarning, match="rlqr_schedule"):
+        old = rc.rlqr(*args, horizon=7)
+    new = rc.rlqr_schedule(*args, horizon=7)
+    assert isinstance(old, rc.RLQRSchedule)
+    np.testing.assert_array_equal(old.K, new.K)
+    np.testing.assert_array_equal(old.P, new.P)
 
 
 def test_errors_single_design(generic_plant):
@@ -276,7 +286,7 @@ def test_batch_broadcasting_and_shapes():
         ({"H": np.ones((2, 1))}, ValueError, "H must have 3 rows"),
         ({"Q": np.ones((3, 3)) - 2 * np.eye(3)}, ValueError, "Q must be positive semidefinite"),
         ({"R": [[-1.0]]}, ValueError, "R must be positive definite"),
-        ({"horizon": 0}, ValueError, "horizon must be a positive integer"),
+        ({"horizon": 0}, ValueError, "horizon must be a positive integer"),  # the deprecated form
         ({"tol": 0.0}, ValueError, "tol must be > 0"),
         ({"max_iter": 0}, ValueError, "max_iter must be a positive integer"),
         ({"implementation": "fast"}, ValueError, "implementation must be"),
@@ -360,5 +370,5 @@ def test_newton_fallback_keeps_failures_flagged():
                           [[1.0]], np.inf)):
         rec, new = rc.rlqr_gains(p, ef, eg, m), rc.rlqr_gains(p, ef, eg, m, fallback="newton")
         assert list(new.reason) == list(rec.reason)
-    with pytest.raises(ValueError, match="fallback must be 'recursion' or 'newton'"):
+    with pytest.raises(ValueError, match="fallback must be one of 'recursion', 'newton'"):
         rc.rlqr_gains(plant, EF, EG, mu, fallback="fast")
