@@ -372,3 +372,58 @@ def test_newton_fallback_keeps_failures_flagged():
         assert list(new.reason) == list(rec.reason)
     with pytest.raises(ValueError, match="fallback must be one of 'recursion', 'newton'"):
         rc.rlqr_gains(plant, EF, EG, mu, fallback="fast")
+
+
+# ---------------------------------------------------------------------------- uncertainty object, stabilisability
+def test_uncertainty_object_equals_the_explicit_matrices(generic_plant):
+    H, EF, EG = np.array([[1.0], [0.5], [0.2]]), np.array([[0.1, 0.2, 0.2]]), np.array([[0.1]])
+    unc = rc.NormBounded(H, EF, EG)
+    explicit = rc.rlqr(generic_plant, EF, EG, 1e4, H=H)
+    for c in (rc.rlqr(generic_plant, mu=1e4, uncertainty=unc), rc.design("rlqr", generic_plant, mu=1e4, uncertainty=unc)):
+        np.testing.assert_array_equal(c.K, explicit.K)
+    b = rc.rlqr_gains(generic_plant, mu=[1e2, 1e4], uncertainty=unc)
+    np.testing.assert_array_equal(b.K[1], explicit.K)
+    sch = rc.rlqr_schedule(generic_plant, mu=1e4, uncertainty=unc, horizon=3)
+    np.testing.assert_array_equal(sch.K, rc.rlqr_schedule(generic_plant, EF, EG, 1e4, H=H, horizon=3).K)
+    with pytest.raises(TypeError, match="either uncertainty=NormBounded"):
+        rc.rlqr(generic_plant, EF, EG, 1e4, uncertainty=unc)
+    with pytest.raises(TypeError, match="uncertainty must be a robustctl.NormBounded"):
+        rc.rlqr(generic_plant, mu=1e4, uncertainty=(H, EF, EG))
+    with pytest.raises(ValueError, match="uncertainty is for n=3"):
+        rc.rlqr(rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1), mu=1e4, uncertainty=unc)
+    with pytest.raises(TypeError, match="mu is required"):
+        rc.rlqr(generic_plant, uncertainty=unc)
+    with pytest.raises(TypeError, match="give EF and EG"):
+        rc.rlqr(generic_plant, mu=1.0)
+
+
+def _with_uncontrollable_mode(rng, n_c, mode):
+    """F = T blkdiag(A_c, mode) T^-1, G = T [B_c; 0]: ``mode`` is uncontrollable by construction."""
+    n = n_c + 1
+    A_c = 0.5 * rng.standard_normal((n_c, n_c))
+    F = np.zeros((n, n))
+    F[:n_c, :n_c], F[n_c, n_c] = A_c, mode
+    F[:n_c, n_c] = rng.standard_normal(n_c)        # coupling from the uncontrollable part
+    G = np.vstack([rng.standard_normal((n_c, 1)), [[0.0]]])
+    T = rng.standard_normal((n, n)) + n * np.eye(n)
+    return rc.Plant(T @ F @ np.linalg.inv(T), T @ G, 0.1)
+
+
+@pytest.mark.parametrize("mode,stabilisable", [(1.3, False), (-1.0, False), (1.0, False), (0.99, True), (0.2, True)])
+def test_every_design_raises_the_same_error_on_an_unstabilisable_plant(mode, stabilisable):
+    plant = _with_uncontrollable_mode(np.random.default_rng(4), 2, mode)
+    assert plant.is_stabilizable == stabilisable
+    EF, EG = [[0.1, 0.2, 0.1]], [[0.5]]
+    if stabilisable:
+        assert plant.unstabilizable_modes.size == 0
+        assert rc.lqr(plant).is_stabilizing() and rc.rlqr(plant, EF, EG, 1e6).info["residual"] < 1e-10
+        return
+    np.testing.assert_allclose(plant.unstabilizable_modes, [mode], atol=1e-9)
+    for design in (lambda: rc.lqr(plant), lambda: rc.rlqr(plant, EF, EG, 1e6), lambda: rc.rlqr(plant, EF, EG, 10.0)):
+        with pytest.raises(rc.NotStabilizableError, match=rf"plant is not stabilisable: its mode lambda = {mode:g}"):
+            design()
+    # the same class serves handlers written for lqr (ConvergenceError) and hinf (InfeasibleError)
+    assert issubclass(rc.NotStabilizableError, rc.ConvergenceError)
+    assert issubclass(rc.NotStabilizableError, rc.InfeasibleError)
+    b = rc.rlqr_gains(plant, np.array(EF)[None].repeat(3, 0), EG, [1.0, 1e6, np.inf])
+    assert list(b.reason) == ["unstabilizable"] * 3 and np.isnan(b.K).all() and not b.stabilizing.any()

@@ -108,7 +108,7 @@ def _check_mu(mu, batch: bool) -> np.ndarray:
     return np.atleast_1d(arr)
 
 
-def _uncertainty(EF, EG, H, uncertainty):
+def _uncertainty(plant, EF, EG, H, uncertainty):
     """``(EF, EG, H)`` from the explicit matrices or from ``uncertainty``, never both."""
     if uncertainty is None:
         if EF is None or EG is None:
@@ -118,6 +118,7 @@ def _uncertainty(EF, EG, H, uncertainty):
         raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
     if EF is not None or EG is not None or H is not None:
         raise TypeError("give either uncertainty=NormBounded(...) or EF, EG (and H), not both")
+    uncertainty.check_plant(plant)
     return uncertainty.EF, uncertainty.EG, uncertainty.H
 
 
@@ -142,7 +143,7 @@ def build(plant, EF, EG, mu, *, Q, R, H, alpha, uncertainty=None, batch: bool) -
     if not plant.is_discrete:
         raise ValueError("plant must be discrete-time (dt > 0) for the RLQR; discretise it first")
     n, m = plant.n, plant.m
-    EF, EG, H = _uncertainty(EF, EG, H, uncertainty)
+    EF, EG, H = _uncertainty(plant, EF, EG, H, uncertainty)
     EF = _as_designs(EF, "EF", (None, n), ("", "the number of states"), batch)
     l = EF.shape[1]
     EG = _as_designs(EG, "EG", (l, m), ("the rows of EF", "the number of inputs"), batch)
