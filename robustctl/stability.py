@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_float_array
+from ._validation import as_float_array, as_matrix, check_square
 from .errors import NotStabilizableError
 
 __all__ = ["STABILITY_MARGIN", "spectral_radius", "is_schur_stable", "is_stable", "unstabilizable_modes",
@@ -106,10 +106,9 @@ def is_stable(A, *, discrete: bool, margin: float = STABILITY_MARGIN) -> bool:
 
 def unstabilizable_modes(F, G, *, discrete: bool = True) -> np.ndarray:
     """Eigenvalues of ``F`` that are not stable and that ``G`` cannot move (PBH test, module docstring)."""
-    F, G = _stack(F, "F"), as_float_array(G, "G")
+    F = check_square(as_matrix(F, "F"), "F")
     n = F.shape[0]
-    if F.ndim != 2 or G.ndim != 2 or G.shape[0] != n:
-        raise ValueError(f"F (n, n) and G (n, m) must be matrices with as many rows, got shapes {F.shape}, {G.shape}")
+    G = as_matrix(G, "G", rows=n, vector="column", rows_what="the number of states, from F")
     scale = max(1.0, float(np.linalg.norm(np.hstack([F, G]), 2)))
     modes = np.linalg.eigvals(F)
     unstable = np.abs(modes) >= 1.0 - UNSTABLE_TOL if discrete else modes.real >= -UNSTABLE_TOL

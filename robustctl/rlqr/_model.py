@@ -111,8 +111,9 @@ def _check_mu(mu, batch: bool) -> np.ndarray:
 def _uncertainty(plant, EF, EG, H, uncertainty):
     """``(EF, EG, H)`` from the explicit matrices or from ``uncertainty``, never both."""
     if uncertainty is None:
-        if EF is None or EG is None:
-            raise TypeError("give EF and EG (or uncertainty=NormBounded(H, EF, EG))")
+        for name, value in (("EF", EF), ("EG", EG)):
+            if value is None:
+                raise TypeError(f"{name} is required: give EF and EG (or uncertainty=NormBounded(H, EF, EG))")
         return EF, EG, H
     if not isinstance(uncertainty, NormBounded):
         raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")

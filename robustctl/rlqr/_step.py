@@ -7,6 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._validation import as_matrix, check_spd
 from ..plant import Plant
 from ._model import DEFAULT_ALPHA, Model, _norm2, build
 
@@ -113,6 +114,16 @@ def block_steps(P: np.ndarray, d: Model) -> Step:
     return out
 
 
+def _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite: bool):
+    """The arguments of the single-step functions, validated like :func:`robustctl.rlqr`'s."""
+    d = build(Plant(F, G, 1.0), EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, batch=False)
+    n = d.F.shape[0]
+    P_next = check_spd(as_matrix(P_next, "P_next", rows=n, cols=n), "P_next", semidefinite=not definite)
+    if definite:
+        check_spd(d.Q, "Q")
+    return P_next, d
+
+
 def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_ALPHA):
     """One RLQR step by the paper's block system (Theorem 1, PAPER_NOTES reading).
 
@@ -132,12 +143,10 @@ def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEF
     ``lambda -> 0`` limit). Needs ``P_next`` and ``Q`` positive definite.
 
     Returns ``(L, K, P)``. Dense ``(4n + 2m + l)``-square solve: for tests and
-    small problems, not for batches. The arguments are not validated (see
-    :func:`robustctl.rlqr`).
+    small problems, not for batches. Arguments are validated like :func:`robustctl.rlqr`'s.
     """
-    F, G, Q, R = (np.asarray(a, float) for a in (F, G, Q, R))
-    EF, EG, H = np.atleast_2d(EF).astype(float), np.atleast_2d(EG).astype(float), np.asarray(H, float)
-    P, K, L = block_step(np.asarray(P_next, float), F, G, EF, EG, Q, R, H, float(mu), alpha)
+    P_next, d = _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite=True)
+    P, K, L = block_step(P_next, d.F, d.G, d.EF[0], d.EG[0], d.Q, d.R, d.H, float(d.mu[0]), d.alpha)
     return L, K, P
 
 
@@ -145,9 +154,8 @@ def rlqr_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_A
     """One RLQR step by the penalty/KKT form (package docstring). Returns ``(L, K, P)``.
 
     Same arguments as :func:`rlqr_step_block`; ``P_next`` and ``Q`` may be
-    only positive semidefinite. The arguments are validated like :func:`robustctl.rlqr`'s.
+    only positive semidefinite.
     """
-    plant = Plant(F, G, 1.0)
-    d = build(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, batch=False)
-    P, K, L = kkt_step(np.asarray(P_next, float)[None], d)
+    P_next, d = _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite=False)
+    P, K, L = kkt_step(P_next[None], d)
     return L[0], K[0], P[0]
