@@ -107,7 +107,7 @@ def test_progress_bar_on_a_terminal(tmp_path, monkeypatch, capsys):
     (["--problem", "zdt1", "--algorithm", "nsga2", "--pop-size", "2"], "--pop-size must be >= 4"),
     (["--problem", "zdt1", "--algorithm", "nsga2", "--seed", "-1"], "--seed must be >= 0"),
     (["--problem", "zdt1", "--n-obj", "3", "--algorithm", "nsga2"], "has 2 objectives"),
-    (["--problem", "dtlz2", "--n-obj", "1", "--algorithm", "nsga2"], "n_obj must be between 2"),
+    (["--problem", "dtlz2", "--n-obj", "1", "--algorithm", "nsga2"], "--n-obj must be between 2"),
     (["--problem", "zdt1", "--algorithm", "nsga2", "--max-leaders", "3"], "--max-leaders needs --molsp"),
     (["--problem", "zdt1", "--algorithm", "nsga2", "--evals", "many"], "invalid int value"),
     (["--problem", "zdt1"], "required"),

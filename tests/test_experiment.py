@@ -82,10 +82,11 @@ def test_write_json_atomic_failure_keeps_old_file(tmp_path):
 # ----------------------------------------------------------------------------- resumption
 
 class _FakeResult:
-    def __init__(self, problem, algorithm, seed, evals, n_obj, molsp, max_leaders):
+    def __init__(self, problem, algorithm, seed, evals, n_obj, molsp, max_leaders, pop_size):
         self.wall_time = 0.0
         self._d = {"problem": problem, "n_obj": 2 if n_obj is None else n_obj, "algorithm": algorithm,
                    "molsp": molsp, "max_leaders": max_leaders, "seed": seed, "budget": evals,
+                   "pop_size": pop_size,
                    "F": [[float(seed % 7), 1.0]], "hv_ref_point": [10.0, 10.0]}
 
     def to_dict(self):
@@ -102,7 +103,7 @@ def fake_run(monkeypatch):
         if state["fail_after"] is not None and len(calls) >= state["fail_after"]:
             raise KeyboardInterrupt
         calls.append((algorithm, molsp, seed))
-        return _FakeResult(problem, algorithm, seed, evals, n_obj, molsp, max_leaders)
+        return _FakeResult(problem, algorithm, seed, evals, n_obj, molsp, max_leaders, pop_size)
 
     monkeypatch.setattr(moo.runner, "run", run)
     return calls, state
@@ -203,8 +204,8 @@ def test_cli_experiment_and_stats_end_to_end(tmp_path):
     (["experiment", "--problem", "zdt1", "--runs", "0", "--evals", "300"], "--runs must be >= 1"),
     (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "50"], "population size"),
     (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--workers", "0"], "--workers"),
-    (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--molsp-max-leaders", "0"],
-     "--molsp-max-leaders"),
+    (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--max-leaders", "0"],
+     "--max-leaders must be >= 1"),
     (["experiment", "--problem", "zdt1", "--runs", "x", "--evals", "300"], "invalid int value"),
     (["experiment", "--problem", "zdt1", "--evals", "300"], "required: --runs"),
 ])
