@@ -143,7 +143,8 @@ def _parser() -> argparse.ArgumentParser:
 
 _FLAGS = {"seed": "--seed", "base_seed": "--seed", "evals": "--evals", "pop_size": "--pop-size",
           "max_leaders": "--max-leaders", "n_obj": "--n-obj", "runs": "--runs", "workers": "--workers",
-          "scheduler": "--scheduler", "executor": "--executor", "alpha": "--alpha", "algorithms": "--algorithms"}
+          "scheduler": "--scheduler", "executor": "--executor", "alpha": "--alpha", "algorithms": "--algorithms",
+          "out": "--out"}
 
 
 def _flagged(message: str) -> str:
