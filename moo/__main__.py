@@ -49,7 +49,7 @@ import re
 import sys
 import traceback
 from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
@@ -235,7 +235,7 @@ def _cmd_experiment(args) -> int:
         print(f"{grid.skipped} of {len(grid.specs)} runs already done in {grid.out} (skipped); "
               f"{len(grid.todo)} to run{retry}", file=sys.stderr)
     try:
-        with executor as ex:
+        with executor if grid.todo else nullcontext() as ex:    # nothing to run: no cluster to start
             report = grid.run(ex, keep_going=args.keep_going)
     except RunFailedError as exc:
         return _error(f"{exc}; the records written stay, rerun to resume", 1)

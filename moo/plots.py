@@ -40,13 +40,13 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from moo.experiment import problem_dir
-from moo.stats import INDICATORS, FriedmanResult, RunIndicators, friedman, run_indicators, true_front
+from moo.stats import (INDICATORS, LABELS, FriedmanResult, RunIndicators, friedman, registry_order,
+                       run_indicators, true_front)
 
 __all__ = ["FORMATS", "check_formats", "hv_history", "indicator_boxplots", "fronts", "cd_diagram", "plot_results"]
 
 #: File formats :func:`plot_results` writes.
 FORMATS: tuple[str, ...] = ("png", "pdf", "svg")
-_LABELS = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
 _COLOURS = {False: "tab:blue", True: "tab:orange"}
 _NAMES = {False: "plain", True: "MO-LSP"}
 _GRID_POINTS = 200
@@ -67,10 +67,7 @@ def _key(rec: dict) -> str:
 
 
 def _algorithms(names) -> list[str]:
-    from moo.algorithms import ALGORITHMS
-
-    order = {name: i for i, name in enumerate(ALGORITHMS)}
-    return sorted(set(names), key=lambda a: (order.get(a, len(order)), a))
+    return sorted(set(names), key=registry_order)
 
 
 def _panels(n: int, width: float = 3.2, height: float = 2.6, max_cols: int = 5):
@@ -146,7 +143,7 @@ def indicator_boxplots(runs: Sequence[RunIndicators], title: str = "") -> Figure
             if ax is axes[0]:
                 ax.plot([], [], "s", color=_COLOURS[molsp], alpha=0.6, label=_NAMES[molsp])
         ax.set_xticks(range(len(algs)), algs, fontsize=8, rotation=20)
-        ax.set_ylabel(_LABELS[name])
+        ax.set_ylabel(LABELS[name])
         ax.tick_params(axis="y", labelsize=7)
         ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside upper right", ncols=2, fontsize=8)
@@ -287,7 +284,7 @@ def cd_diagram(result: FriedmanResult) -> Figure:
         y = -0.15 - 0.12 * n
         ax.plot([r[i] - 0.03, r[j] + 0.03], [y, y], color="k", lw=3, solid_capstyle="round")
     verdict = "rejects" if result.rejects else "does not reject"
-    fig.suptitle(f"{result.problem}, {_LABELS.get(result.indicator, result.indicator)}: mean ranks over "
+    fig.suptitle(f"{result.problem}, {LABELS.get(result.indicator, result.indicator)}: mean ranks over "
                  f"{result.n_blocks} runs; Friedman p = {result.p_value:.3g} ({verdict} at {result.alpha:g}); "
                  f"bars: within CD (Nemenyi)", fontsize=9)
     return fig

@@ -88,10 +88,12 @@ from numpy.typing import ArrayLike
 from scipy import stats as sps
 
 from moo import indicators as ind
+from moo.algorithms import ALGORITHMS
+from moo.experiment import problem_dir
 
-__all__ = ["INDICATORS", "HIGHER_IS_BETTER", "RunIndicators", "Comparison", "FriedmanResult", "true_front",
+__all__ = ["INDICATORS", "HIGHER_IS_BETTER", "LABELS", "RunIndicators", "Comparison", "FriedmanResult", "true_front",
            "reference_sets", "run_indicators", "pairwise_test", "rank_sum_test", "holm", "friedman_test",
-           "nemenyi_cd", "compare", "friedman", "to_csv", "to_markdown", "to_latex", "ranks_to_csv",
+           "nemenyi_cd", "registry_order", "compare", "friedman", "to_csv", "to_markdown", "to_latex", "ranks_to_csv",
            "ranks_to_markdown", "ranks_to_latex", "analyse"]
 
 #: Indicator names in the paper's column order. (A new indicator, e.g. IGD+ once
@@ -100,7 +102,9 @@ __all__ = ["INDICATORS", "HIGHER_IS_BETTER", "RunIndicators", "Comparison", "Fri
 INDICATORS: tuple[str, ...] = ("igd", "sp", "hv", "pd", "spread")
 #: Direction of each indicator (True: larger is better).
 HIGHER_IS_BETTER: dict[str, bool] = {"igd": False, "sp": False, "hv": True, "pd": True, "spread": False}
-_LABELS = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
+#: Column labels of the indicators.
+LABELS: dict[str, str] = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
+_LABELS = LABELS
 
 _TRUE_FRONT_POINTS = 5000
 
@@ -432,12 +436,9 @@ def compare(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Comparis
     groups: dict[tuple[str, str], dict[bool, list[RunIndicators]]] = {}
     for r in runs:
         groups.setdefault((_pkey(r), r.algorithm), {False: [], True: []})[r.molsp].append(r)
-    from moo.algorithms import ALGORITHMS
-
-    order = {name: i for i, name in enumerate(ALGORITHMS)}
     rows = []
-    for (problem, algorithm), by_variant in sorted(
-            groups.items(), key=lambda kv: (kv[0][0], order.get(kv[0][1], len(order)), kv[0][1])):
+    for (problem, algorithm), by_variant in sorted(groups.items(),
+                                                   key=lambda kv: (kv[0][0], *registry_order(kv[0][1]))):
         for name in INDICATORS:
             a = _sample([getattr(r, name) for r in by_variant[False]], "plain")
             b = _sample([getattr(r, name) for r in by_variant[True]], "molsp")
@@ -473,16 +474,13 @@ def friedman(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Friedma
     """
     if not 0 < alpha < 1:
         raise ValueError(f"alpha must be in (0, 1), got {alpha!r}")
-    from moo.algorithms import ALGORITHMS
-
-    order = {name: i for i, name in enumerate(ALGORITHMS)}
     by_problem: dict[str, dict[str, dict[int, RunIndicators]]] = defaultdict(lambda: defaultdict(dict))
     for r in runs:
         by_problem[_pkey(r)][_variant(r.algorithm, r.molsp)][r.seed] = r
     out = []
     for problem in sorted(by_problem):
         cells = by_problem[problem]
-        algs = sorted({v.removesuffix("+molsp") for v in cells}, key=lambda a: (order.get(a, len(order)), a))
+        algs = sorted({v.removesuffix("+molsp") for v in cells}, key=registry_order)
         variants = tuple(v for a in algs for v in (_variant(a, True), a) if v in cells)
         for name in INDICATORS:
             seeds = sorted(set.intersection(*(set(cells[v]) for v in variants)))
@@ -500,7 +498,13 @@ def friedman(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Friedma
 
 
 def _pkey(r: RunIndicators) -> str:
-    return f"{r.problem}-m{r.n_obj}" if r.problem.startswith("dtlz") else r.problem
+    return problem_dir(r.problem, r.n_obj)
+
+
+def registry_order(algorithm: str) -> tuple[int, str]:
+    """Sort key of an algorithm name: its place in :data:`moo.algorithms.ALGORITHMS`, others after, by name."""
+    names = list(ALGORITHMS)
+    return (names.index(algorithm) if algorithm in ALGORITHMS else len(names), algorithm)
 
 
 def analyse(results_dir: str | os.PathLike, alpha: float = 0.05) -> tuple[list[RunIndicators], list[Comparison]]:
@@ -682,17 +686,13 @@ def _ranks_rows(results: Sequence[FriedmanResult], bold, sup):
     """(problem, [(label, cells)], footer rows) for each problem, cells written with bold(text) and sup(marks)."""
     for problem, by_ind in _ranks_layout(results).items():
         variants = next(iter(by_ind.values())).variants
-        rows = []
-        for v in variants:
-            cells = []
-            for name in INDICATORS:
-                r = by_ind.get(name)
-                if r is None:
-                    cells.append("")
-                    continue
-                text, is_best, marks = _rank_cell(r, v)
-                cells.append((bold(text) if is_best else text) + (sup(marks) if marks else ""))
-            rows.append((v.replace("+molsp", "/MO-LSP"), cells))
+        def cell(r: FriedmanResult | None, v: str) -> str:
+            if r is None:
+                return ""
+            text, is_best, marks = _rank_cell(r, v)
+            return (bold(text) if is_best else text) + (sup(marks) if marks else "")
+
+        rows = [(v.replace("+molsp", "/MO-LSP"), [cell(by_ind.get(n), v) for n in INDICATORS]) for v in variants]
         footer = [("Friedman p", [f"{by_ind[n].p_value:.3g}" if n in by_ind else "" for n in INDICATORS]),
                   ("CD", [f"{by_ind[n].cd:.3g}" if n in by_ind else "" for n in INDICATORS]),
                   ("N", [str(by_ind[n].n_blocks) if n in by_ind else "" for n in INDICATORS])]

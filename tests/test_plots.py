@@ -48,8 +48,8 @@ def test_check_formats():
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
     out = tmp_path_factory.mktemp("res")
-    for problem in ("zdt1", "dtlz2"):
-        run_experiment(problem, "nsga2,nsga3", runs=3, evals=300, pop_size=20, out=out, progress=False)
+    run_experiment("zdt1", "nsga2,nsga3", runs=3, evals=300, pop_size=20, out=out, progress=False)
+    run_experiment("dtlz2", "nsga3", runs=3, evals=300, pop_size=20, out=out, progress=False)
     return out
 
 
@@ -60,14 +60,16 @@ def test_plot_results_writes_every_figure(results, tmp_path):
         for stem in (f"hv_{key}", f"boxplots_{key}", *(f"cd_{key}_{i}" for i in ("igd", "sp", "hv", "pd", "spread"))):
             assert {f"{stem}.png", f"{stem}.pdf"} <= names
     assert "fronts_zdt1.png" in names                                  # one figure for two objectives
-    assert {"fronts_dtlz2-m3_nsga2.png", "fronts_dtlz2-m3_nsga3.png"} <= names  # a scatter matrix per MOEA
+    assert "fronts_dtlz2-m3_nsga3.png" in names                         # a scatter matrix per MOEA
     for p in paths:
         head = p.read_bytes()[:8]
         assert head.startswith(b"\x89PNG") if p.suffix == ".png" else head.startswith(b"%PDF")
         assert p.stat().st_size > 5000
 
 
-def test_cli_plot(results, tmp_path, capsys):
+def test_cli_plot(tmp_path, capsys):
+    results = tmp_path / "res"
+    run_experiment("zdt1", "nsga2", runs=2, evals=100, pop_size=20, out=results, progress=False)
     assert main(["plot", str(results), "--out", str(tmp_path / "fig"), "--format", "png"]) == 0
     printed = capsys.readouterr().out.split()
     assert len(printed) == len(list((tmp_path / "fig").iterdir())) and all(p.endswith(".png") for p in printed)
