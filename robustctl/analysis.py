@@ -201,7 +201,8 @@ class CostBound:
     info: Mapping[str, Any] = field(default_factory=dict)
 
     def __repr__(self) -> str:
-        return f"CostBound(bound={self.bound:.6g}, multiplier={self.multiplier:.6g}, x0={'given' if self.x0 is not None else 'worst unit'})"
+        x0 = "given" if self.x0 is not None else "worst unit"
+        return f"CostBound(bound={self.bound:.6g}, multiplier={self.multiplier:.6g}, x0={x0!r})"
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -318,7 +319,11 @@ def _lyapunov_factor(A: np.ndarray, Q: np.ndarray, discrete: bool) -> np.ndarray
         P = scipy.linalg.solve_discrete_lyapunov(A.T, Qr)
     else:
         P = scipy.linalg.solve_continuous_lyapunov(A.T, -Qr)
-    return np.linalg.cholesky(0.5 * (P + P.T))
+    try:
+        return np.linalg.cholesky(0.5 * (P + P.T))
+    except np.linalg.LinAlgError:
+        raise ConvergenceError("the Lyapunov equation of the nominal closed loop has no positive definite "
+                               "solution in floating point: the loop is on the edge of stability") from None
 
 
 def _block(A: np.ndarray, B: np.ndarray, P, N, discrete: bool):
@@ -404,8 +409,9 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     P = cp.Variable((n, n), symmetric=True, name="P")
     mu = cp.Variable(name="mu")
     N = _diag(Eh.T @ Eh, np.zeros((p, p))) - mu * _diag(np.zeros((n, n)), np.eye(p))
-    rep = _cvx.solve_sdp(cp.Minimize(mu), [_cvx.LMI("lyapunov", _block(Ah, Hh, P, N, discrete)), _cvx.LMI("P", P)],
-                         infeasible_msg="the bounded-real LMI of the uncertainty loop is infeasible")
+    lmis = [_cvx.LMI("lyapunov", _block(Ah, Hh, P, N, discrete)), _cvx.LMI("P", P)]
+    rep = _cvx.solve_sdp(cp.Minimize(mu), lmis, infeasible_msg="the bounded-real LMI of the uncertainty loop is "
+                                                               "infeasible")
     mu_opt = max(float(mu.value), 0.0)
     no_reach = not (np.any(H) and np.any(E))
     margin = np.inf if no_reach or mu_opt == 0.0 else 1.0 / (np.sqrt(mu_opt) * hh * eh)
@@ -443,7 +449,7 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "polytope",
                                MappingProxyType({"nominal_radius": nominal}))
     T = _Coordinates(_lyapunov_factor(A0, np.eye(n), discrete))
-    Ah0, Dh = T.A(A0), [T.A(A0 + Di) - T.A(A0) for Di in D]
+    Ah0, Dh = T.A(A0), [T.A(Di) for Di in D]
     empty = np.zeros((n, 0))
     reports = []
 
@@ -580,7 +586,7 @@ def _balanced(Hh: np.ndarray, Eh: np.ndarray) -> tuple[np.ndarray, np.ndarray, f
 
 
 def _multiplier(lam, p: int, c: float) -> float:
-    """The S-procedure multiplier in the plant's scaling: ``lam^ (|E^ x^|^2 - |q^|^2) = lam^ (|E x|^2 - |q|^2) / c^2``."""
+    """The multiplier in the plant's scaling: ``lam^ (|E^ x^|^2 - |q^|^2) = lam^ (|E x|^2 - |q|^2) / c^2``."""
     return float(lam.value) / c**2 if p else 0.0
 
 
@@ -735,7 +741,8 @@ class _Objective:
         lam, Y, X = self._eig(D)
         i = int(np.argmax(np.abs(lam) if self.discrete else lam.real))
         x, y = X[:, i], Y[:, i]
-        g = np.outer(y.conj() @ self.H, self.E @ x) / (y.conj() @ x)
+        den = y.conj() @ x  # ~0 only at a defective eigenvalue: keep the direction
+        g = np.outer(y.conj() @ self.H, self.E @ x) / (den if abs(den) > 1e-300 else 1.0)
         if self.discrete:
             f = float(abs(lam[i]))
             grad = (np.conj(lam[i]) * g).real / f if f > 0 else g.real
