@@ -17,6 +17,8 @@ from .plant import Plant
 from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
 from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
+from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guaranteed_cost, robust_hinf_bound,
+                       robust_stability, worst_case)
 
 
 __all__ = [
@@ -25,4 +27,6 @@ __all__ = [
     "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
 ]
+__all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
+            "RobustStability", "CostBound", "HinfBound", "WorstCase"]
 __version__ = "0.1.0"
