@@ -28,10 +28,11 @@ extensions = [
     "numpydoc",
     "sphinx_gallery.gen_gallery",
     "apipages",
+    "papertables",
 ]
 
 root_doc = "index"
-exclude_patterns = ["_build", "**.ipynb_checkpoints", "examples/README.rst"]
+exclude_patterns = ["_build", "_generated", "**.ipynb_checkpoints", "examples/README.rst"]
 templates_path = ["_templates"]
 nitpicky = True
 
@@ -81,7 +82,7 @@ sphinx_gallery_conf = {
     "only_warn_on_example_error": False,
     "remove_config_comments": True,
     "download_all_examples": False,
-    "within_subsection_order": "FileNameSortKey",
+    "within_subsection_order": "gallery_order.ExampleOrder",   # the user guide's order
     "matplotlib_animations": False,
     "reset_modules": ("matplotlib",),
     "show_memory": False,

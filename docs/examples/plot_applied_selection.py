@@ -52,9 +52,12 @@ print(sel)
 
 colors = ["tab:blue" if k == "front" else "tab:orange" for k in d.kinds]
 colors[sel.best] = "tab:red"
+x = np.arange(1, len(d) + 1)
 fig, ax = plt.subplots(figsize=(9, 3.2), layout="constrained")
-ax.bar(np.arange(1, len(d) + 1), counts, color=colors)
-ax.set_xticks(np.arange(1, len(d) + 1)[d.n_front:], d.labels[d.n_front:], rotation=30)
-ax.set(xlabel="design (front by $f_1$, then the extra designs)", ylabel="wins",
-       title=f"z* = design {d.labels[sel.best]}: {int(counts[sel.best])} of {len(sel.deltas)} wins")
+ax.bar(x, counts, color=colors)
+ax.set_xticks([1, *range(10, d.n_front + 1, 10)])
+extras = ", ".join(f"{lab} ({int(counts[i])})" for i, (lab, k) in enumerate(zip(d.labels, d.kinds))
+                   if k != "front")
+ax.set(xlabel=f"design: 1-{d.n_front} the front by $f_1$; then, in orange, {extras} wins",
+       ylabel="wins", title=f"z* = design {d.labels[sel.best]}: {int(counts[sel.best])} of {len(sel.deltas)} wins")
 print("z* =", np.array2string(sel.z, precision=4))
