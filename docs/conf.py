@@ -63,7 +63,6 @@ intersphinx_mapping = {
     "cvxpy": ("https://www.cvxpy.org", str(_INV / "cvxpy.inv")),
     "moocore": ("https://multi-objective.github.io/moocore/python", str(_INV / "moocore.inv")),
 }
-intersphinx_timeout = 1
 
 # Genuine gaps of other projects' inventories, each with its reason (never our own names).
 nitpick_ignore = [

@@ -113,14 +113,8 @@ def numpy_inventory() -> Inventory:
         full = f"numpy.random.SeedSequence.{member}"
         inv.add(full, "py:method", f"reference/random/bit_generators/generated/{full}.html#$")
     inv.add("numpy.random.PCG64", "py:class", "reference/random/bit_generators/pcg64.html#$")
-    # annotations name these classes by their defining (private) module
-    inv.add("numpy.random._generator.Generator", "py:class",
-            "reference/random/generator.html#numpy.random.Generator", "numpy.random.Generator")
     for name in numpy.typing.__all__:
-        full = f"numpy.typing.{name}"
-        inv.add(full, "py:data", "reference/typing.html#$")
-        # autodoc cross-references type aliases in signatures with the class role
-        inv.add(full, "py:class", "reference/typing.html#$")
+        inv.add(f"numpy.typing.{name}", "py:data", "reference/typing.html#$")
     return inv
 
 
