@@ -239,7 +239,7 @@ def _name_of(obj) -> str | None:
         return _DOCUMENTED[id(obj)]
     if inspect.ismodule(obj):
         return obj.__name__
-    if _is_api_object(obj) and not obj.__module__.split(".")[0] in PACKAGES:
+    if _is_api_object(obj) and obj.__module__.split(".")[0] not in PACKAGES:
         return f"{obj.__module__}.{obj.__qualname__}"
     return None
 
@@ -285,10 +285,10 @@ def _skip_member(app, what, name, obj, skip, options):
     """Class pages list inherited members (so a public class shows what it gets from a
     private base of ours) but only those defined in our packages, not pymoo's."""
     func = obj.fget if isinstance(obj, property) else getattr(obj, "__func__", obj)
+    if what != "class" or not inspect.isroutine(func):      # data members keep autodoc's rule
+        return None
     module = getattr(func, "__module__", None)
-    if what == "class" and isinstance(module, str) and module.split(".")[0] not in PACKAGES:
-        return True
-    return None
+    return True if isinstance(module, str) and module.split(".")[0] not in PACKAGES else None
 
 
 def _config_inited(app, config) -> None:
