@@ -62,6 +62,7 @@ intersphinx_mapping = {
     "matplotlib": ("https://matplotlib.org/stable", str(_INV / "matplotlib.inv")),
     "cvxpy": ("https://www.cvxpy.org", str(_INV / "cvxpy.inv")),
     "moocore": ("https://multi-objective.github.io/moocore/python", str(_INV / "moocore.inv")),
+    "distributed": ("https://distributed.dask.org/en/stable", str(_INV / "distributed.inv")),
 }
 
 # Genuine gaps of other projects' inventories, each with its reason (never our own names).

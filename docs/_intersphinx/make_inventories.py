@@ -249,10 +249,27 @@ def moocore_inventory() -> Inventory:
     return inv
 
 
+# -- dask.distributed: https://distributed.dask.org/en/stable/ (api.rst documents these) -----
+def distributed_inventory() -> Inventory:
+    import distributed
+
+    inv = Inventory("Dask.distributed", distributed.__version__)
+    for name in ("Client", "Future", "LocalCluster", "SpecCluster", "as_completed"):
+        obj = getattr(distributed, name)
+        inv.add(f"distributed.{name}", "py:class", "api.html#$")
+        if name == "Client":
+            for member, role in _members(obj):
+                inv.add(f"distributed.Client.{member}", role, "api.html#$")
+    for name in ("wait", "fire_and_forget", "futures_of"):
+        inv.add(f"distributed.{name}", "py:function", "api.html#$")
+    return inv
+
+
 def main() -> None:
     for name, build in (("numpy", numpy_inventory), ("control", control_inventory),
                         ("matplotlib", matplotlib_inventory), ("pymoo", pymoo_inventory),
-                        ("cvxpy", cvxpy_inventory), ("moocore", moocore_inventory)):
+                        ("cvxpy", cvxpy_inventory), ("moocore", moocore_inventory),
+                        ("distributed", distributed_inventory)):
         build().write(HERE / f"{name}.inv")
 
 
