@@ -85,7 +85,7 @@ Numerics
     (finite there) is kept if a strictly feasible ``(X, K X)`` at that level
     exists; ``X`` is built from a Riccati equation of the closed loop and
     accepted only on the eigenvalues of every block
-    (:meth:`_Problem.certify_at_level`; no second solve);
+    (``_Problem.certify_at_level``; no second solve);
   - otherwise (or if that fails) a second problem at the fixed level
     maximises the smallest eigenvalue ``t`` of every LMI block (a
     well-centred strictly feasible point). If that fails or its
