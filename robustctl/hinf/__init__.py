@@ -1,0 +1,106 @@
+r"""H-infinity state feedback by LMI optimisation (cvxpy + Clarabel).
+
+Plant, with the gain ``u = K x`` (the paper's sign convention)::
+
+    x+ = F x + Bw w + G u         (discrete, dt > 0; x' = ... for dt = None)
+    z  = Cz x + Dzw w + Dzu u
+
+The closed loop ``T_zw`` has ``A_K = F + G K``, ``C_K = Cz + Dzu K``. With the
+change of variables ``Y = K X`` (Bernussou, Peres & Geromel 1989) the
+bounded-real lemma becomes linear in ``(X, Y, gamma^2)``.
+
+Discrete time (``X > 0``; storage ``V(x) = x' X^-1 x``)::
+
+    [ X      A X + G Y   Bw   0               ]
+    [ *      X           0    (Cz X + Dzu Y)' ]  > 0
+    [ *      *           I    Dzw'            ]
+    [ *      *           *    gamma^2 I       ]
+
+Continuous time::
+
+    [ He(F X + G Y)   Bw    (Cz X + Dzu Y)' ]
+    [ *               -I    Dzw'            ]  < 0,   He(M) = M + M'
+    [ *               *     -gamma^2 I      ]
+
+Either inequality says ``V(x+) - V(x) <= |w|^2 - |z|^2 / gamma^2`` (or
+``dV/dt <= ...``), hence ``||T_zw||_inf < gamma`` and internal stability.
+This is the *gamma^2 form*: the same ``X`` bounds the reachable set,
+``x' X^-1 x <= E`` for every disturbance of energy ``sum |w|^2 <= E``
+(Boyd, El Ghaoui, Feron & Balakrishnan 1994, Sec. 6.1.3), so
+``|u_j| = |k_j x| <= u_max_j`` holds whenever (Sec. 7.2.3)::
+
+    [ u_max_j^2 / E   y_j ]
+    [ y_j'            X   ]  >= 0       (y_j: row j of Y).
+
+Polytopic plants: the LMI is imposed at every vertex ``(F_i, G_i)`` with one
+common ``(X, Y)``; it is affine in ``(F, G)``, so the gain is guaranteed for
+every plant in the convex hull (even time-varying). The *extended* (slack
+variable) discrete-time condition of de Oliveira, Bernussou & Geromel (1999)
+and de Oliveira, Geromel & Bernussou (2002) uses a vertex-dependent ``P_i``
+and a common slack ``S`` (not symmetric), ``K = L S^-1``::
+
+    [ P_i    F_i S + G_i L   Bw   0               ]
+    [ *      S + S' - P_i    0    (Cz S + Dzu L)' ]  > 0
+    [ *      *               I    Dzw'            ]
+    [ *      *               *    gamma^2 I       ]
+
+It reduces to the standard one for ``S = P_i = X`` (never more
+conservative) and guarantees the bound for every *constant* plant of the
+hull (storage ``x' P(a)^-1 x`` with ``P(a) = sum a_i P_i``). The input bound
+then uses ``[[u_max_j^2/E, l_j], [l_j', S + S' - P_i]] >= 0`` at each vertex
+(``S + S' - P <= S' P^-1 S``).
+
+Numerics
+--------
+The synthesis is a sequence of pure stages (:mod:`robustctl.hinf._synthesis`
+lists them; every tolerance is named in :mod:`robustctl.hinf._tolerances`):
+
+* Coordinates (:mod:`._coordinates`): states balanced (SLICOT ``TB01ID``)
+  and scaled so that ``||Bw|| = 1``; ``w`` scaled to unit energy when
+  ``u_max`` is given; ``z`` scaled so that the fixed level of a centring
+  problem is 1; ``[Cz Dzu Dzw]`` replaced by a factor with the same Gram
+  matrix when that has fewer rows. A single plant is solved in coordinates
+  where the inverse of its LQR Riccati solution (weight
+  ``[Cz Dzu]'[Cz Dzu]``) is ~ I: the optimal ``X`` has roughly that shape,
+  so the optimum is well conditioned (on the benchmark plants with n = 10:
+  13-16 interior-point iterations instead of ~27 ending
+  ``optimal_inaccurate``).
+* Blocks (:mod:`._lmis`): the constant disturbance block ``I`` is
+  eliminated by a Schur complement (e.g. the discrete block becomes
+  ``[[X - Bw Bw', A X + G Y, -Bw Dzw'], [*, X, (Cz X + Dzu Y)'], [*, *,
+  gamma^2 I - Dzw Dzw']] >= 0``): same set, ``q`` rows smaller.
+* Level (:mod:`._level`): ``gamma_opt`` minimises ``gamma^2`` (non-strict
+  LMIs: the infimum), in the LQR coordinates of one plant at tolerance
+  1e-8, first without Clarabel's iterative refinement (see
+  :func:`robustctl._cvx.solve_sdp`), otherwise at 1e-10 with refinement
+  (the truck polytope is badly conditioned), with fallbacks to the
+  balanced coordinates, to a restart of the extended LMI from the standard
+  one, and a polish of an ``optimal_inaccurate`` result.
+* Gain (:mod:`._gains`): at the optimum ``X`` can be nearly singular and
+  ``K = Y X^-1`` huge, so unless ``backoff=0`` the gain is certified at
+  ``gamma = (1 + backoff) gamma_opt`` by the first of an ordered list of
+  strategies (the optimum's own gain with a Riccati-built certificate for
+  one discrete plant; centring re-solves; a raised backoff).
+  ``info["gain_from"]`` names the route.
+* Every solve goes through :func:`robustctl._cvx.solve_sdp`: status check,
+  explicit symmetrisation, certificate eigenvalues; solver failures are
+  retried with looser tolerances, the certificate is checked regardless.
+* A fixed ``gamma`` is a feasibility problem posed as "maximise the common
+  margin ``t <= 1``" (always feasible); ``t <= 0`` means infeasible.
+
+References
+----------
+S. Boyd, L. El Ghaoui, E. Feron, V. Balakrishnan, *Linear Matrix Inequalities
+in System and Control Theory*, SIAM 1994, Sec. 6.1.3, 7.2.3, 7.5.
+M. C. de Oliveira, J. Bernussou, J. C. Geromel, "A new discrete-time robust
+stability condition", Systems & Control Letters 37, 1999.
+M. C. de Oliveira, J. C. Geromel, J. Bernussou, "Extended H2 and H-infinity
+norm characterizations and controller parametrizations for discrete-time
+systems", Int. J. Control 75(9), 2002.
+P. Gahinet, P. Apkarian, "A linear matrix inequality approach to
+H-infinity control", Int. J. Robust Nonlinear Control 4, 1994.
+"""
+
+from ._synthesis import HinfController, hinf
+
+__all__ = ["hinf", "HinfController"]

@@ -1,0 +1,169 @@
+"""Stage 3 of the synthesis: the decision variables and the named LMI blocks.
+
+The blocks (each ``M >= margin I``, see :class:`robustctl._cvx.LMI`) are
+built from a :class:`Point`, which holds either cvxpy variables (to solve)
+or arrays (to evaluate a candidate's certificate with the very same code).
+The maths is in the docstring of :mod:`robustctl.hinf`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .. import _cvx
+from . import _tolerances as tol
+from ._coordinates import Coordinates
+
+__all__ = ["Point", "variables", "blocks", "hinf_blocks", "lyapunov_blocks", "input_bound_blocks",
+           "is_strict"]
+
+
+@dataclass(frozen=True, eq=False)
+class Point:
+    """Decision variables of the LMIs (cvxpy variables) or their values (arrays).
+
+    Standard LMI: the Lyapunov matrix ``X`` and ``Y = K X``. Extended
+    (slack-variable) LMI: ``P`` (one per vertex), the slack ``S`` (not
+    symmetric) and ``L = K S``.
+    """
+
+    X: Any = None
+    Y: Any = None
+    P: tuple = ()
+    S: Any = None
+    L: Any = None
+
+    @property
+    def extended(self) -> bool:
+        return self.S is not None
+
+    def values(self) -> "Point":
+        """The solution held by the cvxpy variables, as arrays."""
+        if self.extended:
+            return Point(P=tuple(np.asarray(P.value, dtype=float) for P in self.P),
+                         S=np.asarray(self.S.value, dtype=float), L=np.asarray(self.L.value, dtype=float))
+        X = np.asarray(self.X.value, dtype=float)
+        return Point(X=0.5 * (X + X.T), Y=np.asarray(self.Y.value, dtype=float))
+
+    def shape_matrix(self) -> np.ndarray:
+        """The matrix whose shape defines recentred coordinates: ``X``, or the symmetric part of ``S``."""
+        M = self.S if self.extended else self.X
+        return 0.5 * (M + M.T)
+
+    def nominal_lyapunov(self) -> np.ndarray:
+        """``X``, or ``P`` of the nominal vertex."""
+        return self.P[0] if self.extended else self.X
+
+    def lyapunov_matrices(self) -> tuple[np.ndarray, ...]:
+        """One Lyapunov matrix per vertex (the common ``X`` once)."""
+        return self.P if self.extended else (self.X,)
+
+    def gain(self) -> np.ndarray:
+        """``K = Y X^-1`` (``L S^-1``) in the point's coordinates."""
+        if self.extended:
+            return np.linalg.solve(self.S.T, self.L.T).T
+        return np.linalg.solve(self.X, self.Y.T).T
+
+
+def variables(n: int, m: int, vertices: int, extended: bool) -> Point:
+    """Fresh cvxpy variables for ``vertices`` plants with ``n`` states and ``m`` inputs."""
+    import cvxpy as cp
+
+    if extended:
+        return Point(P=tuple(cp.Variable((n, n), symmetric=True, name=f"P{i}") for i in range(vertices)),
+                     S=cp.Variable((n, n), name="S"), L=cp.Variable((m, n), name="L"))
+    return Point(X=cp.Variable((n, n), symmetric=True, name="X"), Y=cp.Variable((m, n), name="Y"))
+
+
+def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin=0.0,
+                z_scale: float = 1.0) -> list[_cvx.LMI]:
+    """The bounded-real-lemma block of every vertex, ``hinf[i]``, at the scaled level ``level_sq``.
+
+    ``level_sq`` is ``(w_scale z_scale gamma)^2`` (a float or a cvxpy
+    variable); ``z_scale`` multiplies ``z``. The constant disturbance block
+    ``I`` is eliminated by a Schur complement (``q`` rows smaller, still linear).
+    """
+    import cvxpy as cp
+
+    Ip = np.eye(data.p)
+    Cz, Dzu, Dzw = z_scale * data.Cz, z_scale * data.Dzu, z_scale * data.Dzw
+    Bw = data.Bw
+    BB, BD, DD = Bw @ Bw.T, Bw @ Dzw.T, Dzw @ Dzw.T
+    out = []
+    for i, (F, G) in enumerate(zip(data.F, data.G)):
+        if V.extended:
+            P, S, L = V.P[i], V.S, V.L
+            AS, CS = F @ S + G @ L, Cz @ S + Dzu @ L
+            M = cp.bmat([[P - BB, AS, -BD],
+                         [AS.T, S + S.T - P, CS.T],
+                         [-BD.T, CS, level_sq * Ip - DD]])
+        else:
+            X, Y = V.X, V.Y
+            AX, CX = F @ X + G @ Y, Cz @ X + Dzu @ Y
+            if discrete:
+                M = cp.bmat([[X - BB, AX, -BD],
+                             [AX.T, X, CX.T],
+                             [-BD.T, CX, level_sq * Ip - DD]])
+            else:  # -(continuous bounded-real lemma) >= 0
+                M = cp.bmat([[-(AX + AX.T) - BB, -CX.T - BD],
+                             [-CX - BD.T, level_sq * Ip - DD]])
+        out.append(_cvx.LMI(f"hinf[{i}]", M, margin))
+    return out
+
+
+def lyapunov_blocks(V: Point, x_margin, x_upper: float) -> list[_cvx.LMI]:
+    """``X >= x_margin I`` and ``X <= x_upper I`` (extended: ``sym(S) >= x_margin I``, every ``P_i <= x_upper I``)."""
+    n_eye = np.eye((V.S if V.extended else V.X).shape[0])
+    if V.extended:
+        return ([_cvx.LMI("S", 0.5 * (V.S + V.S.T), x_margin)]
+                + [_cvx.LMI(f"P_upper[{i}]", x_upper * n_eye - P) for i, P in enumerate(V.P)])
+    return [_cvx.LMI("X", V.X, x_margin), _cvx.LMI("X_upper", x_upper * n_eye - V.X)]
+
+
+def input_bound_blocks(V: Point, u_max: np.ndarray) -> list[_cvx.LMI]:
+    """``|u_j| <= u_max_j`` on the unit-energy reachable set: ``[[u_max_j^2, y_j], [y_j', X]] >= 0``.
+
+    Extended: ``[[u_max_j^2, l_j], [l_j', S + S' - P_i]] >= 0`` at every
+    vertex (``S + S' - P <= S' P^-1 S``). ``u_max_j^2`` is reduced by the
+    relative ``U_SLACK`` so that solver rounding cannot exceed the bound.
+    """
+    import cvxpy as cp
+
+    out = []
+    for j, umax in enumerate(u_max):
+        c = np.array([[umax**2 * (1.0 - tol.U_SLACK)]])
+        if V.extended:
+            lj = V.L[j:j + 1, :]
+            out += [_cvx.LMI(f"u_max[{j}][{i}]", cp.bmat([[c, lj], [lj.T, V.S + V.S.T - P]]), 0.0)
+                    for i, P in enumerate(V.P)]
+        else:
+            yj = V.Y[j:j + 1, :]
+            out.append(_cvx.LMI(f"u_max[{j}]", cp.bmat([[c, yj], [yj.T, V.X]]), 0.0))
+    return out
+
+
+def blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, u_max: np.ndarray | None,
+           margin=0.0, z_scale: float = 1.0, x_margin=None, x_upper: float | None = None) -> list[_cvx.LMI]:
+    """Every LMI block of one synthesis problem, named.
+
+    The H-infinity blocks get ``margin``. With ``x_margin`` the Lyapunov (or
+    slack) matrix is also bounded, ``x_margin I <= X <= x_upper I``;
+    otherwise continuous time adds ``X >= margin I`` (discrete time implies
+    ``X > 0``). ``u_max`` adds the input-bound blocks.
+    """
+    out = hinf_blocks(data, V, level_sq, discrete=discrete, margin=margin, z_scale=z_scale)
+    if x_margin is not None:
+        out += lyapunov_blocks(V, x_margin, x_upper)
+    elif not discrete:
+        out.append(_cvx.LMI("X", V.X, margin))
+    if u_max is not None:
+        out += input_bound_blocks(V, u_max)
+    return out
+
+
+def is_strict(certificate) -> bool:
+    """Every H-infinity block and the Lyapunov (slack) matrix strictly positive definite."""
+    return all(v > 0 for k, v in certificate.items() if k.startswith(("hinf", "X", "S")) and k != "X_upper")
