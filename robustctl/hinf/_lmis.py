@@ -124,23 +124,31 @@ def lyapunov_blocks(V: Point, x_margin, x_upper: float) -> list[_cvx.LMI]:
 
 
 def input_bound_blocks(V: Point, u_max: np.ndarray) -> list[_cvx.LMI]:
-    """``|u_j| <= u_max_j`` on the unit-energy reachable set: ``[[u_max_j^2, y_j], [y_j', X]] >= 0``.
+    """``|u_j| <= u_max_j`` on the unit-energy reachable set: ``y_j X^-1 y_j' <= u_max_j^2``.
 
-    Extended: ``[[u_max_j^2, l_j], [l_j', S + S' - P_i]] >= 0`` at every
-    vertex (``S + S' - P <= S' P^-1 S``). ``u_max_j^2`` is reduced by the
-    relative ``U_SLACK`` so that solver rounding cannot exceed the bound.
+    The textbook block ``[[u_max_j^2, y_j], [y_j', X]] >= 0`` (Boyd et al.
+    1994, Sec. 7.2.3) after the congruence ``diag(1 / s_j, I)`` with
+    ``s_j = max(1, u_max_j)``: ``[[(u_max_j / s_j)^2, y_j / s_j], [*, X]]``.
+    For ``u_max_j <= 1`` that is the textbook block; a looser bound keeps
+    every entry of the order of ``X`` (written with ``u_max_j^2``, a bound of
+    1e5 put 1e10 beside ``X ~ 1`` and the solver reported infeasibility).
+    Extended: ``S + S' - P_i`` instead of ``X`` and ``l_j`` instead of
+    ``y_j``, at every vertex (``S + S' - P <= S' P^-1 S``). The constant is
+    reduced by the relative ``U_SLACK`` so that solver rounding cannot
+    exceed the bound.
     """
     import cvxpy as cp
 
     out = []
     for j, umax in enumerate(u_max):
-        c = np.array([[umax**2 * (1.0 - tol.U_SLACK)]])
+        s = max(1.0, float(umax))
+        c = np.array([[(umax / s) ** 2 * (1.0 - tol.U_SLACK)]])
         if V.extended:
-            lj = V.L[j:j + 1, :]
+            lj = V.L[j:j + 1, :] / s
             out += [_cvx.LMI(f"u_max[{j}][{i}]", cp.bmat([[c, lj], [lj.T, V.S + V.S.T - P]]), 0.0)
                     for i, P in enumerate(V.P)]
         else:
-            yj = V.Y[j:j + 1, :]
+            yj = V.Y[j:j + 1, :] / s
             out.append(_cvx.LMI(f"u_max[{j}]", cp.bmat([[c, yj], [yj.T, V.X]]), 0.0))
     return out
 
