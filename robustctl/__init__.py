@@ -12,6 +12,8 @@ from .controller import Controller
 from .design import design
 from .errors import ConvergenceError, InfeasibleError, RankConditionError, RobustCtlError
 from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
+from .h2 import H2Controller, h2
+from .regions import ConicSector, Disk, HalfPlane
 from .lqr import lqr
 from .plant import Plant
 from .rlqr import RLQRBatch, rlqr, rlqr_gains
@@ -21,6 +23,7 @@ from .uncertainty import NormBounded
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
     "hinf", "HinfController",
+    "h2", "H2Controller", "Disk", "HalfPlane", "ConicSector",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError",
 ]
 __version__ = "0.1.0"

@@ -122,8 +122,8 @@ def test_lqr_coordinates_give_up_cleanly(discrete, monkeypatch):
     assert _coordinates.lqr_coordinates(stuck, True) is None
     # no disturbance: nothing to normalise by
     assert _coordinates.lqr_coordinates(dataclasses.replace(data, Bw=np.zeros_like(data.Bw),
-                                                            original=data.original[:2] + (np.zeros((4, 2)),
-                                                                                          data.original[3])),
+                                                            original=data.original[:2] + (np.zeros((4, 2)),)
+                                                            + data.original[3:]),
                                         True) is None
     # a Riccati solver returning a matrix that is not positive
     monkeypatch.setattr(scipy.linalg, "solve_discrete_are", lambda *a, **k: -np.eye(4))
@@ -173,8 +173,7 @@ def test_blocks_at_the_riccati_built_point_are_positive_exactly_above_the_gains_
 def _lmis_certificate(problem, data, point, z_scale):
     from robustctl import _cvx
 
-    return _cvx.certificate(_lmis.blocks(data, point, 1.0, discrete=problem.discrete, u_max=problem.u_max,
-                                         z_scale=z_scale))
+    return _cvx.certificate(_lmis.blocks(problem, data, point, 1.0, z_scale=z_scale))
 
 
 def test_lyapunov_bounds_and_strictness(polytope):
@@ -461,3 +460,12 @@ def test_optimum_certified_skips_a_non_finite_riccati_solution(discrete, monkeyp
     monkeypatch.setattr(scipy.linalg, "solve_discrete_are", lambda *a, **k: np.full((4, 4), np.nan))
     attempt = _gains.optimum_certified(problem, opt, 1e-3)
     assert attempt.gain is None and attempt.failure is None
+
+
+def test_closed_loop_check_of_the_pole_regions():
+    from robustctl import Disk
+
+    K = np.array([[0.0, -39.0]])                      # |pole| 0.997 for mass 1: stable, far outside Disk(0, 0.5)
+    with pytest.raises(ConvergenceError, match=r"a closed-loop pole of plant lies outside Disk\(center=0.0"):
+        _synthesis.check_closed_loop(K, [msd(1.0)], (Disk(0.0, 0.5),))
+    _synthesis.check_closed_loop(K, [msd(1.0)], (Disk(0.0, 1.0),))

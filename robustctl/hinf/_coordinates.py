@@ -33,9 +33,11 @@ class Coordinates:
 
     ``F``, ``G`` hold one matrix per vertex. ``Bw`` and ``Dzw`` include the
     disturbance scaling ``w = w_scale w~``; ``Cz``, ``Dzu``, ``Dzw`` may be
-    the compressed factor (``p`` rows, see :func:`normalised`). ``original``
-    is ``(F, G, Bw, Cz)`` at ``T = I``; ``balancing`` the diagonal similarity
-    of :func:`normalised` (reported in ``info["scaling"]``).
+    the compressed factor (``p`` rows, see :func:`normalised`). ``H``,
+    ``EF``, ``EG`` are the norm-bounded uncertainty ``[dF dG] = H Delta [EF
+    EG]`` (``None`` without one). ``original`` is ``(F, G, Bw, Cz, H, EF)``
+    at ``T = I``; ``balancing`` the diagonal similarity of
+    :func:`normalised` (reported in ``info["scaling"]``).
     """
 
     F: tuple[np.ndarray, ...]
@@ -48,6 +50,9 @@ class Coordinates:
     original: tuple
     w_scale: float
     balancing: np.ndarray
+    H: np.ndarray | None = None
+    EF: np.ndarray | None = None
+    EG: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -63,9 +68,10 @@ class Coordinates:
 
     def to(self, T: np.ndarray) -> "Coordinates":
         """The same data in the coordinates ``x = T x^`` (``T`` relative to the original states)."""
-        Fs, Gs, Bw, Cz = self.original
+        Fs, Gs, Bw, Cz, H, EF = self.original
         return replace(self, T=T, F=tuple(np.linalg.solve(T, F @ T) for F in Fs),
-                       G=tuple(np.linalg.solve(T, G) for G in Gs), Bw=np.linalg.solve(T, Bw), Cz=Cz @ T)
+                       G=tuple(np.linalg.solve(T, G) for G in Gs), Bw=np.linalg.solve(T, Bw), Cz=Cz @ T,
+                       H=None if H is None else np.linalg.solve(T, H), EF=None if EF is None else EF @ T)
 
     def from_original(self, X: np.ndarray) -> np.ndarray:
         """A Lyapunov matrix of the original states in these coordinates, ``T^-1 X T^-T``."""
@@ -77,8 +83,11 @@ class Coordinates:
 
 
 def normalised(F: Sequence[np.ndarray], G: Sequence[np.ndarray], Bw: np.ndarray, Cz: np.ndarray,
-               Dzu: np.ndarray, Dzw: np.ndarray, w_scale: float = 1.0) -> Coordinates:
+               Dzu: np.ndarray, Dzw: np.ndarray, w_scale: float = 1.0, uncertainty=None) -> Coordinates:
     """Balanced, ``||Bw~|| = 1`` coordinates of the vertices ``(F[i], G[i])``, with ``z`` compressed.
+
+    ``uncertainty`` (a :class:`~robustctl.NormBounded` or ``None``) is carried
+    along (``H`` and ``EF`` change with the coordinates).
 
     Only ``z'z`` matters to every synthesis here, so ``[Cz Dzu Dzw]`` is
     replaced by ``R`` with ``R'R = [Cz Dzu Dzw]'[Cz Dzu Dzw]`` (full row
@@ -96,9 +105,10 @@ def normalised(F: Sequence[np.ndarray], G: Sequence[np.ndarray], Bw: np.ndarray,
     if 0 < r < CD.shape[0]:
         CD = sv[:r, None] * Vt[:r]
         Cz, Dzu, Dzw = CD[:, :n], CD[:, n:n + m], CD[:, n + m:]
-    eye = np.eye(n)
-    base = Coordinates(F=Fs, G=Gs, Bw=Bw * w_scale, Cz=Cz, Dzu=Dzu, Dzw=Dzw * w_scale, T=eye,
-                       original=(Fs, Gs, Bw * w_scale, Cz), w_scale=float(w_scale), balancing=d)
+    H, EF, EG = (None, None, None) if uncertainty is None else (uncertainty.H, uncertainty.EF, uncertainty.EG)
+    base = Coordinates(F=Fs, G=Gs, Bw=Bw * w_scale, Cz=Cz, Dzu=Dzu, Dzw=Dzw * w_scale, T=np.eye(n),
+                       original=(Fs, Gs, Bw * w_scale, Cz, H, EF), w_scale=float(w_scale), balancing=d,
+                       H=H, EF=EF, EG=EG)
     return base.to(np.diag(d))
 
 

@@ -91,7 +91,8 @@ def at_optimum(problem: Problem, opt: Optimum) -> Gain:
 def optimum_certified(problem: Problem, opt: Optimum, backoff: float) -> Attempt:
     """The optimum's gain ``K`` with a Riccati-built strictly feasible ``(X, K X)`` at the backed-off level.
 
-    Discrete time, one vertex, standard LMI (otherwise not applicable). With
+    Discrete time, one vertex, standard LMI, no uncertainty (otherwise not
+    applicable). With
     ``(A, B, C, D) = (F + G K, Bw, b (Cz + Dzu K), b Dzw)`` at the output
     scaling ``b`` of level 1, the Schur complement of the H-infinity block
     with respect to its last two block rows is ``X - A X A' - B B' -
@@ -105,7 +106,7 @@ def optimum_certified(problem: Problem, opt: Optimum, backoff: float) -> Attempt
     does not rely on the Riccati solver. The margin is the smallest
     eigenvalue of the H-infinity block.
     """
-    if not problem.discrete or problem.extended or problem.polytopic:
+    if not problem.discrete or problem.extended or problem.polytopic or problem.uncertainty is not None:
         return Attempt()
     data = opt.data
     z_scale = 1.0 / (data.w_scale * opt.gamma_opt * (1.0 + backoff))
@@ -123,7 +124,7 @@ def optimum_certified(problem: Problem, opt: Optimum, backoff: float) -> Attempt
             continue
         X = 0.5 * (X + X.T)
         point = Point(X=X, Y=K @ X)
-        cert = _cvx.certificate(blocks(data, point, 1.0, discrete=True, u_max=problem.u_max, z_scale=z_scale))
+        cert = _cvx.certificate(blocks(problem, data, point, 1.0, z_scale=z_scale))
         if min(cert.values()) > tol.STRICT:
             return Attempt(Gain(point, data, cert, cert["hinf[0]"], "optimum-certified"))
     return Attempt()
@@ -198,15 +199,14 @@ def _max_margin(problem: Problem, data: Coordinates, gamma: float, infeasible_ms
     the smallest eigenvalue of ``X`` (blocks ``>= margin``). Returns ``(V, t, report)``."""
     import cvxpy as cp
 
-    V = variables(data.n, data.m, len(data.F), problem.extended)
+    V = variables(data.n, data.m, len(data.F), problem.extended, uncertain=problem.uncertainty is not None)
     t = cp.Variable(name="t")
     z_scale = 1.0 / (data.w_scale * gamma)  # the scaled level is then 1
     if x_upper is None:
-        lmis = blocks(data, V, 1.0, discrete=problem.discrete, u_max=problem.u_max, margin=t, z_scale=z_scale)
+        lmis = blocks(problem, data, V, 1.0, margin=t, z_scale=z_scale)
         cons = [t <= 1.0]
     else:
-        lmis = blocks(data, V, 1.0, discrete=problem.discrete, u_max=problem.u_max, margin=margin,
-                      z_scale=z_scale, x_margin=t, x_upper=x_upper)
+        lmis = blocks(problem, data, V, 1.0, margin=margin, z_scale=z_scale, x_margin=t, x_upper=x_upper)
         cons = []
     rep = _cvx.solve_sdp(cp.Maximize(t), lmis, cons, solver=problem.solver, tol=tol.CENTRE_TOL,
                          infeasible_msg=infeasible_msg)

@@ -84,10 +84,10 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
     import cvxpy as cp
 
     extended = problem.extended if extended is None else extended
-    V = variables(data.n, data.m, len(data.F), extended)
+    V = variables(data.n, data.m, len(data.F), extended, uncertain=problem.uncertainty is not None)
     level_sq = cp.Variable(name="level_sq")
     rep = _cvx.solve_sdp(cp.Minimize(level_sq),
-                         blocks(data, V, level_sq, discrete=problem.discrete, u_max=problem.u_max, z_scale=z_scale),
+                         blocks(problem, data, V, level_sq, z_scale=z_scale),
                          solver=problem.solver, tol=tol.LEVEL_TOL if preconditioned else tol.LEVEL_TOL_GENERAL,
                          infeasible_msg=f"no H-infinity state feedback: {problem.infeasibility()}",
                          fast=preconditioned)

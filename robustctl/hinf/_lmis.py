@@ -15,10 +15,11 @@ import numpy as np
 
 from .. import _cvx
 from . import _tolerances as tol
+from ..regions import region_lmi
 from ._coordinates import Coordinates
 
 __all__ = ["Point", "variables", "blocks", "hinf_blocks", "lyapunov_blocks", "input_bound_blocks",
-           "is_strict"]
+           "region_blocks", "is_strict"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -27,7 +28,8 @@ class Point:
 
     Standard LMI: the Lyapunov matrix ``X`` and ``Y = K X``. Extended
     (slack-variable) LMI: ``P`` (one per vertex), the slack ``S`` (not
-    symmetric) and ``L = K S``.
+    symmetric) and ``L = K S``. With a norm-bounded uncertainty: one
+    S-procedure multiplier ``eps`` per vertex.
     """
 
     X: Any = None
@@ -35,6 +37,7 @@ class Point:
     P: tuple = ()
     S: Any = None
     L: Any = None
+    eps: tuple = ()
 
     @property
     def extended(self) -> bool:
@@ -46,7 +49,8 @@ class Point:
             return Point(P=tuple(np.asarray(P.value, dtype=float) for P in self.P),
                          S=np.asarray(self.S.value, dtype=float), L=np.asarray(self.L.value, dtype=float))
         X = np.asarray(self.X.value, dtype=float)
-        return Point(X=0.5 * (X + X.T), Y=np.asarray(self.Y.value, dtype=float))
+        return Point(X=0.5 * (X + X.T), Y=np.asarray(self.Y.value, dtype=float),
+                     eps=tuple(float(e.value) for e in self.eps))
 
     def shape_matrix(self) -> np.ndarray:
         """The matrix whose shape defines recentred coordinates: ``X``, or the symmetric part of ``S``."""
@@ -68,14 +72,15 @@ class Point:
         return np.linalg.solve(self.X, self.Y.T).T
 
 
-def variables(n: int, m: int, vertices: int, extended: bool) -> Point:
+def variables(n: int, m: int, vertices: int, extended: bool, uncertain: bool = False) -> Point:
     """Fresh cvxpy variables for ``vertices`` plants with ``n`` states and ``m`` inputs."""
     import cvxpy as cp
 
     if extended:
         return Point(P=tuple(cp.Variable((n, n), symmetric=True, name=f"P{i}") for i in range(vertices)),
                      S=cp.Variable((n, n), name="S"), L=cp.Variable((m, n), name="L"))
-    return Point(X=cp.Variable((n, n), symmetric=True, name="X"), Y=cp.Variable((m, n), name="Y"))
+    eps = tuple(cp.Variable(name=f"eps{i}") for i in range(vertices)) if uncertain else ()
+    return Point(X=cp.Variable((n, n), symmetric=True, name="X"), Y=cp.Variable((m, n), name="Y"), eps=eps)
 
 
 def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin=0.0,
@@ -84,7 +89,9 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
 
     ``level_sq`` is ``(w_scale z_scale gamma)^2`` (a float or a cvxpy
     variable); ``z_scale`` multiplies ``z``. The constant disturbance block
-    ``I`` is eliminated by a Schur complement (``q`` rows smaller, still linear).
+    ``I`` is eliminated by a Schur complement (``q`` rows smaller, still
+    linear). With an uncertainty in ``data`` (and multipliers in ``V``) the
+    block is the robust one of :mod:`robustctl.hinf` (S-procedure).
     """
     import cvxpy as cp
 
@@ -103,7 +110,9 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
         else:
             X, Y = V.X, V.Y
             AX, CX = F @ X + G @ Y, Cz @ X + Dzu @ Y
-            if discrete:
+            if V.eps:
+                M = _robust_block(data, V.eps[i], X, Y, AX, CX, level_sq * Ip - DD, BB, BD, discrete)
+            elif discrete:
                 M = cp.bmat([[X - BB, AX, -BD],
                              [AX.T, X, CX.T],
                              [-BD.T, CX, level_sq * Ip - DD]])
@@ -112,6 +121,29 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
                              [-CX - BD.T, level_sq * Ip - DD]])
         out.append(_cvx.LMI(f"hinf[{i}]", M, margin))
     return out
+
+
+def _robust_block(data: Coordinates, eps, X, Y, AX, CX, W, BB, BD, discrete: bool):
+    """The bounded-real block for ``[dF dG] = H Delta [EF EG]``, ``||Delta|| <= 1``, with multiplier ``eps``.
+
+    With ``EX = EF X + EG Y`` and ``W = gamma^2 I - Dzw Dzw'``, discrete:
+    ``[[X - BB' - eps HH', AX, -BD', 0], [*, X, CX', EX'], [*, *, W, 0],
+    [*, *, *, eps I]] >= 0``; continuous: ``[[-He(AX) - BB' - eps HH',
+    -CX' - BD', -EX'], [*, W, 0], [*, *, eps I]] >= 0``.
+    """
+    import cvxpy as cp
+
+    EX = data.EF @ X + data.EG @ Y
+    n, p, l = data.n, W.shape[0], EX.shape[0]
+    epsHH, epsI = eps * (data.H @ data.H.T), eps * np.eye(l)
+    if discrete:
+        return cp.bmat([[X - BB - epsHH, AX, -BD, np.zeros((n, l))],
+                        [AX.T, X, CX.T, EX.T],
+                        [-BD.T, CX, W, np.zeros((p, l))],
+                        [np.zeros((l, n)), EX, np.zeros((l, p)), epsI]])
+    return cp.bmat([[-(AX + AX.T) - BB - epsHH, -CX.T - BD, -EX.T],
+                    [-CX - BD.T, W, np.zeros((p, l))],
+                    [-EX, np.zeros((l, p)), epsI]])
 
 
 def lyapunov_blocks(V: Point, x_margin, x_upper: float) -> list[_cvx.LMI]:
@@ -153,25 +185,32 @@ def input_bound_blocks(V: Point, u_max: np.ndarray) -> list[_cvx.LMI]:
     return out
 
 
-def blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, u_max: np.ndarray | None,
-           margin=0.0, z_scale: float = 1.0, x_margin=None, x_upper: float | None = None) -> list[_cvx.LMI]:
-    """Every LMI block of one synthesis problem, named.
+def region_blocks(regions, data: Coordinates, V: Point, margin=0.0) -> list[_cvx.LMI]:
+    """``poles[k][i]``: the closed loop of vertex ``i`` has its poles in region ``k`` (same ``X``)."""
+    return [_cvx.LMI(f"poles[{k}][{i}]", region_lmi(region, F @ V.X + G @ V.Y, V.X), margin)
+            for k, region in enumerate(regions) for i, (F, G) in enumerate(zip(data.F, data.G))]
 
-    The H-infinity blocks get ``margin``. With ``x_margin`` the Lyapunov (or
-    slack) matrix is also bounded, ``x_margin I <= X <= x_upper I``;
-    otherwise continuous time adds ``X >= margin I`` (discrete time implies
-    ``X > 0``). ``u_max`` adds the input-bound blocks.
+
+def blocks(problem, data: Coordinates, V: Point, level_sq, *, margin=0.0, z_scale: float = 1.0, x_margin=None,
+           x_upper: float | None = None) -> list[_cvx.LMI]:
+    """Every LMI block of one H-infinity synthesis problem (a :class:`._problem.Problem`), named.
+
+    The H-infinity and pole-region blocks get ``margin``. With ``x_margin``
+    the Lyapunov (or slack) matrix is also bounded, ``x_margin I <= X <=
+    x_upper I``; otherwise continuous time adds ``X >= margin I`` (discrete
+    time implies ``X > 0``). An input bound adds its blocks.
     """
-    out = hinf_blocks(data, V, level_sq, discrete=discrete, margin=margin, z_scale=z_scale)
+    out = hinf_blocks(data, V, level_sq, discrete=problem.discrete, margin=margin, z_scale=z_scale)
     if x_margin is not None:
         out += lyapunov_blocks(V, x_margin, x_upper)
-    elif not discrete:
+    elif not problem.discrete:
         out.append(_cvx.LMI("X", V.X, margin))
-    if u_max is not None:
-        out += input_bound_blocks(V, u_max)
+    out += region_blocks(problem.regions, data, V, margin)
+    if problem.u_max is not None:
+        out += input_bound_blocks(V, problem.u_max)
     return out
 
 
 def is_strict(certificate) -> bool:
-    """Every H-infinity block and the Lyapunov (slack) matrix strictly positive definite."""
-    return all(v > 0 for k, v in certificate.items() if k.startswith(("hinf", "X", "S")) and k != "X_upper")
+    """Every H-infinity and pole-region block and the Lyapunov (slack) matrix strictly positive definite."""
+    return all(v > 0 for k, v in certificate.items() if k.startswith(("hinf", "X", "S", "poles")) and k != "X_upper")

@@ -12,9 +12,12 @@ from .. import _cvx
 from .._validation import check_performance, check_positive_scalar
 from ..errors import InfeasibleError
 from ..plant import Plant
+from ..regions import Region, as_regions, describe_regions
+from ..uncertainty import NormBounded
 from . import _tolerances as tol
 
-__all__ = ["Problem", "validate", "check_vertices", "check_stabilisable"]
+__all__ = ["Problem", "validate", "check_vertices", "check_stabilisable", "check_poles_reachable",
+           "check_uncertainty", "check_backoff", "immovable_mode"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -22,7 +25,10 @@ class Problem:
     """What :func:`robustctl.hinf` was asked, checked: plants, channels and options.
 
     ``plants`` is ``(plant, *vertices)``; ``u_max`` is ``None`` or one bound
-    per input; ``w_energy`` is set exactly when ``u_max`` is.
+    per input; ``w_energy`` is set exactly when ``u_max`` is; ``regions`` the
+    pole regions (their intersection; empty for none); ``uncertainty`` a
+    :class:`~robustctl.NormBounded` with ``dF, dG`` not identically zero, or
+    ``None``.
     """
 
     plants: tuple[Plant, ...]
@@ -36,6 +42,8 @@ class Problem:
     backoff: float
     extended: bool
     solver: str
+    regions: tuple[Region, ...] = ()
+    uncertainty: NormBounded | None = None
 
     @property
     def discrete(self) -> bool:
@@ -52,7 +60,11 @@ class Problem:
         else:
             what = (f"no common {'slack matrix' if self.extended else 'Lyapunov matrix'} and gain satisfy the "
                     f"H-infinity LMI at all {len(self.plants)} vertices"
-                    + ("" if self.extended else " (try extended=True)"))
+                    + ("" if self.extended or self.regions or self.uncertainty else " (try extended=True)"))
+        if self.uncertainty is not None:
+            what += " for every ||Delta|| <= 1 of the norm-bounded uncertainty (S-procedure)"
+        if self.regions:
+            what += f" with every closed-loop pole in {describe_regions(self.regions)} (the same Lyapunov matrix)"
         if self.u_max is not None:
             what += (f" together with |u_j| <= u_max = {self.u_max.tolist()} for every disturbance of energy "
                      f"{self.w_energy:g} (the input bound may be too tight for this disturbance energy)")
@@ -60,7 +72,7 @@ class Problem:
 
 
 def validate(plant, *, Bw, Cz, Dzu, Dzw, vertices, gamma, u_max, w_energy, backoff, extended,
-             solver) -> Problem:
+             solver, poles=None, uncertainty=None) -> Problem:
     """Check every argument of :func:`robustctl.hinf` (errors name the argument) and stabilisability."""
     if not isinstance(plant, Plant):
         raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
@@ -73,17 +85,42 @@ def validate(plant, *, Bw, Cz, Dzu, Dzw, vertices, gamma, u_max, w_energy, backo
         w_energy = 1.0 if w_energy is None else check_positive_scalar(w_energy, "w_energy")
     elif w_energy is not None:
         raise ValueError("w_energy is only used together with u_max; give u_max or drop w_energy")
-    if isinstance(backoff, bool) or not isinstance(backoff, numbers.Real) or not np.isfinite(backoff) \
-            or backoff < 0:
-        raise ValueError(f"backoff must be a finite number >= 0, got {backoff!r}")
+    backoff = check_backoff(backoff)
     if not isinstance(extended, (bool, np.bool_)):
         raise TypeError(f"extended must be a bool, got {type(extended).__name__}")
     if extended and not plant.is_discrete:
         raise ValueError("extended=True is the discrete-time slack-variable LMI; plant is continuous-time (dt=None)")
     solver = _cvx.check_solver(solver)
+    regions = as_regions(poles)
+    uncertainty = check_uncertainty(uncertainty, plant)
+    for name, given in (("poles", regions), ("uncertainty", uncertainty)):
+        if extended and given:
+            raise ValueError(f"{name} is supported with the standard LMI only; drop {name} or use extended=False")
     check_stabilisable(plants)
+    check_poles_reachable(plants, regions)
     return Problem(plants=tuple(plants), Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, gamma=gamma, u_max=u_max,
-                   w_energy=w_energy, backoff=float(backoff), extended=bool(extended), solver=solver)
+                   w_energy=w_energy, backoff=float(backoff), extended=bool(extended), solver=solver,
+                   regions=regions, uncertainty=uncertainty)
+
+
+def check_uncertainty(uncertainty, plant: Plant) -> NormBounded | None:
+    """A NormBounded of the plant's size; ``None`` if absent or if ``H = 0`` or ``[EF EG] = 0`` (no uncertainty)."""
+    if uncertainty is None:
+        return None
+    if not isinstance(uncertainty, NormBounded):
+        raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
+    uncertainty.check_plant(plant)
+    if not np.any(uncertainty.H) or not (np.any(uncertainty.EF) or np.any(uncertainty.EG)):
+        return None  # dF = dG = 0 exactly: the nominal design (the S-procedure multiplier would be unbounded)
+    return uncertainty
+
+
+def check_backoff(backoff) -> float:
+    """A finite real ``>= 0``."""
+    if isinstance(backoff, bool) or not isinstance(backoff, numbers.Real) or not np.isfinite(backoff) \
+            or backoff < 0:
+        raise ValueError(f"backoff must be a finite number >= 0, got {backoff!r}")
+    return float(backoff)
 
 
 def check_vertices(plant: Plant, vertices) -> list[Plant]:
@@ -124,20 +161,65 @@ def _check_u_max(u_max, m: int) -> np.ndarray:
     return arr
 
 
+def immovable_mode(plant: Plant, concerned) -> complex | None:
+    """The first eigenvalue ``lambda`` of ``F`` with ``concerned(lambda)`` that the input cannot move (PBH).
+
+    PBH rank test: ``[F - lambda I, G]`` has a smallest singular value of at
+    most ``PBH_RANK * max(1, ||[F G]||)``.
+    """
+    F, G = plant.F, plant.G
+    scale = max(1.0, np.linalg.norm(np.hstack([F, G]), 2))
+    for lam in np.linalg.eigvals(F):
+        if concerned(lam) and \
+                np.linalg.svd(np.hstack([F - lam * np.eye(plant.n), G]), compute_uv=False)[-1] <= tol.PBH_RANK * scale:
+            return complex(lam)
+    return None
+
+
+def _where(i: int) -> str:
+    return "plant" if i == 0 else f"vertices[{i - 1}]"
+
+
 def check_stabilisable(plants: Sequence[Plant]) -> None:
     """PBH test at every unstable eigenvalue of every vertex; plain-English InfeasibleError if it fails."""
     for i, p in enumerate(plants):
-        F, G = p.F, p.G
-        scale = max(1.0, np.linalg.norm(np.hstack([F, G]), 2))
-        for lam in np.linalg.eigvals(F):
-            unstable = abs(lam) >= 1.0 - tol.UNSTABLE_MODE if p.is_discrete else lam.real >= -tol.UNSTABLE_MODE * scale
-            if not unstable:
-                continue
-            smin = np.linalg.svd(np.hstack([F - lam * np.eye(p.n), G]), compute_uv=False)[-1]
-            if smin <= tol.PBH_RANK * scale:
-                where = "plant" if i == 0 else f"vertices[{i - 1}]"
-                kind = "|lambda| >= 1" if p.is_discrete else "Re(lambda) >= 0"
-                raise InfeasibleError(
-                    f"{where} is not stabilisable: its mode lambda = {complex(lam):.6g} ({kind}) cannot be moved "
-                    "by the input G (PBH rank test), so no gain u = K x makes the loop stable and no finite "
-                    "gamma exists")
+        scale = max(1.0, np.linalg.norm(np.hstack([p.F, p.G]), 2))
+        if p.is_discrete:
+            lam = immovable_mode(p, lambda z: abs(z) >= 1.0 - tol.UNSTABLE_MODE)
+        else:
+            lam = immovable_mode(p, lambda s: s.real >= -tol.UNSTABLE_MODE * scale)
+        if lam is not None:
+            kind = "|lambda| >= 1" if p.is_discrete else "Re(lambda) >= 0"
+            raise InfeasibleError(
+                f"{_where(i)} is not stabilisable: its mode lambda = {lam:.6g} ({kind}) cannot be moved "
+                "by the input G (PBH rank test), so no gain u = K x makes the loop stable and no finite "
+                "gamma exists")
+
+
+def check_poles_reachable(plants: Sequence[Plant], regions: Sequence[Region]) -> None:
+    """InfeasibleError with the reason if no gain can place the poles of a vertex in the regions.
+
+    Exact for one plant: the regions and the stability region must meet on
+    the real axis (an open convex set symmetric about it then contains a
+    real interval, where the movable poles can be placed), and every mode
+    outside the regions must be movable by the input (PBH rank test).
+    """
+    if not regions:
+        return
+    discrete = plants[0].is_discrete
+    lo, hi = (-1.0, 1.0) if discrete else (-np.inf, 0.0)
+    for r in regions:
+        a, b = r.real_interval()
+        lo, hi = max(lo, a), min(hi, b)
+    if not lo < hi:
+        stable = "|z| < 1" if discrete else "Re z < 0"
+        raise InfeasibleError(f"the pole regions {describe_regions(regions)} have no point in common with each "
+                              f"other and with the stability region {stable} (none on the real axis), so no gain "
+                              "places every closed-loop pole there")
+    for i, p in enumerate(plants):
+        lam = immovable_mode(p, lambda z: not all(r.contains(z) for r in regions))
+        if lam is not None:
+            raise InfeasibleError(
+                f"{_where(i)}'s mode lambda = {lam:.6g} lies outside the pole region {describe_regions(regions)} "
+                "and cannot be moved by the input G (PBH rank test), so no gain places every closed-loop pole "
+                "there")

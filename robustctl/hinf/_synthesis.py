@@ -24,6 +24,8 @@ from numpy.typing import ArrayLike
 from ..controller import Controller
 from ..errors import ConvergenceError
 from ..plant import Plant
+from ..regions import Region
+from ..uncertainty import NormBounded
 from . import _tolerances as tol
 from ._coordinates import lqr_coordinates, normalised
 from ._gains import Gain, gain_at_level, gain_near_optimum
@@ -59,6 +61,7 @@ class HinfController(Controller):
 def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: ArrayLike | None = None,
          vertices: Sequence[Plant] | None = None, gamma: float | None = None, u_max: ArrayLike | None = None,
          w_energy: float | None = None, backoff: float = 1e-3, extended: bool = False,
+         poles: Region | Sequence[Region] | None = None, uncertainty: NormBounded | None = None,
          solver: str = "CLARABEL") -> HinfController:
     r"""H-infinity state feedback ``u = K x`` by LMI optimisation.
 
@@ -110,6 +113,21 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     extended : bool, default False
         Use the slack-variable condition of de Oliveira et al. (discrete time
         only): less conservative with ``vertices``, equal without.
+    poles : Region or list of Region, optional
+        Pole regions (:mod:`robustctl.regions`: ``Disk``, ``HalfPlane``,
+        ``ConicSector``; a list means their intersection): every pole of
+        ``F + G K`` of every vertex lies in them (Chilali & Gahinet 1996),
+        imposed with the same Lyapunov matrix as the H-infinity bound, so
+        ``gamma_opt`` is the best level *subject to* the regions (a
+        conservative bound: one ``X`` for both). Standard LMI only.
+    uncertainty : NormBounded, optional
+        Robust synthesis for ``[dF dG] = H Delta [EF EG]`` with every
+        ``||Delta||_2 <= 1`` (also time-varying) around every vertex: the
+        bound ``gamma`` then holds for every such plant (quadratic
+        stability and performance, by the S-procedure with one multiplier
+        per vertex; see :mod:`robustctl.hinf`). The convex counterpart of
+        :func:`robustctl.rlqr`. ``H = 0`` or ``[EF EG] = 0`` is the nominal
+        design. Pole regions apply to the nominal vertices. Standard LMI only.
     solver : str, default "CLARABEL"
         cvxpy SDP solver. Clarabel is run with explicit tolerances (1e-8 for
         the level of one plant, 1e-10 with vertices, 1e-7 for centring);
@@ -127,8 +145,9 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         (per-solve diagnostics), ``X`` (Lyapunov matrix; ``P`` of the
         nominal vertex when ``extended``), ``u_bound`` (guaranteed
         ``max |u_j|`` for ``w_energy``, when ``u_max`` is given),
-        ``scaling`` (state balancing), ``lmi``, ``vertices`` and ``backoff``
-        (the value used). Each entry of ``solves`` has the solver's
+        ``scaling`` (state balancing), ``lmi``, ``vertices``, ``backoff``
+        (the value used), ``poles`` (the regions), ``uncertainty`` and, with
+        one, ``multipliers`` (the S-procedure multipliers). Each entry of ``solves`` has the solver's
         ``status``, ``value``, ``tol``, ``solve_time``, ``iterations`` and
         ``certificate``; centring solves also name their ``centring`` variant.
 
@@ -136,7 +155,10 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     ------
     InfeasibleError
         A vertex is not stabilisable, the fixed ``gamma`` or the input bound
-        cannot be met, or no common Lyapunov matrix exists for the vertices.
+        cannot be met, no common Lyapunov matrix exists for the vertices (or
+        the uncertainty), or the pole regions cannot be reached (the reason:
+        regions without a common stable point, a mode outside them that the
+        input cannot move, or no common Lyapunov matrix).
     ValueError, TypeError
         Bad arguments (named in the message).
 
@@ -146,10 +168,11 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     >>> ctrl.gamma, ctrl.info["gamma_opt"]                       # doctest: +SKIP
     """
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
-                       w_energy=w_energy, backoff=backoff, extended=extended, solver=solver)
+                       w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
+                       uncertainty=uncertainty)
     w_scale = float(np.sqrt(problem.w_energy)) if problem.u_max is not None else 1.0
     balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
-                          problem.Dzu, problem.Dzw, w_scale)
+                          problem.Dzu, problem.Dzw, w_scale, problem.uncertainty)
     lqr = None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
     if problem.gamma is not None:
         gain, solves = gain_at_level(problem, lqr or balanced, problem.gamma)
@@ -159,21 +182,29 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         gain, used_backoff, centring = gain_near_optimum(problem, opt)
         level, gamma_opt, solves = opt.gamma_opt * (1.0 + used_backoff), opt.gamma_opt, opt.solves + centring
     K, X = gain.data.to_original(gain.point.gain(), gain.point.nominal_lyapunov())
-    check_closed_loop(K, problem.plants)
+    check_closed_loop(K, problem.plants, problem.regions)
     info = _info(problem, gain, K, X, level, gamma_opt, used_backoff, solves)
     return HinfController(K=K, method="hinf", plant=plant, info=info, gamma=float(level), gamma_opt=gamma_opt)
 
 
-def check_closed_loop(K: np.ndarray, plants) -> None:
-    """ConvergenceError unless ``K`` is finite and stabilises every vertex (an internal check)."""
+def check_closed_loop(K: np.ndarray, plants, regions: Sequence[Region] = ()) -> None:
+    """ConvergenceError unless ``K`` is finite and stabilises every vertex with its poles in the regions.
+
+    An internal check of the returned gain (the LMI certificate implies both).
+    """
     if not np.all(np.isfinite(K)):
         raise ConvergenceError("the gain K = Y X^-1 is not finite; increase backoff")
     for i, p in enumerate(plants):
         poles = np.linalg.eigvals(p.F + p.G @ K)
         stable = np.max(np.abs(poles)) < 1 if p.is_discrete else np.max(poles.real) < 0
+        where = "plant" if i == 0 else f"vertices[{i - 1}]"
         if not stable:
-            raise ConvergenceError(f"internal check failed: the LMI gain does not stabilise "
-                                   f"{'plant' if i == 0 else f'vertices[{i - 1}]'}; increase backoff")
+            raise ConvergenceError(f"internal check failed: the LMI gain does not stabilise {where}; "
+                                   "increase backoff")
+        for r in regions:
+            if not np.all(r.contains(poles)):
+                raise ConvergenceError(f"internal check failed: a closed-loop pole of {where} lies outside {r!r} "
+                                       f"(poles {np.round(poles, 6).tolist()}); increase backoff")
 
 
 def guaranteed_input_bound(gain: Gain) -> np.ndarray:
@@ -192,8 +223,10 @@ def _info(problem: Problem, gain: Gain, K, X, level, gamma_opt, backoff, solves)
         "iterations": int(sum(s["iterations"] or 0 for s in solves)),
         "certificate": gain.certificate, "gain_from": gain.route, "X_min_eig": float(np.linalg.eigvalsh(Xs).min()),
         "margin": float(gain.margin), "solves": list(solves), "X": Xs, "scaling": gain.data.balancing,
-        "solver": problem.solver,
+        "solver": problem.solver, "poles": problem.regions, "uncertainty": problem.uncertainty,
     }
+    if problem.uncertainty is not None:
+        info["multipliers"] = gain.point.eps   # S-procedure multipliers (solver coordinates)
     if problem.u_max is not None:
         u_bound = guaranteed_input_bound(gain)
         info.update(u_bound=u_bound, u_max=problem.u_max, w_energy=problem.w_energy)
