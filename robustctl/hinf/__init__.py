@@ -50,6 +50,30 @@ hull (storage ``x' P(a)^-1 x`` with ``P(a) = sum a_i P_i``). The input bound
 then uses ``[[u_max_j^2/E, l_j], [l_j', S + S' - P_i]] >= 0`` at each vertex
 (``S + S' - P <= S' P^-1 S``).
 
+Robust synthesis (``uncertainty=NormBounded(H, EF, EG)``): every plant
+``(F + H Delta EF, G + H Delta EG)`` with ``||Delta|| <= 1`` (also
+time-varying). With ``q = (EF + EG K) x`` and ``p = Delta q`` the loop is
+the nominal one with an extra input ``H p`` and ``|p| <= |q|``; the
+S-procedure (a multiplier ``eps > 0``, one per vertex; equivalently the
+scaled small-gain theorem) adds ``eps (|q|^2 - |p|^2) >= 0`` to the storage
+inequality. In the gamma^2 form, with ``E X = EF X + EG Y`` (Xie, Fu & de
+Souza 1992; Boyd et al. 1994, Sec. 7.5)::
+
+    [ X - eps H H'   A X + G Y   Bw   0               0       ]
+    [ *              X           0    (Cz X + Dzu Y)' (E X)'  ]
+    [ *              *           I    Dzw'            0       ]  > 0     (discrete)
+    [ *              *           *    gamma^2 I       0       ]
+    [ *              *           *    *               eps I   ]
+
+(continuous: ``He(F X + G Y) + eps H H'`` in the bounded-real LMI, with the
+extra row ``[E X, 0, 0, -eps I]``). Linear in ``(X, Y, gamma^2, eps)``: the
+convex counterpart of the RLQR (:func:`robustctl.rlqr`), whose penalty
+parameter plays the part of ``1 / eps``.
+
+Pole regions (``poles=Disk(...)``, :mod:`robustctl.regions`): the LMI
+``M_D(F X + G Y, X) < 0`` of Chilali & Gahinet (1996) at every vertex, with
+the same ``X`` as the H-infinity bound.
+
 Numerics
 --------
 The synthesis is a sequence of pure stages (:mod:`robustctl.hinf._synthesis`
@@ -97,6 +121,10 @@ stability condition", Systems & Control Letters 37, 1999.
 M. C. de Oliveira, J. C. Geromel, J. Bernussou, "Extended H2 and H-infinity
 norm characterizations and controller parametrizations for discrete-time
 systems", Int. J. Control 75(9), 2002.
+L. Xie, M. Fu, C. E. de Souza, "H-infinity control and quadratic stabilization of systems with
+parameter uncertainty via output feedback", IEEE TAC 37(8), 1992.
+M. Chilali, P. Gahinet, "H-infinity design with pole placement constraints: an LMI approach",
+IEEE TAC 41(3), 1996.
 P. Gahinet, P. Apkarian, "A linear matrix inequality approach to
 H-infinity control", Int. J. Robust Nonlinear Control 4, 1994.
 """
