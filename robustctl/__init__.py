@@ -18,6 +18,8 @@ from .lqr import lqr
 from .plant import Plant
 from .rlqr import RLQRBatch, rlqr, rlqr_gains
 from .uncertainty import NormBounded
+from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guaranteed_cost, robust_hinf_bound,
+                       robust_stability, worst_case)
 
 
 __all__ = [
@@ -26,4 +28,6 @@ __all__ = [
     "h2", "H2Controller", "Disk", "HalfPlane", "ConicSector",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError",
 ]
+__all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
+            "RobustStability", "CostBound", "HinfBound", "WorstCase"]
 __version__ = "0.1.0"

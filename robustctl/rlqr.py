@@ -44,7 +44,7 @@ closed loop is ``L``. The fixed point ``P = f(P)`` is found either by
 iterating ``f`` from ``P = Q`` (or ``P_N``) - the paper's recursion,
 ``accelerate=False`` - or, much faster, by the structure-preserving doubling
 algorithm on that Riccati equation written without cross terms (Woodbury
-again keeps it finite for every ``mu``; see :func:`_sda`), which converges
+again keeps it finite for every ``mu``; see ``_sda``), which converges
 quadratically (about 10 doubling steps where the recursion takes hundreds).
 Either way the result is accepted only when one more step of the recursion
 changes ``P`` by less than ``tol`` (relative, Frobenius norm) and ``L`` is

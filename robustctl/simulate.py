@@ -47,7 +47,7 @@ __all__ = ["SimulationResult", "simulate", "simulate_linear", "DEFAULT_INITIAL_E
 #: Initial path-following error of :func:`simulate`: the truck starts 1 m to the
 #: left of the path, parallel to it, at steady speed ([ydot, psidot, rho, theta]).
 DEFAULT_INITIAL_ERROR = (0.0, 0.0, 1.0, 0.0)
-#: Divergence bound on |x - x_ref| (any component), in the states' units.
+#: Divergence bound on ``|x - x_ref|`` (any component), in the states' units.
 DEFAULT_BOUND = 1e3
 
 
