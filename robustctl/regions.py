@@ -31,18 +31,18 @@ from typing import Sequence
 
 import numpy as np
 
+from ._validation import check_positive_scalar
+
 __all__ = ["Region", "Disk", "HalfPlane", "ConicSector", "as_regions", "describe_regions", "region_lmi"]
 
 
-def _real(value, name: str, *, positive: bool = False) -> float:
+def _real(value, name: str) -> float:
+    """A finite real number (``bool`` refused); positive ones go through ``check_positive_scalar``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {x}")
-    if positive and x <= 0:
-        raise ValueError(f"{name} must be > 0, got {x}")
-    return x
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite, got {value}")
+    return float(value)
 
 
 class Region:
@@ -79,7 +79,7 @@ class Disk(Region):
 
     def __post_init__(self):
         object.__setattr__(self, "center", _real(self.center, "center"))
-        object.__setattr__(self, "radius", _real(self.radius, "radius", positive=True))
+        object.__setattr__(self, "radius", check_positive_scalar(self.radius, "radius"))
 
     @property
     def L(self) -> np.ndarray:

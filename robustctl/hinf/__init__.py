@@ -77,7 +77,7 @@ the same ``X`` as the H-infinity bound.
 Numerics
 --------
 The synthesis is a sequence of pure stages (:mod:`robustctl.hinf._synthesis`
-lists them; every tolerance is named in :mod:`robustctl.hinf._tolerances`):
+lists them; every tolerance is named in ``robustctl.hinf._tolerances``):
 
 * Coordinates (:mod:`._coordinates`): states balanced (SLICOT ``TB01ID``)
   and scaled so that ``||Bw|| = 1``; ``w`` scaled to unit energy when

@@ -147,9 +147,10 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         ``max |u_j|`` for ``w_energy``, when ``u_max`` is given),
         ``scaling`` (state balancing), ``lmi``, ``vertices``, ``backoff``
         (the value used), ``poles`` (the regions), ``uncertainty`` and, with
-        one, ``multipliers`` (the S-procedure multipliers). Each entry of ``solves`` has the solver's
-        ``status``, ``value``, ``tol``, ``solve_time``, ``iterations`` and
-        ``certificate``; centring solves also name their ``centring`` variant.
+        one, ``multipliers`` (the S-procedure multipliers). Each entry of
+        ``solves`` has the solver's ``status``, ``value``, ``tol``,
+        ``solve_time``, ``iterations`` and ``certificate``; centring solves
+        also name their ``centring`` variant.
 
     Raises
     ------
