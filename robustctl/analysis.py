@@ -104,7 +104,7 @@ from . import _cvx
 from ._validation import as_batch, as_matrix, check_performance, check_spd
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
-from .plant import Plant, _frozen
+from .plant import Plant, _frozen, check_vertices
 from .uncertainty import NormBounded
 
 __all__ = ["RobustStability", "CostBound", "HinfBound", "WorstCase",
@@ -279,21 +279,6 @@ def _uncertainty(uncertainty, plant: Plant) -> NormBounded:
         raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
     uncertainty.check_plant(plant)
     return uncertainty
-
-
-def _vertices(plant: Plant, vertices) -> list[Plant]:
-    if isinstance(vertices, Plant) or not isinstance(vertices, Sequence) or len(vertices) == 0:
-        raise TypeError("vertices must be a non-empty list of robustctl.Plant")
-    for i, v in enumerate(vertices):
-        if not isinstance(v, Plant):
-            raise TypeError(f"vertices[{i}] must be a robustctl.Plant, got {type(v).__name__}")
-        if (v.n, v.m) != (plant.n, plant.m):
-            raise ValueError(f"vertices[{i}] must have n={plant.n} states and m={plant.m} inputs like the "
-                             f"controller's plant, got n={v.n}, m={v.m}")
-        if v.dt != plant.dt:
-            raise ValueError(f"vertices[{i}] must have the sampling time of the controller's plant "
-                             f"(dt={plant.dt}), got dt={v.dt}")
-    return [plant, *vertices]
 
 
 # ---------------------------------------------------------------- linear algebra
@@ -548,7 +533,9 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
     if (uncertainty is None) == (vertices is None):
         raise ValueError("give exactly one of uncertainty (a NormBounded) and vertices (a list of Plant)")
     if vertices is not None:
-        return _polytope_stability(_vertices(plant, vertices), K)
+        # a polytope needs a vertex besides the nominal plant
+        return _polytope_stability(check_vertices(plant, vertices, reference="the controller's plant",
+                                                  non_empty=True), K)
     return _norm_bounded_stability(plant, K, _uncertainty(uncertainty, plant))
 
 

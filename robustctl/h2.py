@@ -56,9 +56,9 @@ from .errors import ConvergenceError, InfeasibleError
 from .hinf import _tolerances as tol
 from .hinf._coordinates import Coordinates, normalised, recentred
 from .hinf._lmis import Point, region_blocks, variables
-from .hinf._problem import check_backoff, check_poles_reachable, check_stabilisable, check_vertices
+from .hinf._problem import check_backoff, check_poles_reachable, check_stabilisable
 from .hinf._synthesis import check_closed_loop
-from .plant import Plant
+from .plant import Plant, check_vertices
 from .regions import Region, as_regions, describe_regions
 
 __all__ = ["h2", "H2Controller"]

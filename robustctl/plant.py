@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -10,7 +11,7 @@ import numpy as np
 from ._validation import as_matrix, check_choice, check_positive_scalar, check_square
 from .stability import unstabilizable_modes
 
-__all__ = ["Plant"]
+__all__ = ["Plant", "check_plant", "check_vertices"]
 
 _METHODS = ("zoh", "tustin", "euler")
 
@@ -141,3 +142,36 @@ class Plant:
     def __repr__(self) -> str:
         time = "continuous" if self.dt is None else f"dt={self.dt:g}"
         return f"Plant(n={self.n}, m={self.m}, {time})"
+
+
+def check_plant(value, name: str = "plant") -> Plant:
+    """``value`` if it is a :class:`Plant`, else ``TypeError`` naming ``name``."""
+    if not isinstance(value, Plant):
+        raise TypeError(f"{name} must be a robustctl.Plant, got {type(value).__name__}")
+    return value
+
+
+def check_vertices(plant: Plant, vertices, *, reference: str = "plant", non_empty: bool = False) -> list[Plant]:
+    """``[plant, *vertices]`` after checking that every vertex is a :class:`Plant` of ``plant``'s size and ``dt``.
+
+    The vertices of a polytope ``conv{plant, *vertices}`` (e.g. the ``vertices``
+    of :func:`robustctl.hinf` and :func:`robustctl.robust_stability`).
+    ``vertices=None`` (and, unless ``non_empty``, an empty list) is the plant
+    alone. ``reference`` names ``plant`` in the messages. ``TypeError`` for
+    anything but a list (or tuple) of plants, ``ValueError`` naming
+    ``vertices[i]`` for a size or sampling time that differs from ``plant``'s.
+    """
+    if vertices is None and not non_empty:
+        return [plant]
+    if isinstance(vertices, Plant) or not isinstance(vertices, Sequence) or isinstance(vertices, (str, bytes)) \
+            or (non_empty and len(vertices) == 0):
+        raise TypeError(f"vertices must be a {'non-empty ' if non_empty else ''}list of robustctl.Plant")
+    for i, v in enumerate(vertices):
+        check_plant(v, f"vertices[{i}]")
+        if (v.n, v.m) != (plant.n, plant.m):
+            raise ValueError(f"vertices[{i}] must have n={plant.n} states and m={plant.m} inputs like {reference}, "
+                             f"got n={v.n}, m={v.m}")
+        if v.dt != plant.dt:
+            raise ValueError(f"vertices[{i}] must have the sampling time of {reference} (dt={plant.dt}), "
+                             f"got dt={v.dt}")
+    return [plant, *vertices]

@@ -8,6 +8,7 @@ so are nested lists of unequal lengths. See each function's docstring.
 
 from ._validation import (as_batch, as_float_array, as_matrix, check_bool, check_choice, check_int,
                           check_positive_scalar, check_spd, check_square)
+from .plant import check_plant, check_vertices
 
 __all__ = ["as_float_array", "as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
-           "check_int", "check_bool", "check_choice"]
+           "check_int", "check_bool", "check_choice", "check_plant", "check_vertices"]

@@ -11,12 +11,12 @@ import numpy as np
 from .. import _cvx
 from .._validation import check_performance, check_positive_scalar
 from ..errors import InfeasibleError
-from ..plant import Plant
+from ..plant import Plant, check_vertices
 from ..regions import Region, as_regions, describe_regions
 from ..uncertainty import NormBounded
 from . import _tolerances as tol
 
-__all__ = ["Problem", "validate", "check_vertices", "check_stabilisable", "check_poles_reachable",
+__all__ = ["Problem", "validate", "check_stabilisable", "check_poles_reachable",
            "check_uncertainty", "check_backoff", "immovable_mode"]
 
 
@@ -121,25 +121,6 @@ def check_backoff(backoff) -> float:
             or backoff < 0:
         raise ValueError(f"backoff must be a finite number >= 0, got {backoff!r}")
     return float(backoff)
-
-
-def check_vertices(plant: Plant, vertices) -> list[Plant]:
-    """``[plant] + vertices`` after checking that every vertex is a Plant of the same size and dt."""
-    plants = [plant]
-    if vertices is None:
-        return plants
-    if isinstance(vertices, Plant) or not isinstance(vertices, Sequence):
-        raise TypeError("vertices must be a list of robustctl.Plant")
-    for i, v in enumerate(vertices):
-        if not isinstance(v, Plant):
-            raise TypeError(f"vertices[{i}] must be a robustctl.Plant, got {type(v).__name__}")
-        if (v.n, v.m) != (plant.n, plant.m):
-            raise ValueError(f"vertices[{i}] must have n={plant.n} states and m={plant.m} inputs like plant, "
-                             f"got n={v.n}, m={v.m}")
-        if v.dt != plant.dt:
-            raise ValueError(f"vertices[{i}] must have the sampling time of plant (dt={plant.dt}), got dt={v.dt}")
-        plants.append(v)
-    return plants
 
 
 def _check_u_max(u_max, m: int) -> np.ndarray:
