@@ -28,6 +28,14 @@ def _frozen_complex(arr: np.ndarray) -> np.ndarray:
     return arr
 
 
+def _singular(M: np.ndarray, scale: float) -> bool:
+    """``M`` is singular up to the rounding of forming it from terms of norm ``scale``:
+    smallest singular value at most ``n eps scale`` (or ``M`` not finite)."""
+    if not np.all(np.isfinite(M)):
+        return True
+    return bool(np.linalg.svd(M, compute_uv=False)[-1] <= M.shape[0] * np.finfo(float).eps * scale)
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class Plant:
     """A state-space plant without outputs.
@@ -91,7 +99,9 @@ class Plant:
 
         ``method`` is ``"zoh"`` (exact for piecewise-constant inputs, via
         python-control's ``c2d``), ``"tustin"`` (bilinear; needs ``I - A dt/2``
-        invertible, i.e. no eigenvalue of ``A`` at ``2/dt``) or ``"euler"``
+        invertible, i.e. no eigenvalue of ``A`` at ``2/dt``, up to the
+        rounding of forming it: smallest singular value above
+        ``n eps (1 + ||A|| dt/2)``) or ``"euler"``
         (forward Euler, ``F = I + A dt``, ``G = B dt``). ``dt=None`` keeps the
         plant in continuous time. ``ValueError`` naming ``A`` if ``A dt`` is
         too large for the discrete plant to be finite.
@@ -107,7 +117,7 @@ class Plant:
             if method == "euler":
                 F, G = np.eye(n) + A * dt, B * dt
             else:
-                if method == "tustin" and not np.linalg.cond(np.eye(n) - A * (dt / 2)) < 1 / np.finfo(float).eps:
+                if method == "tustin" and _singular(np.eye(n) - A * (dt / 2), 1.0 + np.linalg.norm(A, 2) * dt / 2):
                     raise ValueError(f"method='tustin' needs I - A dt/2 invertible, but A has an eigenvalue at "
                                      f"2/dt = {2 / dt:g} (dt={dt:g}); use method='zoh' or another dt")
                 import control

@@ -3,7 +3,7 @@ never a NaN, a hang or an exception from deep inside numpy."""
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import robustctl as rc
@@ -309,6 +309,7 @@ def test_unstabilisable_plants_raise_in_every_design_and_flag_in_the_batch(seed,
 
 @SETTINGS
 @given(dt=st.floats(0.01, 1.0), other=st.floats(-5.0, 5.0), scale=st.floats(1e200, 1e300))
+@example(dt=0.8585158091592887, other=2.0, scale=1e200)  # I - A dt/2 = diag(eps/2, 0.14): cond 1.3e15 < 1/eps
 def test_discretisation_failures_name_A(dt, other, scale):
     """Cause 6 (tustin with I - A dt/2 singular) and 5 (A dt overflowing is A's fault, not F's)."""
     A = np.diag([2.0 / dt, other])
