@@ -126,7 +126,8 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     Raises
     ------
     InfeasibleError
-        A vertex is not stabilisable, the pole regions cannot be reached
+        A vertex is not stabilisable (:class:`~robustctl.errors.NotStabilizableError`,
+        an ``InfeasibleError``), the pole regions cannot be reached
         (with the reason), or no common Lyapunov matrix exists.
     ValueError, TypeError
         Bad arguments (named in the message).

@@ -95,7 +95,7 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     ------
     NotStabilizableError
         ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`);
-        ``rlqr`` raises the same, ``hinf`` an ``InfeasibleError`` (which this error also is).
+        ``rlqr``, ``hinf`` and ``h2`` raise the same (it is also an ``InfeasibleError``).
     ConvergenceError
         No backend solves the Riccati equation (e.g. ``(F, Q)`` not detectable).
     """

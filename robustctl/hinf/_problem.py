@@ -13,11 +13,11 @@ from .._validation import check_performance, check_positive_scalar
 from ..errors import InfeasibleError
 from ..plant import Plant, check_vertices
 from ..regions import Region, as_regions, describe_regions
+from ..stability import check_stabilizable, immovable_modes
 from ..uncertainty import NormBounded
-from . import _tolerances as tol
 
 __all__ = ["Problem", "validate", "check_stabilisable", "check_poles_reachable",
-           "check_uncertainty", "check_backoff", "immovable_mode"]
+           "check_uncertainty", "check_backoff"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -142,39 +142,14 @@ def _check_u_max(u_max, m: int) -> np.ndarray:
     return arr
 
 
-def immovable_mode(plant: Plant, concerned) -> complex | None:
-    """The first eigenvalue ``lambda`` of ``F`` with ``concerned(lambda)`` that the input cannot move (PBH).
-
-    PBH rank test: ``[F - lambda I, G]`` has a smallest singular value of at
-    most ``PBH_RANK * max(1, ||[F G]||)``.
-    """
-    F, G = plant.F, plant.G
-    scale = max(1.0, np.linalg.norm(np.hstack([F, G]), 2))
-    for lam in np.linalg.eigvals(F):
-        if concerned(lam) and \
-                np.linalg.svd(np.hstack([F - lam * np.eye(plant.n), G]), compute_uv=False)[-1] <= tol.PBH_RANK * scale:
-            return complex(lam)
-    return None
-
-
 def _where(i: int) -> str:
     return "plant" if i == 0 else f"vertices[{i - 1}]"
 
 
 def check_stabilisable(plants: Sequence[Plant]) -> None:
-    """PBH test at every unstable eigenvalue of every vertex; plain-English InfeasibleError if it fails."""
+    """:func:`robustctl.stability.check_stabilizable` at every vertex (``NotStabilizableError``, an InfeasibleError)."""
     for i, p in enumerate(plants):
-        scale = max(1.0, np.linalg.norm(np.hstack([p.F, p.G]), 2))
-        if p.is_discrete:
-            lam = immovable_mode(p, lambda z: abs(z) >= 1.0 - tol.UNSTABLE_MODE)
-        else:
-            lam = immovable_mode(p, lambda s: s.real >= -tol.UNSTABLE_MODE * scale)
-        if lam is not None:
-            kind = "|lambda| >= 1" if p.is_discrete else "Re(lambda) >= 0"
-            raise InfeasibleError(
-                f"{_where(i)} is not stabilisable: its mode lambda = {lam:.6g} ({kind}) cannot be moved "
-                "by the input G (PBH rank test), so no gain u = K x makes the loop stable and no finite "
-                "gamma exists")
+        check_stabilizable(p, _where(i))
 
 
 def check_poles_reachable(plants: Sequence[Plant], regions: Sequence[Region]) -> None:
@@ -183,7 +158,8 @@ def check_poles_reachable(plants: Sequence[Plant], regions: Sequence[Region]) ->
     Exact for one plant: the regions and the stability region must meet on
     the real axis (an open convex set symmetric about it then contains a
     real interval, where the movable poles can be placed), and every mode
-    outside the regions must be movable by the input (PBH rank test).
+    outside the regions must be movable by the input (PBH rank test,
+    :func:`robustctl.stability.immovable_modes`).
     """
     if not regions:
         return
@@ -198,9 +174,9 @@ def check_poles_reachable(plants: Sequence[Plant], regions: Sequence[Region]) ->
                               f"other and with the stability region {stable} (none on the real axis), so no gain "
                               "places every closed-loop pole there")
     for i, p in enumerate(plants):
-        lam = immovable_mode(p, lambda z: not all(r.contains(z) for r in regions))
-        if lam is not None:
+        stuck = immovable_modes(p.F, p.G, lambda z: ~np.all([r.contains(z) for r in regions], axis=0))
+        if stuck.size:
             raise InfeasibleError(
-                f"{_where(i)}'s mode lambda = {lam:.6g} lies outside the pole region {describe_regions(regions)} "
-                "and cannot be moved by the input G (PBH rank test), so no gain places every closed-loop pole "
+                f"{_where(i)}'s mode lambda = {complex(stuck[0]):.6g} lies outside the pole region "
+                f"{describe_regions(regions)} and cannot be moved by the input G (PBH rank test), so no gain places every closed-loop pole "
                 "there")

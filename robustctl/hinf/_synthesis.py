@@ -155,7 +155,8 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     Raises
     ------
     InfeasibleError
-        A vertex is not stabilisable, the fixed ``gamma`` or the input bound
+        A vertex is not stabilisable (:class:`~robustctl.errors.NotStabilizableError`,
+        an ``InfeasibleError``), the fixed ``gamma`` or the input bound
         cannot be met, no common Lyapunov matrix exists for the vertices (or
         the uncertainty), or the pole regions cannot be reached (the reason:
         regions without a common stable point, a mode outside them that the

@@ -72,8 +72,8 @@ equal to the LQR as ``mu -> inf``. With ``EF = EG = 0`` and ``H != 0``,
 Errors. :func:`rlqr` raises :class:`~robustctl.errors.NotStabilizableError`
 for a plant that is not stabilisable (PBH test,
 :func:`robustctl.stability.check_stabilizable`), as :func:`robustctl.lqr`
-does; :func:`robustctl.hinf` raises an ``InfeasibleError`` with the same
-message, and ``NotStabilizableError`` is one too. Without the check the
+does, and so do :func:`robustctl.hinf` and :func:`robustctl.h2`
+(``NotStabilizableError`` is also an ``InfeasibleError``). Without the check the
 recursion would not fail: for finite ``mu`` the fictitious input ``v``
 "stabilises" ``L`` while no ``K`` stabilises ``F + G K``.
 :func:`rlqr_gains` flags every design ``"unstabilizable"`` instead.
@@ -334,8 +334,8 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     Raises
     ------
     NotStabilizableError
-        ``(F, G)`` is not stabilisable; :func:`robustctl.lqr` raises the same,
-        :func:`robustctl.hinf` an ``InfeasibleError`` (which this error also is).
+        ``(F, G)`` is not stabilisable; :func:`robustctl.lqr`, :func:`robustctl.hinf`
+        and :func:`robustctl.h2` raise the same (it is also an ``InfeasibleError``).
     RankConditionError
         ``mu = inf`` and ``EG`` is not of full row rank (``[I -G; 0 -EG]`` is
         then not of full row rank and ``EF + EG K = 0`` may have no solution).
