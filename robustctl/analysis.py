@@ -105,6 +105,7 @@ from ._validation import as_batch, as_matrix, check_performance, check_spd
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .plant import Plant, _frozen, check_vertices
+from .stability import is_stable, spectral_abscissa, spectral_radius
 from .uncertainty import NormBounded
 
 __all__ = ["RobustStability", "CostBound", "HinfBound", "WorstCase",
@@ -243,7 +244,10 @@ class WorstCase:
         Spectral radius (discrete) or spectral abscissa (largest real part,
         continuous) of ``A + H Delta E``.
     destabilizing : bool
-        ``radius >= 1`` (discrete) or ``radius >= 0`` (continuous).
+        The loop at ``Delta`` is not stable in the sense of
+        :mod:`robustctl.stability`: ``radius >= 1 - STABILITY_MARGIN``
+        (discrete) or ``radius >= -STABILITY_MARGIN`` (continuous), as
+        ``not Controller.is_stabilizing``.
     nominal_radius : float
         The same for ``Delta = 0``.
     evaluations : int
@@ -284,12 +288,7 @@ def _uncertainty(uncertainty, plant: Plant) -> NormBounded:
 # ---------------------------------------------------------------- linear algebra
 def _radius(A: np.ndarray, discrete: bool) -> float:
     """Spectral radius (discrete) or spectral abscissa (continuous)."""
-    lam = np.linalg.eigvals(A)
-    return float(np.max(np.abs(lam)) if discrete else np.max(lam.real))
-
-
-def _stable(A: np.ndarray, discrete: bool) -> bool:
-    return _radius(A, discrete) < (1.0 if discrete else 0.0)
+    return float(spectral_radius(A) if discrete else spectral_abscissa(A))
 
 
 def _lyapunov_factor(A: np.ndarray, Q: np.ndarray, discrete: bool) -> np.ndarray:
@@ -381,7 +380,7 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     H, E = unc.H, unc.EF + unc.EG @ K
     n, p = H.shape
     nominal = _radius(A, discrete)
-    if not _stable(A, discrete):
+    if not is_stable(A, discrete=discrete):
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
                                MappingProxyType({"nominal_radius": nominal}))
     e = float(np.linalg.norm(E, 2))
@@ -430,7 +429,7 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
     D = [p.F + p.G @ K - A0 for p in plants]
     n = A0.shape[0]
     nominal = _radius(A0, discrete)
-    if not _stable(A0, discrete):
+    if not is_stable(A0, discrete=discrete):
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "polytope",
                                MappingProxyType({"nominal_radius": nominal}))
     T = _Coordinates(_lyapunov_factor(A0, np.eye(n), discrete))
@@ -440,7 +439,7 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
 
     def feasible(r: float):
         """``P^`` with every scaled vertex's Lyapunov block >= t I, P^ >= t I, P^ <= I and t > 0, or None."""
-        if any(not _stable(A0 + r * Di, discrete) for Di in D):
+        if any(not is_stable(A0 + r * Di, discrete=discrete) for Di in D):
             return None  # a vertex of the scaled polytope is unstable: no solve needed
         P, t = cp.Variable((n, n), symmetric=True, name="P"), cp.Variable(name="t")
         lmis = [_cvx.LMI(f"vertex[{i}]", _block(Ah0 + r * Di, empty, P, np.zeros((n, n)), discrete), t)
@@ -548,7 +547,7 @@ def _robust_loop(controller, uncertainty, what: str):
     unc = _uncertainty(uncertainty, plant)
     discrete = plant.is_discrete
     A, H, E = plant.F + plant.G @ K, unc.H, unc.EF + unc.EG @ K
-    if not _stable(A, discrete):
+    if not is_stable(A, discrete=discrete):
         kind = "spectral radius" if discrete else "spectral abscissa"
         raise InfeasibleError(f"no {what}: the nominal closed loop F + G K is unstable ({kind} "
                               f"{_radius(A, discrete):.6g})")
@@ -806,7 +805,7 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     if np.any(g0):
         U, s, Vt = np.linalg.svd(g0)
         starts += [_polar(g0), np.outer(U[:, 0], Vt[0])]
-    if _stable(A, discrete) and np.any(H) and np.any(E):
+    if is_stable(A, discrete=discrete) and np.any(H) and np.any(E):
         sys = control.ss(A, H, E, np.zeros((l, p)), plant.dt if discrete else 0)
         _, w = control.linfnorm(sys)
         z = np.exp(1j * w * plant.dt) if discrete else 1j * w
@@ -822,5 +821,6 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
         f, D = _ascend(obj, S)
         if f > best_f:
             best_f, best_D = f, D
-    radius = _radius(A + H @ best_D @ E, discrete)
-    return WorstCase(_frozen(best_D), radius, bool(radius >= (1.0 if discrete else 0.0)), nominal, obj.count)
+    worst = A + H @ best_D @ E
+    return WorstCase(_frozen(best_D), _radius(worst, discrete), not is_stable(worst, discrete=discrete), nominal,
+                     obj.count)

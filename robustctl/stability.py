@@ -5,6 +5,9 @@ when its spectral radius is below ``1 - STABILITY_MARGIN``; a continuous-time
 one (Hurwitz) when every eigenvalue has real part below ``-STABILITY_MARGIN``.
 The margin keeps a loop with a pole on the unit circle up to rounding (an
 integrator left in place, ``rho = 1 - 1e-15``) from counting as stable.
+Every stability decision of :mod:`robustctl` goes through :func:`is_stable`
+or :func:`is_schur_stable` (designs, internal checks of the LMI gains, the
+Riccati reference, the robust analysis and the worst-case search).
 
 A plant ``(F, G)`` is stabilisable when every mode that is not stable can be
 moved by the input: ``rank [F - lambda I, G] = n`` at each eigenvalue
@@ -35,7 +38,8 @@ import numpy as np
 from ._validation import as_float_array, as_matrix, check_square
 from .errors import NotStabilizableError
 
-__all__ = ["STABILITY_MARGIN", "spectral_radius", "is_schur_stable", "is_stable", "immovable_modes",
+__all__ = ["STABILITY_MARGIN", "spectral_radius", "spectral_abscissa", "is_schur_stable", "is_stable",
+           "immovable_modes",
            "unstabilizable_modes", "check_stabilizable"]
 
 #: A discrete loop is stable when ``rho(A) < 1 - STABILITY_MARGIN``.
@@ -57,13 +61,24 @@ def _stack(A, name: str = "A") -> np.ndarray:
     return A
 
 
-def _radius(A: np.ndarray) -> np.ndarray:
-    """Spectral radius of a stack (B, n, n); ``inf`` where an entry is not finite."""
-    rho = np.full(A.shape[0], np.inf)
+def _largest(A: np.ndarray, measure) -> np.ndarray:
+    """``max measure(eig(A))`` of each matrix of a stack (B, n, n); ``inf`` where an entry is not finite."""
+    out = np.full(A.shape[0], np.inf)
     finite = np.isfinite(A).all(axis=(1, 2))
     if finite.any():
-        rho[finite] = np.abs(np.linalg.eigvals(A[finite])).max(axis=1)
-    return rho
+        out[finite] = measure(np.linalg.eigvals(A[finite])).max(axis=1)
+    return out
+
+
+def _radius(A: np.ndarray) -> np.ndarray:
+    """Spectral radius of a stack (B, n, n); ``inf`` where an entry is not finite."""
+    return _largest(A, np.abs)
+
+
+def _per_matrix(A, measure) -> np.ndarray | float:
+    A = _stack(A)
+    out = _largest(A.reshape(-1, *A.shape[-2:]), measure).reshape(A.shape[:-2])
+    return float(out) if out.ndim == 0 else out
 
 
 def spectral_radius(A) -> np.ndarray | float:
@@ -71,9 +86,15 @@ def spectral_radius(A) -> np.ndarray | float:
 
     Non-finite matrices have radius ``inf``. Returns a float for one matrix.
     """
-    A = _stack(A)
-    rho = _radius(A.reshape(-1, *A.shape[-2:])).reshape(A.shape[:-2])
-    return float(rho) if rho.ndim == 0 else rho
+    return _per_matrix(A, np.abs)
+
+
+def spectral_abscissa(A) -> np.ndarray | float:
+    """``max Re eig(A)`` of a matrix (n, n) or of each matrix of a stack (..., n, n) (continuous time).
+
+    Non-finite matrices have abscissa ``inf``. Returns a float for one matrix.
+    """
+    return _per_matrix(A, np.real)
 
 
 def _schur(A: np.ndarray, bound: float) -> np.ndarray:
@@ -115,7 +136,7 @@ def is_stable(A, *, discrete: bool, margin: float = STABILITY_MARGIN) -> bool:
         raise ValueError(f"A must be one square matrix, got shape {A.shape}")
     if discrete:
         return bool(is_schur_stable(A, margin))
-    return bool(np.isfinite(A).all() and np.linalg.eigvals(A).real.max() < -margin)
+    return bool(spectral_abscissa(A) < -margin)
 
 
 def _pair(F, G) -> tuple[np.ndarray, np.ndarray, float]:

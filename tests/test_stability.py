@@ -128,3 +128,39 @@ def test_every_design_raises_not_stabilizable_error_naming_the_vertex():
     for design in (rc.hinf, rc.h2):
         with pytest.raises(rc.NotStabilizableError, match=r"^vertices\[0\] is not stabilisable"):
             design(good, **kw, vertices=[bad])
+
+
+def test_spectral_abscissa_matches_the_eigenvalues():
+    from robustctl.stability import spectral_abscissa
+
+    A = np.random.default_rng(2).standard_normal((5, 3, 3))
+    np.testing.assert_allclose(spectral_abscissa(A), np.linalg.eigvals(A).real.max(axis=-1), rtol=1e-12)
+    assert isinstance(spectral_abscissa(A[0]), float)
+    np.testing.assert_array_equal(spectral_abscissa(np.stack([-np.eye(2), np.full((2, 2), np.nan)])), [-1.0, np.inf])
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_every_stability_decision_uses_the_one_margin(discrete):
+    """A loop inside the margin (rho = 1 - 1e-12, or abscissa -1e-12) is unstable for the controller, the
+    LMI syntheses' internal check, the robust analysis and the worst-case search alike."""
+    from robustctl.hinf._synthesis import check_closed_loop
+
+    edge = 1.0 if discrete else 0.0
+    plant = rc.Plant([[edge + 1e-12]], [[1.0]], 1.0 if discrete else None)
+    ctrl = rc.Controller([[-2e-12]], "x", plant)                       # F + G K = edge - 1e-12
+    assert abs(ctrl.closed_loop()[0, 0] - edge) < 2e-12
+    assert not ctrl.is_stabilizing()
+    with pytest.raises(rc.ConvergenceError, match="does not stabilise plant"):
+        check_closed_loop(ctrl.K, [plant])
+    unc = rc.NormBounded([[1.0]], [[0.1]], [[0.0]])
+    res = rc.robust_stability(ctrl, unc)
+    assert not res.certified and res.margin == 0.0 and res.P is None
+    assert not rc.robust_stability(ctrl, vertices=[plant]).certified
+    wc = rc.worst_case(ctrl, rc.NormBounded([[0.0]], [[0.0]], [[0.0]]), seed=0, n_starts=0)
+    assert wc.destabilizing and wc.radius == pytest.approx(edge - 1e-12, abs=1e-15)
+    with pytest.raises(rc.InfeasibleError, match="nominal closed loop F \\+ G K is unstable"):
+        rc.guaranteed_cost(ctrl, unc, [[1.0]], [[1.0]])
+    stable = rc.Controller([[-1e-6]], "x", plant)                       # 1e-6 inside: stable everywhere
+    assert stable.is_stabilizing() and not rc.worst_case(stable, rc.NormBounded([[0.0]], [[0.0]], [[0.0]]),
+                                                         n_starts=0).destabilizing
+    check_closed_loop(stable.K, [plant])

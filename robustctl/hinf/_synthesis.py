@@ -25,6 +25,7 @@ from ..controller import Controller
 from ..errors import ConvergenceError
 from ..plant import Plant
 from ..regions import Region
+from ..stability import is_stable
 from ..uncertainty import NormBounded
 from . import _tolerances as tol
 from ._coordinates import lqr_coordinates, normalised
@@ -192,17 +193,18 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
 def check_closed_loop(K: np.ndarray, plants, regions: Sequence[Region] = ()) -> None:
     """ConvergenceError unless ``K`` is finite and stabilises every vertex with its poles in the regions.
 
-    An internal check of the returned gain (the LMI certificate implies both).
+    An internal check of the returned gain (the LMI certificate implies both);
+    stable means :func:`robustctl.stability.is_stable` (the library's one margin).
     """
     if not np.all(np.isfinite(K)):
         raise ConvergenceError("the gain K = Y X^-1 is not finite; increase backoff")
     for i, p in enumerate(plants):
-        poles = np.linalg.eigvals(p.F + p.G @ K)
-        stable = np.max(np.abs(poles)) < 1 if p.is_discrete else np.max(poles.real) < 0
+        A = p.F + p.G @ K
         where = "plant" if i == 0 else f"vertices[{i - 1}]"
-        if not stable:
+        if not is_stable(A, discrete=p.is_discrete):
             raise ConvergenceError(f"internal check failed: the LMI gain does not stabilise {where}; "
                                    "increase backoff")
+        poles = np.linalg.eigvals(A)
         for r in regions:
             if not np.all(r.contains(poles)):
                 raise ConvergenceError(f"internal check failed: a closed-loop pole of {where} lies outside {r!r} "

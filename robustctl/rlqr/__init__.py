@@ -103,7 +103,7 @@ from .._validation import as_matrix, check_bool, check_choice, check_int, check_
 from ..controller import Controller
 from ..errors import ConvergenceError
 from ..plant import Plant, _frozen
-from ..stability import STABILITY_MARGIN, _schur, check_stabilizable
+from ..stability import check_stabilizable, is_schur_stable
 from ._model import DEFAULT_ALPHA, Model, build
 from ._steady import DEFAULT_MAX_ITER, DEFAULT_TOL, steady_state
 from ._step import block_steps, kkt_step, rlqr_step, rlqr_step_block
@@ -276,7 +276,7 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
     ok = reason == "ok"
     K[~ok], P[~ok], L[~ok] = np.nan, np.nan, np.nan
     stabilizing = np.zeros(B, dtype=bool)
-    stabilizing[ok] = _schur(plant.F + plant.G @ K[ok], 1.0 - STABILITY_MARGIN)
+    stabilizing[ok] = is_schur_stable(plant.F + plant.G @ K[ok])
     return RLQRBatch(*(_frozen(a) for a in (K, P, L)), ok, reason, stabilizing, iterations, residual)
 
 
