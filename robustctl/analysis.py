@@ -91,7 +91,6 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, Mapping, Sequence
@@ -101,7 +100,7 @@ import scipy.linalg
 from numpy.typing import ArrayLike
 
 from . import _cvx
-from ._validation import as_batch, as_matrix, check_performance, check_spd
+from ._validation import as_batch, as_matrix, as_rng, check_int, check_performance, check_spd
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .plant import Plant, _frozen, check_vertices
@@ -793,9 +792,11 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
 
     plant, K = _loop(controller)
     unc = _uncertainty(uncertainty, plant)
-    if isinstance(n_starts, bool) or not isinstance(n_starts, numbers.Integral) or n_starts < 0:
-        raise ValueError(f"n_starts must be an integer >= 0, got {n_starts!r}")
-    rng = np.random.default_rng(seed)
+    try:
+        n_starts = check_int(n_starts, "n_starts", minimum=0)
+    except TypeError as exc:  # worst_case has raised ValueError for every bad n_starts: keep that type
+        raise ValueError(str(exc)) from None
+    rng = as_rng(seed)
     discrete = plant.is_discrete
     A, H, E = plant.F + plant.G @ K, unc.H, unc.EF + unc.EG @ K
     p, l = unc.p, unc.l

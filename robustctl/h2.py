@@ -50,15 +50,15 @@ import scipy.linalg
 from numpy.typing import ArrayLike
 
 from . import _cvx
-from ._validation import check_performance
+from ._validation import check_performance, check_real
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .hinf import _tolerances as tol
 from .hinf._coordinates import Coordinates, normalised, recentred
 from .hinf._lmis import Point, region_blocks, variables
-from .hinf._problem import check_backoff, check_poles_reachable, check_stabilisable
+from .hinf._problem import check_poles_reachable, check_stabilisable
 from .hinf._synthesis import check_closed_loop
-from .plant import Plant, check_vertices
+from .plant import Plant, check_plant, check_vertices
 from .regions import Region, as_regions, describe_regions
 
 __all__ = ["h2", "H2Controller"]
@@ -132,14 +132,12 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     ValueError, TypeError
         Bad arguments (named in the message).
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    plants = check_vertices(plant, vertices)
+    plants = check_vertices(check_plant(plant), vertices)
     Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
     if not plant.is_discrete and np.any(Dzw):
         raise ValueError("Dzw must be zero for a continuous-time plant: a feedthrough from white noise w to z "
                          "makes the H2 norm infinite")
-    backoff = check_backoff(backoff)
+    backoff = check_real(backoff, "backoff", minimum=0.0)
     solver = _cvx.check_solver(solver)
     regions = as_regions(poles)
     check_stabilisable(plants)

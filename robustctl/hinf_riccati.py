@@ -55,7 +55,7 @@ from numpy.typing import ArrayLike
 
 from ._validation import check_performance, check_positive_scalar
 from .errors import InfeasibleError
-from .plant import Plant
+from .plant import Plant, check_plant
 from .stability import is_stable
 
 __all__ = ["RiccatiHinf", "hinf_riccati", "riccati_level"]
@@ -93,8 +93,7 @@ class RiccatiHinf:
 
 
 def _data(plant, Bw, Cz, Dzu, Dzw):
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+    check_plant(plant)
     Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
     return plant.F, plant.G, Bw, Cz, Dzu, Dzw
 
@@ -216,6 +215,7 @@ def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, 
     """
     F, G, Bw, Cz, Dzu, Dzw = _data(plant, Bw, Cz, Dzu, Dzw)
     rtol = check_positive_scalar(rtol, "rtol")
+    gamma_max = check_positive_scalar(gamma_max, "gamma_max")
     level = _level_discrete if plant.is_discrete else _level_continuous
     lo = float(np.linalg.norm(Dzw, 2))
     hi = max(1.0, 2.0 * lo)

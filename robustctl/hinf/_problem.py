@@ -2,22 +2,21 @@
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
 
 from .. import _cvx
-from .._validation import check_performance, check_positive_scalar
+from .._validation import check_bool, check_performance, check_positive_scalar, check_positive_vector, check_real
 from ..errors import InfeasibleError
-from ..plant import Plant, check_vertices
+from ..plant import Plant, check_plant, check_vertices
 from ..regions import Region, as_regions, describe_regions
 from ..stability import check_stabilizable, immovable_modes
 from ..uncertainty import NormBounded
 
 __all__ = ["Problem", "validate", "check_stabilisable", "check_poles_reachable",
-           "check_uncertainty", "check_backoff"]
+           "check_uncertainty"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,21 +73,17 @@ class Problem:
 def validate(plant, *, Bw, Cz, Dzu, Dzw, vertices, gamma, u_max, w_energy, backoff, extended,
              solver, poles=None, uncertainty=None) -> Problem:
     """Check every argument of :func:`robustctl.hinf` (errors name the argument) and stabilisability."""
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    plants = check_vertices(plant, vertices)
+    plants = check_vertices(check_plant(plant), vertices)
     Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
     if gamma is not None:
         gamma = check_positive_scalar(gamma, "gamma")
     if u_max is not None:
-        u_max = _check_u_max(u_max, plant.m)
+        u_max = check_positive_vector(u_max, "u_max", plant.m, what="the number of inputs")
         w_energy = 1.0 if w_energy is None else check_positive_scalar(w_energy, "w_energy")
     elif w_energy is not None:
         raise ValueError("w_energy is only used together with u_max; give u_max or drop w_energy")
-    backoff = check_backoff(backoff)
-    if not isinstance(extended, (bool, np.bool_)):
-        raise TypeError(f"extended must be a bool, got {type(extended).__name__}")
-    if extended and not plant.is_discrete:
+    backoff = check_real(backoff, "backoff", minimum=0.0)
+    if check_bool(extended, "extended") and not plant.is_discrete:
         raise ValueError("extended=True is the discrete-time slack-variable LMI; plant is continuous-time (dt=None)")
     solver = _cvx.check_solver(solver)
     regions = as_regions(poles)
@@ -113,33 +108,6 @@ def check_uncertainty(uncertainty, plant: Plant) -> NormBounded | None:
     if not np.any(uncertainty.H) or not (np.any(uncertainty.EF) or np.any(uncertainty.EG)):
         return None  # dF = dG = 0 exactly: the nominal design (the S-procedure multiplier would be unbounded)
     return uncertainty
-
-
-def check_backoff(backoff) -> float:
-    """A finite real ``>= 0``."""
-    if isinstance(backoff, bool) or not isinstance(backoff, numbers.Real) or not np.isfinite(backoff) \
-            or backoff < 0:
-        raise ValueError(f"backoff must be a finite number >= 0, got {backoff!r}")
-    return float(backoff)
-
-
-def _check_u_max(u_max, m: int) -> np.ndarray:
-    if isinstance(u_max, (str, bytes)):
-        raise TypeError(f"u_max must be a positive number or {m} positive numbers, got {type(u_max).__name__}")
-    try:
-        arr = np.array(u_max, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"u_max must be a positive number or {m} positive numbers") from None
-    if arr.ndim == 0:
-        arr = np.full(m, float(arr))
-    if arr.shape != (m,):
-        raise ValueError(f"u_max must be a scalar or have {m} {'entry' if m == 1 else 'entries'} "
-                         f"(the number of inputs), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError("u_max must be finite (use u_max=None for no input bound)")
-    if np.any(arr <= 0):
-        raise ValueError(f"u_max must be > 0 for every input, got {arr.tolist()}")
-    return arr
 
 
 def _where(i: int) -> str:
