@@ -105,7 +105,7 @@ from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .plant import Plant, _frozen, check_vertices
 from .stability import is_stable, spectral_abscissa, spectral_radius
-from .uncertainty import NormBounded
+from .uncertainty import NormBounded, check_norm_bounded
 
 __all__ = ["RobustStability", "CostBound", "HinfBound", "WorstCase",
            "robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case"]
@@ -277,13 +277,6 @@ def _loop(controller) -> tuple[Plant, np.ndarray]:
     raise TypeError(f"controller must be a robustctl.Controller or a (Plant, K) pair, got {type(controller).__name__}")
 
 
-def _uncertainty(uncertainty, plant: Plant) -> NormBounded:
-    if not isinstance(uncertainty, NormBounded):
-        raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
-    uncertainty.check_plant(plant)
-    return uncertainty
-
-
 # ---------------------------------------------------------------- linear algebra
 def _radius(A: np.ndarray, discrete: bool) -> float:
     """Spectral radius (discrete) or spectral abscissa (continuous)."""
@@ -356,9 +349,8 @@ class _Coordinates:
 
 
 def _solve_info(reports) -> dict:
-    return {"solve_time": float(sum(r.solve_time for r in reports)),
-            "iterations": int(sum(r.iterations or 0 for r in reports)),
-            "solves": tuple(r.as_dict() for r in reports)}
+    solves = tuple(r.as_dict() for r in reports)
+    return {**_cvx.totals(solves), "solves": solves}
 
 
 # ---------------------------------------------------------------- robust stability
@@ -534,7 +526,7 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
         # a polytope needs a vertex besides the nominal plant
         return _polytope_stability(check_vertices(plant, vertices, reference="the controller's plant",
                                                   non_empty=True), K)
-    return _norm_bounded_stability(plant, K, _uncertainty(uncertainty, plant))
+    return _norm_bounded_stability(plant, K, check_norm_bounded(uncertainty, plant))
 
 
 # ---------------------------------------------------------------- performance bounds
@@ -543,7 +535,7 @@ def _robust_loop(controller, uncertainty, what: str):
     import control
 
     plant, K = _loop(controller)
-    unc = _uncertainty(uncertainty, plant)
+    unc = check_norm_bounded(uncertainty, plant)
     discrete = plant.is_discrete
     A, H, E = plant.F + plant.G @ K, unc.H, unc.EF + unc.EG @ K
     if not is_stable(A, discrete=discrete):
@@ -791,7 +783,7 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     import control
 
     plant, K = _loop(controller)
-    unc = _uncertainty(uncertainty, plant)
+    unc = check_norm_bounded(uncertainty, plant)
     try:
         n_starts = check_int(n_starts, "n_starts", minimum=0)
     except TypeError as exc:  # worst_case has raised ValueError for every bad n_starts: keep that type

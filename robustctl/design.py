@@ -5,7 +5,7 @@ from __future__ import annotations
 from importlib import import_module
 
 from .controller import Controller
-from .plant import Plant
+from .plant import Plant, check_plant
 
 __all__ = ["design", "METHODS"]
 
@@ -30,7 +30,6 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     if not isinstance(method, str) or method.lower() not in METHODS:
         raise ValueError(f"method must name a design: unknown design method {method!r}; "
                          f"valid: {', '.join(sorted(METHODS))}")
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+    check_plant(plant)
     module, func = METHODS[method.lower()].split(":")
     return getattr(import_module(module), func)(plant, *args, **kwargs)

@@ -154,10 +154,16 @@ class Plant:
         return f"Plant(n={self.n}, m={self.m}, {time})"
 
 
-def check_plant(value, name: str = "plant") -> Plant:
-    """``value`` if it is a :class:`Plant`, else ``TypeError`` naming ``name``."""
+def check_plant(value, name: str = "plant", *, discrete_for: str | None = None) -> Plant:
+    """``value`` if it is a :class:`Plant`, else ``TypeError`` naming ``name``.
+
+    With ``discrete_for`` (a design's name), a continuous-time plant is refused
+    with a ``ValueError`` that says so.
+    """
     if not isinstance(value, Plant):
         raise TypeError(f"{name} must be a robustctl.Plant, got {type(value).__name__}")
+    if discrete_for is not None and not value.is_discrete:
+        raise ValueError(f"{name} must be discrete-time (dt > 0) for {discrete_for}; discretise it first")
     return value
 
 

@@ -13,7 +13,7 @@ from ..errors import InfeasibleError
 from ..plant import Plant, check_plant, check_vertices
 from ..regions import Region, as_regions, describe_regions
 from ..stability import check_stabilizable, immovable_modes
-from ..uncertainty import NormBounded
+from ..uncertainty import NormBounded, check_norm_bounded
 
 __all__ = ["Problem", "validate", "check_stabilisable", "check_poles_reachable",
            "check_uncertainty"]
@@ -102,9 +102,7 @@ def check_uncertainty(uncertainty, plant: Plant) -> NormBounded | None:
     """A NormBounded of the plant's size; ``None`` if absent or if ``H = 0`` or ``[EF EG] = 0`` (no uncertainty)."""
     if uncertainty is None:
         return None
-    if not isinstance(uncertainty, NormBounded):
-        raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
-    uncertainty.check_plant(plant)
+    check_norm_bounded(uncertainty, plant)
     if not np.any(uncertainty.H) or not (np.any(uncertainty.EF) or np.any(uncertainty.EG)):
         return None  # dF = dG = 0 exactly: the nominal design (the S-procedure multiplier would be unbounded)
     return uncertainty

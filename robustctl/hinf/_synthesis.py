@@ -21,6 +21,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import _cvx
 from ..controller import Controller
 from ..errors import ConvergenceError
 from ..plant import Plant
@@ -222,9 +223,7 @@ def _info(problem: Problem, gain: Gain, K, X, level, gamma_opt, backoff, solves)
     info = {
         "gamma": level, "gamma_opt": gamma_opt, "backoff": backoff,
         "lmi": ("extended" if problem.extended else "standard") + ("-discrete" if problem.discrete else "-continuous"),
-        "vertices": len(problem.plants), "status": solves[-1]["status"],
-        "solve_time": float(sum(s["solve_time"] for s in solves)),
-        "iterations": int(sum(s["iterations"] or 0 for s in solves)),
+        "vertices": len(problem.plants), "status": solves[-1]["status"], **_cvx.totals(solves),
         "certificate": gain.certificate, "gain_from": gain.route, "X_min_eig": float(np.linalg.eigvalsh(Xs).min()),
         "margin": float(gain.margin), "solves": list(solves), "X": Xs, "scaling": gain.data.balancing,
         "solver": problem.solver, "poles": problem.regions, "uncertainty": problem.uncertainty,
