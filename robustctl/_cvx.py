@@ -84,7 +84,7 @@ class SolveReport:
 
 
 def totals(solves: Sequence[Mapping]) -> dict:
-    """``solve_time`` (s) and ``iterations`` summed over solves (each a :meth:`SolveReport.as_dict`)."""
+    """``solve_time`` (s) and ``iterations`` summed over solves (each a ``SolveReport.as_dict()``)."""
     return {"solve_time": float(sum(s["solve_time"] for s in solves)),
             "iterations": int(sum(s["iterations"] or 0 for s in solves))}
 

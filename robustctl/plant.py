@@ -155,7 +155,7 @@ class Plant:
 
 
 def check_plant(value, name: str = "plant", *, discrete_for: str | None = None) -> Plant:
-    """``value`` if it is a :class:`Plant`, else ``TypeError`` naming ``name``.
+    """``value`` if it is a :class:`~robustctl.Plant`, else ``TypeError`` naming ``name``.
 
     With ``discrete_for`` (a design's name), a continuous-time plant is refused
     with a ``ValueError`` that says so.
@@ -168,7 +168,7 @@ def check_plant(value, name: str = "plant", *, discrete_for: str | None = None) 
 
 
 def check_vertices(plant: Plant, vertices, *, reference: str = "plant", non_empty: bool = False) -> list[Plant]:
-    """``[plant, *vertices]`` after checking that every vertex is a :class:`Plant` of ``plant``'s size and ``dt``.
+    """``[plant, *vertices]`` after checking that every vertex is a :class:`~robustctl.Plant` of ``plant``'s size and ``dt``.
 
     The vertices of a polytope ``conv{plant, *vertices}`` (e.g. the ``vertices``
     of :func:`robustctl.hinf` and :func:`robustctl.robust_stability`).

@@ -103,7 +103,7 @@ class NormBounded:
 
 
 def check_norm_bounded(value, plant: Plant, name: str = "uncertainty") -> NormBounded:
-    """``value`` if it is a :class:`NormBounded` of ``plant``'s size; ``TypeError``/``ValueError`` naming ``name``."""
+    """``value`` if it is a :class:`~robustctl.NormBounded` of ``plant``'s size; ``TypeError``/``ValueError`` naming ``name``."""
     if not isinstance(value, NormBounded):
         raise TypeError(f"{name} must be a robustctl.NormBounded, got {type(value).__name__}")
     value.check_plant(plant)
