@@ -15,12 +15,13 @@ from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .lqr import lqr
 from .plant import Plant
 from .rlqr import RLQRBatch, rlqr, rlqr_gains
+from .stability import is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
 
 
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
-    "hinf", "HinfController",
+    "hinf", "HinfController", "spectral_radius", "is_schur_stable",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError",
 ]
 __version__ = "0.1.0"

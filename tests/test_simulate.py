@@ -91,7 +91,7 @@ def test_doubled_column_equals_single(K_lqr):
     path = default_route(duration=40.0)
     single = simulate(K_lqr, path, [0.0, 100.0])
     split = np.array([[0.3, 0.7]]).T * K_lqr               # u1 + u2 = K x
-    doubled = simulate(split, path, [0.0, 100.0])
+    doubled = simulate(split, path, [0.0, 100.0], input_map=truck.DOUBLED_INPUT_MAP)
     np.testing.assert_allclose(doubled.errors, single.errors, rtol=1e-10, atol=1e-14)
 
 
@@ -166,7 +166,7 @@ def test_population_speed(K_lqr):
     K2 = np.concatenate([K / 2, K / 2], axis=1)
     path = default_route(duration=500.0)
     t0 = time.perf_counter()
-    res = simulate(K2, path, [0.0, 100.0], keep_trajectories=False)
+    res = simulate(K2, path, [0.0, 100.0], keep_trajectories=False, input_map=[[1.0, 1.0]])
     elapsed = time.perf_counter() - t0
     assert res.mse().shape == (92, 2, 4)
     assert elapsed < 5.0          # generous: the CI machine is shared

@@ -57,7 +57,7 @@ import numpy as np
 import robustctl as rc
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
-from robustctl.simulate import simulate
+from robustctl.pathfollow import PathFollowing
 
 from .._validation import as_matrix, check_int
 from .applied import AppliedRLQRProblem
@@ -302,7 +302,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
 
     Each ``Delta_s`` is a payload overload ``150 (1 + Delta_s)`` % held over the
     run (:func:`overload_from_delta`); every design drives the true truck at
-    that payload along ``path`` (:func:`robustctl.simulate.simulate`: nominal
+    that payload along ``path`` (:class:`robustctl.pathfollow.PathFollowing`: nominal
     reference states and feedforward, 0.45 rad steering limit, 1 m initial
     offset), and
 
@@ -320,7 +320,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
     the units the designs trade them in. ``E = T * sum_i f_i / sigma_i^2``
     with ``f_i`` the MOP's per-scenario MSEs. A gain with non-finite entries
     gets ``+inf``; a run that diverges is frozen by the simulator at its bound
-    (a huge finite error, see :mod:`robustctl.simulate`).
+    (a huge finite error, see :mod:`robustctl.batchsim`).
 
     Parameters
     ----------
@@ -348,12 +348,12 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
         path = default_route()
     elif not isinstance(path, ReferencePath):
         raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
-    obj = list(truck.OBJECTIVE_STATES)
+    steering = np.ones((1, Kb.shape[1]))                   # alpha = u1 (+ u2 on the doubled column)
     E = np.empty((Kb.shape[0], overloads.size))
     for start in range(0, overloads.size, _SCENARIO_CHUNK):
         chunk = overloads[start:start + _SCENARIO_CHUNK]
-        res = simulate(Kb, path, tuple(chunk.tolist()), keep_trajectories=False)
-        E[:, start:start + chunk.size] = (res.sq_error_sum[..., obj] / sigma**2).sum(axis=2)
+        res = PathFollowing(path, tuple(chunk.tolist()), input_map=steering).run(Kb, keep_trajectories=False)
+        E[:, start:start + chunk.size] = (res.sq_error_sum[..., list(res.objectives)] / sigma**2).sum(axis=2)
     E[~ok] = np.inf
     return E
 
