@@ -18,17 +18,7 @@ import control
 import numpy as np
 
 import robustctl as rc
-
-
-def truck_plant() -> rc.Plant:
-    try:  # the project's truck model when available
-        from robustctl.models.truck import truck_plant as make
-
-        return make(0.0, doubled_column=True)
-    except Exception:  # fall back to a comparable 4-state lateral model
-        A = np.array([[-5.0, -10.0, 0, 0], [-2.0, -8.0, 0, 0], [1.0, 0, 0, 16.67], [0, 1.0, 0, 0]])
-        p = rc.Plant.from_continuous(A, np.array([[6.6], [1.5], [0], [0]]), 0.1)
-        return rc.Plant(p.F, np.hstack([p.G, p.G]), 0.1)
+from robustctl.models.truck import truck_plant
 
 
 def best_of(fn, repeat: int) -> float:
@@ -45,7 +35,7 @@ def main() -> None:
     ap.add_argument("--designs", type=int, default=2000)
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args()
-    plant = truck_plant()
+    plant = truck_plant(0.0, doubled=True)
     rng = np.random.default_rng(0)
     z = rng.uniform(0, 500, (args.designs, 7))
     z[z == 0] = 1e-9
