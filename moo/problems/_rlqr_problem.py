@@ -9,8 +9,10 @@ both MOPs take for a whole population at once:
 1. check and decode the population (:meth:`~RLQRTuningProblem.decode`);
 2. design all gains in one batched call (:func:`robustctl.rlqr_gains`);
 3. screen the closed loops ``F_s + G_s M K`` of the S scenarios for Schur
-   stability (:func:`robustctl.spectral_radius`; ``M`` maps the controller's
-   inputs to the plant's, e.g. the doubled steering column);
+   stability (:func:`robustctl.is_schur_stable`, and
+   :func:`robustctl.spectral_radius` for the unstable designs' penalty; ``M``
+   maps the controller's inputs to the plant's, e.g. the doubled steering
+   column);
 4. compute the raw objectives of the stable designs only (the subclass's
    :meth:`~RLQRTuningProblem.scenario_objectives`, one batched simulation),
    combine the scenarios (``mean`` or ``max``) and apply the penalty rule.
@@ -34,23 +36,20 @@ from robustctl.batchsim import BACKENDS
 
 from .._validation import as_float_array, as_matrix, check_int, check_positive_scalar
 
-__all__ = ["RLQRTuningProblem", "penalise", "is_stable"]
+__all__ = ["RLQRTuningProblem", "penalise"]
 
 
-def is_stable(rho: np.ndarray) -> np.ndarray:
-    """The MOPs' stability test on spectral radii: ``rho < 1`` (``inf``/NaN radii are unstable)."""
-    return np.asarray(rho) < 1.0
-
-
-def penalise(J: np.ndarray, ok: np.ndarray, rho: np.ndarray, penalty: float) -> np.ndarray:
+def penalise(J: np.ndarray, ok: np.ndarray, stable: np.ndarray, rho: np.ndarray, penalty: float) -> np.ndarray:
     """Apply the penalty rule (module docstring) to raw objectives ``J`` (B, M).
 
-    ``ok`` (B,): the RLQR design was computed; ``rho`` (B,): the largest
-    closed-loop spectral radius over the scenarios. Every returned value is
-    finite and the penalised ones are ``>= penalty``.
+    ``ok`` (B,): the RLQR design was computed; ``stable`` (B,): its closed
+    loops are Schur-stable in every scenario; ``rho`` (B,): the largest
+    closed-loop spectral radius over the scenarios (read only where
+    ``ok & ~stable``). Every returned value is finite and the penalised ones
+    are ``>= penalty``.
     """
     out = np.where(np.isfinite(J), np.minimum(J, penalty), penalty)
-    unstable = ok & ~is_stable(rho)
+    unstable = ok & ~stable
     out[unstable] = (penalty * np.minimum(np.nan_to_num(rho[unstable], nan=2.0), 2.0))[:, None]
     out[~ok] = 2.0 * penalty
     return out
@@ -161,10 +160,26 @@ class RLQRTuningProblem(Problem):
             raise ValueError(f"K must have shape (B, {m}, {n}), got shape {K.shape}")
         return K
 
-    def closed_loop_radius(self, K) -> np.ndarray:
-        """Spectral radius (B, S) of the true closed loop ``F_s + G_s M K`` per scenario (inf for non-finite K)."""
+    def closed_loops(self, K) -> np.ndarray:
+        """The true closed loops ``F_s + G_s M K`` (B, S, n, n) of gains ``K`` (B, m, n)."""
         K = self.check_gains(K)
-        return rc.spectral_radius(self._F_s[None] + self._G_s_steer[None] @ K[:, None])
+        return self._F_s[None] + self._G_s_steer[None] @ K[:, None]
+
+    def closed_loop_radius(self, K) -> np.ndarray:
+        """Spectral radius (B, S) of the true closed loop per scenario (inf for non-finite K)."""
+        return rc.spectral_radius(self.closed_loops(K))
+
+    def stability(self, K) -> tuple[np.ndarray, np.ndarray]:
+        """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the largest spectral
+        radius over the scenarios of the designs unstable somewhere (NaN for the others, which
+        need no eigenvalues; inf for non-finite K)."""
+        A = self.closed_loops(K)
+        stable = rc.is_schur_stable(A)
+        rho = np.full(A.shape[0], np.nan)
+        bad = ~stable.all(axis=1)
+        if bad.any():
+            rho[bad] = rc.spectral_radius(A[bad]).max(axis=1)
+        return stable, rho
 
     def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
         """Raw objectives (B, S, n_obj) of finite gains whose closed loops are all stable (subclass)."""
@@ -181,10 +196,10 @@ class RLQRTuningProblem(Problem):
         batch = self.gains(z)
         ok = np.asarray(batch.ok, dtype=bool) & np.all(np.isfinite(batch.K), axis=(1, 2))
         K = np.where(ok[:, None, None], batch.K, np.nan)
-        rho = np.max(self.closed_loop_radius(K), axis=1)
-        run = ok & is_stable(rho)
+        stable, rho = self.stability(K)
+        run = ok & stable.all(axis=1)
         J = np.full((z.shape[0], self.n_obj), np.inf)
         if run.any():
             e = self.scenario_objectives(K[run])
             J[run] = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
-        out["F"] = penalise(J, ok, rho, self.penalty)
+        out["F"] = penalise(J, ok, run, rho, self.penalty)

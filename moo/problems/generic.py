@@ -39,7 +39,7 @@ import robustctl as rc
 from robustctl.batchsim import LinearSimulator
 
 from .._validation import as_matrix, check_int
-from ._rlqr_problem import RLQRTuningProblem, is_stable
+from ._rlqr_problem import RLQRTuningProblem
 
 __all__ = ["GenericRLQRProblem"]
 
@@ -217,7 +217,7 @@ class GenericRLQRProblem(RLQRTuningProblem):
         loops get ``e = inf``; designs with no stable scenario are not simulated.
         """
         rho = self.closed_loop_radius(K)
-        stable = is_stable(rho)
+        stable = rc.is_schur_stable(self.closed_loops(K))
         e = np.full(rho.shape + (self.plant.n,), np.inf)
         some = stable.any(axis=1)
         if some.any():
