@@ -54,7 +54,7 @@ import numpy as np
 
 from ._validation import as_batch, as_float_array, check_positive_scalar
 
-__all__ = ["SimulationResult", "LinearSimulator", "simulate_linear", "DEFAULT_BOUND", "BACKENDS"]
+__all__ = ["SimulationResult", "LinearSimulator", "simulate_linear", "check_gains", "DEFAULT_BOUND", "BACKENDS"]
 
 #: Divergence bound on |x - x_ref| (any component), in the states' units.
 DEFAULT_BOUND = 1e3

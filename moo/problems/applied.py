@@ -6,8 +6,8 @@ with the doubled steering column (``G2 = [G G]``, steering ``alpha = u1 + u2``,
 :func:`robustctl.models.truck.truck_plant`), designed on the nominal-payload
 model with ``H = [1, 1, 1, 1]^T`` and ``mu = 10**sqrt(z7)``. The gain then
 drives the truck along a reference path at several payloads
-(:func:`robustctl.simulate.simulate`), and the four objectives are the mean
-squared path-following errors
+(:class:`robustctl.pathfollow.PathFollowing`, built once per problem), and the
+four objectives are the mean squared path-following errors
 
 * ``f1``: lateral displacement ``rho`` [m^2],
 * ``f2``: yaw rate ``psidot`` [(rad/s)^2],
@@ -56,7 +56,7 @@ class AppliedRLQRProblem(RLQRTuningProblem):
        doubled-column truck at the nominal payload, ``H = ones((4, 1))``,
        weights ``Q``, ``R``; the whole population is designed in one batched call;
     3. the closed loop is simulated, for all designs and payload scenarios in
-       one array recursion (:func:`robustctl.simulate.simulate`): true truck at
+       one compiled run (:class:`robustctl.pathfollow.PathFollowing`): true truck at
        each overload, steering ``alpha = sat_0.45(u1 + u2 + alpha_ff)``, the
        nominal model's steady-cornering reference states and feedforward, the
        truck starting 1 m off the path;
@@ -86,11 +86,12 @@ class AppliedRLQRProblem(RLQRTuningProblem):
     alpha : float
         RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin.
     max_iter : int
-        Recursion steps of :func:`robustctl.rlqr_gains` before its Newton phase;
-        a design not converged by then counts as not computable. Default 2000:
-        of 3000 uniformly random designs, the 2710 stable ones converged within
-        12 steps except two with ``E_G1 ~ E_G2`` (a nearly singular split of the
-        doubled column), which took 346 and 872.
+        Steps of the plain recursion :func:`robustctl.rlqr_gains` may take for
+        a design the doubling leaves unsettled; a design not converged by then
+        counts as not computable. Default 2000: of 3000 uniformly random
+        designs, the 2710 stable ones converged within 12 steps except two
+        with ``E_G1 ~ E_G2`` (a nearly singular split of the doubled column),
+        which took 346 and 872.
     path : ReferencePath, optional
         Reference path (default :func:`robustctl.path.default_route`, 540 s).
     overloads : sequence of float
@@ -104,6 +105,9 @@ class AppliedRLQRProblem(RLQRTuningProblem):
         Base penalty (default ``1e7``).
     hv_ref_point, molsp_ref_point : (4,) array_like, optional
         Override the reference points.
+    backend : {"numba", "numpy"}
+        Simulator (:mod:`robustctl.batchsim`): the compiled kernel (default)
+        or the numpy reference.
 
     Attributes
     ----------

@@ -97,15 +97,16 @@ class GenericRLQRProblem(RLQRTuningProblem):
     alpha : float
         RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin (see :func:`robustctl.rlqr_gains`).
     max_iter : int
-        Recursion steps :func:`robustctl.rlqr_gains` may take before its Newton
-        phase (default 50, against the library's 10000); a design that has not
-        converged by then counts as not computable (``2 * penalty``). Slowly
-        converging designs cost up to seconds per batch (MO-LSP's mutants
-        produce many) and are worthless here: of 12000 sampled designs
-        (uniform, and around the slow region MO-LSP's mutants reach), the 6844
-        stable ones all converged within 10 steps, none of the 521 that needed
-        more than 300 steps was stable on the true plant, and caps of 30, 50,
-        100 and 200 gave identical objectives.
+        Steps of the plain recursion :func:`robustctl.rlqr_gains` may take for a
+        design the doubling leaves unsettled (default 50, against the
+        library's 10000); a design not converged by then counts as not
+        computable (``2 * penalty``). Slowly converging designs cost up to
+        seconds per batch (MO-LSP's mutants produce many) and are worthless
+        here: of 12000 sampled designs (uniform, and around the slow region
+        MO-LSP's mutants reach), the 6844 stable ones all converged within 10
+        steps, none of the 521 that needed more than 300 steps was stable on
+        the true plant, and caps of 30, 50, 100 and 200 gave identical
+        objectives.
     deltas : 1-D array_like, optional
         The uncertainty realisations, each in ``[-1, 1]``. Default: ``-1``, ``+1``
         and ``n_deltas - 2`` values drawn from ``U(-1, 1)`` with ``seed``.
@@ -124,6 +125,10 @@ class GenericRLQRProblem(RLQRTuningProblem):
         design's error at the default settings).
     hv_ref_point, molsp_ref_point : (3,) array_like, optional
         Override the reference points (see below).
+    backend : {"numba", "numpy"}
+        Simulator of the regulation runs (:mod:`robustctl.batchsim`): the
+        compiled kernel (default) or the numpy reference. One run per
+        scenario and initial state, ``horizon + 1`` samples, zero reference.
 
     Attributes
     ----------

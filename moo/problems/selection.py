@@ -57,6 +57,7 @@ import numpy as np
 import robustctl as rc
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
+from robustctl.batchsim import check_gains
 from robustctl.pathfollow import PathFollowing
 
 from .._validation import as_matrix, check_int
@@ -228,18 +229,14 @@ def overload_from_delta(deltas) -> np.ndarray:
 
 def _as_gains(K, n: int, ms: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
     """(D, m, n) float gains (non-finite rows zeroed) and the (D,) mask of finite rows."""
-    if isinstance(K, (str, bytes)) or K is None:
-        raise TypeError(f"K must be a (D, m, {n}) array of gains, got {type(K).__name__}")
+    want = " or ".join(f"(D, {m}, {n})" for m in ms)
     try:
-        arr = np.array(K, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"K must be a (D, m, {n}) array of real numbers") from None
-    if arr.ndim != 3 or arr.shape[0] < 1 or arr.shape[1] not in ms or arr.shape[2] != n:
-        want = " or ".join(f"(D, {m}, {n})" for m in ms)
-        raise ValueError(f"K must have shape {want} (one gain per design), got shape {arr.shape}")
-    ok = np.all(np.isfinite(arr), axis=(1, 2))
-    arr[~ok] = 0.0
-    return arr, ok
+        arr, bad = check_gains(K, n, "flag")
+    except ValueError:
+        arr = None
+    if arr is None or np.ndim(K) != 3 or arr.shape[1] not in ms:
+        raise ValueError(f"K must have shape {want} (one gain per design), got shape {np.shape(K)}")
+    return arr, ~bad
 
 
 def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> np.ndarray:
@@ -281,7 +278,7 @@ def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> n
         raise TypeError(f"problem must be a GenericRLQRProblem, got {type(problem).__name__}")
     Kb, ok = _as_gains(K, problem.plant.n, (problem.plant.m,))
     mc = GenericRLQRProblem(deltas=_as_deltas(deltas), initial_states=problem.initial_states,
-                            horizon=problem.horizon)
+                            horizon=problem.horizon, backend=problem.backend)
     e, _ = mc.regulation_errors(np.where(ok[:, None, None], Kb, np.nan))
     E = e.sum(axis=2)
     E[~ok] = np.inf
