@@ -17,6 +17,8 @@ from .plant import Plant
 from .rlqr import RLQRBatch, rlqr, rlqr_gains
 from .stability import is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
+from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guaranteed_cost, robust_hinf_bound,
+                       robust_stability, worst_case)
 
 
 __all__ = [
@@ -24,4 +26,6 @@ __all__ = [
     "hinf", "HinfController", "spectral_radius", "is_schur_stable",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError",
 ]
+__all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
+            "RobustStability", "CostBound", "HinfBound", "WorstCase"]
 __version__ = "0.1.0"

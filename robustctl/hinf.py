@@ -153,6 +153,10 @@ _CENTRE_TOL = 1e-7
 # u-bound LMIs use u_max^2 (1 - _U_SLACK) / E so that solver rounding cannot
 # exceed u_max (the bound is conservative by 0.005 %).
 _U_SLACK = 1e-4
+# backoff=0: eigenvalues of the optimal X (solver coordinates) below this
+# fraction of lambda_max(X) are below the accuracy of the level minimisation
+# (_MIN_TOL) and are raised to it before K = Y X^-1 (see _Problem.gain).
+_OPTIMUM_X_FLOOR = 1e-8
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -499,8 +503,18 @@ class _Problem:
                 return {"X": _Value(X), "Y": _Value(K @ X)}, cert, cert["hinf[0]"]
         return None
 
-    def gain(self, V) -> tuple[np.ndarray, np.ndarray]:
-        """``(K, X)`` in the original coordinates (``X``: Lyapunov matrix of the nominal vertex)."""
+    def gain(self, V, x_floor: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """``(K, X)`` in the original coordinates (``X``: Lyapunov matrix of the nominal vertex).
+
+        With ``x_floor > 0`` (standard LMI) the eigenvalues of ``X`` below
+        ``x_floor * lambda_max(X)`` are raised to that value first. At a
+        singular optimum (continuous time, reached only as ``|K| -> inf``)
+        the smallest eigenvalue of the solver's ``X`` is rounding noise of
+        either sign, and its sign decides the direction of the unbounded part
+        of ``K = Y X^-1``: a negative one gives a destabilising gain. The
+        floor makes ``K`` the member of the optimal family with ``X > 0``,
+        independent of the last bits; a well-conditioned ``X`` is unchanged.
+        """
         if self.extended:
             S, L = V["S"].value, V["L"].value
             Ks = np.linalg.solve(S.T, L.T).T
@@ -508,6 +522,9 @@ class _Problem:
         else:
             Xs, Y = V["X"].value, V["Y"].value
             Xs = 0.5 * (Xs + Xs.T)
+            if x_floor > 0:
+                lam, U = np.linalg.eigh(Xs)
+                Xs = (U * np.maximum(lam, x_floor * lam[-1])) @ U.T
             Ks = np.linalg.solve(Xs, Y.T).T
         T = self.T
         return np.linalg.solve(T.T, Ks.T).T, T @ Xs @ T.T
@@ -557,7 +574,10 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     backoff : float, default 1e-3
         The gain is computed at ``gamma = (1 + backoff) gamma_opt`` from a
         well-centred strictly feasible point. ``0`` returns the optimal
-        point's gain (can be badly conditioned). If no strictly feasible point
+        point's gain (can be badly conditioned; eigenvalues of ``X`` below
+        ``1e-8 lambda_max(X)``, the accuracy of the minimisation, are raised
+        to that floor first, so that a singular optimum gives a stabilising,
+        reproducible gain). If no strictly feasible point
         with a positive certificate is found at that level (nearly infeasible
         problems, e.g. a tight ``u_max``), the backoff is raised tenfold, at
         most twice; ``info["backoff"]`` and ``gamma`` report the value used.
@@ -775,7 +795,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         if not final_margin > _STRICT:
             raise InfeasibleError(f"{infeasible} (largest strictness margin {final_margin:.3g})")
 
-    K, X = prob.gain(V)
+    K, X = prob.gain(V, x_floor=_OPTIMUM_X_FLOOR if gain_from == "optimum" else 0.0)
     if not np.all(np.isfinite(K)):
         raise ConvergenceError("the gain K = Y X^-1 is not finite; increase backoff")
     for i, p in enumerate(plants):
