@@ -10,12 +10,12 @@ Sign convention everywhere: ``u = K x``.
 
 from .controller import Controller
 from .design import design
-from .errors import ConvergenceError, InfeasibleError, RankConditionError, RobustCtlError
+from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, RankConditionError, RobustCtlError
 from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .lqr import lqr
 from .plant import Plant
-from .rlqr import RLQRBatch, rlqr, rlqr_gains
-from .stability import is_schur_stable, spectral_radius
+from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
+from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
 from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guaranteed_cost, robust_hinf_bound,
                        robust_stability, worst_case)
@@ -23,8 +23,9 @@ from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guarant
 
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
-    "hinf", "HinfController", "spectral_radius", "is_schur_stable",
-    "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError",
+    "rlqr_schedule", "RLQRSchedule", "hinf", "HinfController",
+    "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
+    "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
 ]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
             "RobustStability", "CostBound", "HinfBound", "WorstCase"]

@@ -84,6 +84,9 @@ class RLQRTuningProblem(Problem):
         As documented by the subclasses; ``Q``, ``R`` and ``alpha`` are checked
         by :func:`robustctl.rlqr_gains` itself (one trial design here), so a bad
         weight is reported at construction with the library's message.
+    fallback : {"recursion", "newton"}
+        :func:`robustctl.rlqr_gains`'s treatment of designs the doubling
+        leaves unsettled.
     default_hv, default_molsp : (M,) ndarray
         The subclass's reference points.
     n_obj : int
@@ -95,7 +98,7 @@ class RLQRTuningProblem(Problem):
     """
 
     def __init__(self, plant: rc.Plant, H: np.ndarray, F_s: np.ndarray, G_s: np.ndarray, input_map, *,
-                 Q, R, alpha: float, max_iter: int, aggregate: str, penalty: float, hv_ref_point,
+                 Q, R, alpha: float, max_iter: int, fallback: str, aggregate: str, penalty: float, hv_ref_point,
                  molsp_ref_point, default_hv: np.ndarray, default_molsp: np.ndarray, n_obj: int, xl, xu,
                  backend: str):
         self.plant, self.H = plant, H
@@ -104,8 +107,9 @@ class RLQRTuningProblem(Problem):
         n, m = plant.n, plant.m
         self.Q = np.eye(n) if Q is None else as_matrix(Q, "Q")
         self.R = np.eye(m) if R is None else as_matrix(R, "R")
+        self.fallback = fallback
         rc.rlqr_gains(plant, np.zeros((1, 1, n)), np.zeros((1, 1, m)), np.ones(1), Q=self.Q, R=self.R, H=H,
-                      alpha=self.alpha, max_iter=1)                      # checks Q, R, H, alpha
+                      alpha=self.alpha, max_iter=1, fallback=fallback)   # checks Q, R, H, alpha, fallback
         if aggregate not in ("mean", "max"):
             raise ValueError(f"aggregate must be 'mean' or 'max', got {aggregate!r}")
         self.aggregate = aggregate
@@ -149,7 +153,7 @@ class RLQRTuningProblem(Problem):
         """The batched RLQR design of a population ``z`` (B, n + m + 1)."""
         EF, EG, mu = self.decode(z)
         return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
-                             max_iter=self.max_iter)
+                             max_iter=self.max_iter, fallback=self.fallback)
 
     # -- closed loops -------------------------------------------------------------
     def check_gains(self, K) -> np.ndarray:

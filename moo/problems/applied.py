@@ -92,6 +92,13 @@ class AppliedRLQRProblem(RLQRTuningProblem):
         designs, the 2710 stable ones converged within 12 steps except two
         with ``E_G1 ~ E_G2`` (a nearly singular split of the doubled column),
         which took 346 and 872.
+    fallback : {"newton", "recursion"}
+        How :func:`robustctl.rlqr_gains` treats the designs the doubling
+        leaves unsettled (those ill-conditioned ``E_G1 ~ E_G2`` splits): Newton
+        refinement of the doubling result (default; within 4e-11 of a 1e-13
+        reference recursion and about 15x cheaper than the capped plain
+        recursion, whose 2000 steps cost most of an NSGA-II run), or the plain
+        recursion.
     path : ReferencePath, optional
         Reference path (default :func:`robustctl.path.default_route`, 540 s).
     overloads : sequence of float
@@ -147,6 +154,7 @@ class AppliedRLQRProblem(RLQRTuningProblem):
         R=None,
         alpha: float = 0.1,
         max_iter: int = 2000,
+        fallback: Literal["newton", "recursion"] = "newton",
         path: ReferencePath | None = None,
         overloads=(0.0, 100.0),
         aggregate: Literal["mean", "max"] = "mean",
@@ -168,7 +176,7 @@ class AppliedRLQRProblem(RLQRTuningProblem):
         F_s, G_s, _ = truck.discretise(self.overloads)       # true plants of the scenarios (S, 4, 4), (S, 4, 1)
         super().__init__(plant, np.ones((plant.n, 1)), F_s, G_s, truck.DOUBLED_INPUT_MAP,
                          Q=Q_default if Q is None else Q, R=R_default if R is None else R, alpha=alpha,
-                         max_iter=max_iter, aggregate=aggregate, penalty=penalty, hv_ref_point=hv_ref_point,
+                         max_iter=max_iter, fallback=fallback, aggregate=aggregate, penalty=penalty, hv_ref_point=hv_ref_point,
                          molsp_ref_point=molsp_ref_point, default_hv=self._HV_REF,
                          default_molsp=self._MOLSP_REF, n_obj=4, xl=Z_LOWER, xu=Z_UPPER, backend=backend)
         if self.penalty <= DEFAULT_BOUND**2:

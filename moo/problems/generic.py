@@ -106,7 +106,9 @@ class GenericRLQRProblem(RLQRTuningProblem):
         MO-LSP's mutants reach), the 6844 stable ones all converged within 10
         steps, none of the 521 that needed more than 300 steps was stable on
         the true plant, and caps of 30, 50, 100 and 200 gave identical
-        objectives.
+        objectives. The fallback is the plain recursion
+        (``rlqr_gains(..., fallback="recursion")``): it is what penalises
+        those slow designs through ``max_iter``.
     deltas : 1-D array_like, optional
         The uncertainty realisations, each in ``[-1, 1]``. Default: ``-1``, ``+1``
         and ``n_deltas - 2`` values drawn from ``U(-1, 1)`` with ``seed``.
@@ -203,7 +205,7 @@ class GenericRLQRProblem(RLQRTuningProblem):
         F_s = F_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EF_true)
         G_s = G_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EG_true)
         super().__init__(rc.Plant(F_GENERIC, G_GENERIC, dt=1.0), H_GENERIC.copy(), F_s, G_s, None, Q=Q, R=R,
-                         alpha=alpha, max_iter=max_iter, aggregate=aggregate, penalty=penalty,
+                         alpha=alpha, max_iter=max_iter, fallback="recursion", aggregate=aggregate, penalty=penalty,
                          hv_ref_point=hv_ref_point, molsp_ref_point=molsp_ref_point, default_hv=self._HV_REF,
                          default_molsp=self._MOLSP_REF, n_obj=n, xl=0.0, xu=200.0, backend=backend)
         # one regulation run per (scenario, initial state): scenario index s * n0 + i
