@@ -199,23 +199,26 @@ def closed_loop(KT, F, G, xr, uff, w, e0, lim, bound, dead, keep, sq, sqx, div_s
                                 xn[o + j] += ((a0 * x[ol + j] + a1 * x[ol + W + j] + a2 * x[ol + 2 * W + j])
                                               + a3 * x[ol + 3 * W + j])
                         c = w[sW, tW, i]
-                        if p == 1:
-                            g = G[sG, tG, i, 0]
-                            for j in range(nb):
-                                xn[o + j] = (xn[o + j] + g * u[j]) + c
-                        else:
+                        if p > 1:
                             for j in range(nb):
                                 gu = 0.0
                                 for q in range(p):
                                     gu += G[sG, tG, i, q] * u[q * W + j]
                                 xn[o + j] = (xn[o + j] + gu) + c
-                    x, xn = xn, x
-                    if any_dead:
-                        for i in range(n):
+                        elif any_dead:                   # frozen runs: x = x_ref + ef
+                            g = G[sG, tG, i, 0]
                             r = xr[sX, k + 1, i]
-                            o = i * W
                             for j in range(nb):
-                                x[o + j] = x[o + j] if alive[j] else r + ef[o + j]
+                                xn[o + j] = (xn[o + j] + g * u[j]) + c if alive[j] else r + ef[o + j]
+                        else:
+                            g = G[sG, tG, i, 0]
+                            for j in range(nb):
+                                xn[o + j] = (xn[o + j] + g * u[j]) + c
+                        if p > 1 and any_dead:
+                            r = xr[sX, k + 1, i]
+                            for j in range(nb):
+                                xn[o + j] = xn[o + j] if alive[j] else r + ef[o + j]
+                    x, xn = xn, x
             for j in range(nb):
                 div_step[b0 + j, s] = div[j]
                 sat_steps[b0 + j, s] = nsat[j]
