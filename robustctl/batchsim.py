@@ -47,6 +47,7 @@ error from a reference trajectory).
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from typing import Literal, Sequence
 
@@ -221,6 +222,13 @@ def _scenario_count(arrays: dict[str, np.ndarray]) -> int:
     return S
 
 
+def _input_map(input_map, p: int) -> np.ndarray:
+    """The (p, m) input map (a 1-D map is one row)."""
+    M = as_float_array(input_map, "input_map")
+    return as_batch(M if M.ndim == 2 else M[None], "input_map", (p, None),
+                    ("the plant's inputs, from G", "the controller's inputs"))
+
+
 def _limits(u_limit, p: int) -> np.ndarray:
     """(p,) saturation levels, ``inf`` for none."""
     if u_limit is None:
@@ -305,13 +313,8 @@ class LinearSimulator:
         self.S = _scenario_count({"F": self._F, "G": self._G, "x_ref": self._xr, "u_ff": self._uff,
                                   "w": self._w, "x0": self._e0})
         self.n, self.p, self.T = n, p, T
-        if input_map is None:
-            self._M, self.m = None, p
-        else:
-            M = as_float_array(input_map, "input_map")
-            M = as_batch(M if M.ndim == 2 else M[None], "input_map", (p, None),
-                         ("the plant's inputs, from G", "the controller's inputs"))
-            self._M, self.m = M, M.shape[1]
+        self._M = None if input_map is None else _input_map(input_map, p)
+        self.m = p if input_map is None else self._M.shape[1]
         self._lim = _limits(u_limit, p)
         self._has_limit = u_limit is not None
         self._bound = check_positive_scalar(bound, "bound", allow_inf=True)
@@ -327,11 +330,9 @@ class LinearSimulator:
 
     def with_input_map(self, input_map) -> "LinearSimulator":
         """The same simulator with another input map ``M`` (p, m') (no other argument is checked again)."""
-        M = as_float_array(input_map, "input_map")
-        M = as_batch(M if M.ndim == 2 else M[None], "input_map", (self.p, None),
-                     ("the plant's inputs, from G", "the controller's inputs"))
-        other = object.__new__(LinearSimulator)
-        other.__dict__.update(self.__dict__, _M=M, m=M.shape[1])
+        M = _input_map(input_map, self.p)
+        other = copy.copy(self)
+        other._M, other.m = M, M.shape[1]
         return other
 
     def run(self, K, *, keep_trajectories: bool = True, nan_gains: Literal["raise", "flag"] = "raise",

@@ -49,9 +49,9 @@ G_GENERIC = np.array([[0.6], [0.1], [0.25]])
 H_GENERIC = np.ones((3, 1))
 EF_TRUE = np.array([[0.1, 0.2, 0.2]])
 EG_TRUE = np.array([[0.1]])
-#: Divergence bound of the regulation runs: never reached by a Schur-stable loop
-#: from the initial states, it only keeps the unstable scenarios finite (their
-#: errors are reported as inf).
+#: Divergence bound of the regulation runs: far above the transient of any
+#: Schur-stable loop from the initial states; it only keeps the unstable
+#: scenarios finite (their errors are reported as inf).
 _REGULATION_BOUND = 1e100
 
 
