@@ -146,7 +146,7 @@ def problem_dir(problem: str, n_obj: int | None) -> str:
 
 
 def run_seeds(runs: int, base_seed: int = 0) -> list[int]:
-    """The integer seeds of runs ``0 .. runs-1`` (see the module docstring)."""
+    """The integer seeds of runs ``0`` to ``runs - 1`` (see the module docstring)."""
     runs = check_int(runs, "runs", 1)
     base_seed = check_int(base_seed, "base_seed", 0)
     return [int(child.generate_state(1)[0]) for child in np.random.SeedSequence(base_seed).spawn(runs)]

@@ -84,7 +84,7 @@ def _versions() -> dict[str, str]:
 
 @dataclass(frozen=True, repr=False)
 class RunResult:
-    """The record of one run (see :func:`run`); :meth:`to_dict` gives its JSON form.
+    """The record of one run (see :func:`run`); :meth:`~RunResult.to_dict` gives its JSON form.
 
     ``F``/``X`` are the objectives and decision vectors of the final
     non-dominated set (of the final population together with the algorithm's

@@ -12,6 +12,8 @@ from .controller import Controller
 from .design import design
 from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, RankConditionError, RobustCtlError
 from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
+from .h2 import H2Controller, h2
+from .regions import ConicSector, Disk, HalfPlane
 from .lqr import lqr
 from .plant import Plant
 from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
@@ -24,6 +26,7 @@ from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guarant
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
     "rlqr_schedule", "RLQRSchedule", "hinf", "HinfController",
+    "h2", "H2Controller", "Disk", "HalfPlane", "ConicSector",
     "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
 ]

@@ -67,19 +67,34 @@ def _row4(F, s, t, i, l, n):
 def closed_loop(KT, F, G, xr, uff, w, e0, lim, bound, dead, keep, sq, sqx, div_step, sat_steps, E, U):
     """Run ``x[k+1] = F x[k] + G u[k] + w[k]``, ``u[k] = sat(K (x[k] - xr[k]) + uff[k])`` for all gains.
 
-    Parameters (C-contiguous; a leading size 1 broadcasts over scenarios or time)
+    Parameters
     ----------
-    KT : (p, n, B) float64
+    KT : (p, n, B) float64 ndarray
         Effective gains (input map applied), design ``b`` at ``[:, :, b]``.
-    F : (1 or S, 1 or T, n, n); G : (1 or S, 1 or T, n, p)
-    xr : (1 or S, T, n); uff : (1 or S, 1 or T, p); w : (1 or S, 1 or T, n); e0 : (1 or S, n)
-    lim : (p,) saturation levels (``inf``: none); bound : float (``inf``: no divergence test)
-    dead : (B,) bool, gains flagged as not computable (frozen at ``+bound`` from step 0)
-    keep : bool, write the trajectories ``E`` (B, S, T, n) and ``U`` (B, S, T, p)
+    F, G : (1 or S, 1 or T, n, n), (1 or S, 1 or T, n, p) ndarray
+        Plant per scenario and time step (a leading size 1 broadcasts).
+    xr, uff, w : (1 or S, T, n), (1 or S, 1 or T, p), (1 or S, 1 or T, n) ndarray
+        Reference, feedforward, disturbance.
+    e0 : (1 or S, n) ndarray
+        Initial errors.
+    lim : (p,) ndarray
+        Saturation levels (``inf``: none).
+    bound : float
+        Divergence bound (``inf``: no test).
+    dead : (B,) bool ndarray
+        Gains flagged as not computable (frozen at ``+bound`` from step 0).
+    keep : bool
+        Write the trajectories ``E`` and ``U``.
+    sq, sqx : (B, S, n) ndarray
+        Output: sums of ``e^2`` and ``x^2``.
+    div_step, sat_steps : (B, S) int64 ndarray
+        Output: first step beyond the bound (-1: none), steps at a limit.
+    E, U : (B, S, T, n), (B, S, T, p) ndarray
+        Output trajectories when ``keep`` (else any 4-D arrays, unused).
 
-    Outputs (written in place)
-    --------------------------
-    sq, sqx : (B, S, n) sums of ``e^2`` and ``x^2``; div_step, sat_steps : (B, S) int64
+    Notes
+    -----
+    Every array is C-contiguous; the outputs are written in place.
     """
     p, n, B = KT.shape
     S = sq.shape[1]

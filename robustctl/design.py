@@ -14,6 +14,7 @@ METHODS = {
     "lqr": "robustctl.lqr:lqr",
     "rlqr": "robustctl.rlqr:rlqr",
     "hinf": "robustctl.hinf:hinf",
+    "h2": "robustctl.h2:h2",
 }
 
 

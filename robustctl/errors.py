@@ -29,9 +29,10 @@ class InfeasibleError(RobustCtlError, ValueError):
 class NotStabilizableError(ConvergenceError, InfeasibleError):
     """The plant is not stabilisable: some unstable mode cannot be moved by the input (PBH test).
 
-    Raised by every design (``lqr``, ``rlqr``, ``hinf``) before it starts, since
-    no gain ``u = K x`` stabilises such a plant. It is both a
-    :class:`ConvergenceError` (what ``lqr`` raised when its Riccati solver
-    failed on such plants) and an :class:`InfeasibleError` (what ``hinf``
-    raises), so handlers written for either keep working.
+    Raised by ``lqr`` and ``rlqr`` before they start
+    (:func:`robustctl.stability.check_stabilizable`), since no gain ``u = K x``
+    stabilises such a plant. It is both a :class:`ConvergenceError` (what
+    ``lqr`` raised when its Riccati solver failed on such plants) and an
+    :class:`InfeasibleError` (what ``hinf`` raises, with the same message), so
+    handlers written for either keep working.
     """

@@ -94,8 +94,8 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     Raises
     ------
     NotStabilizableError
-        ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`),
-        as ``rlqr`` and ``hinf`` do.
+        ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`);
+        ``rlqr`` raises the same, ``hinf`` an ``InfeasibleError`` (which this error also is).
     ConvergenceError
         No backend solves the Riccati equation (e.g. ``(F, Q)`` not detectable).
     """

@@ -80,7 +80,7 @@ class Plant:
 
     @property
     def is_stabilizable(self) -> bool:
-        """Some gain ``u = K x`` makes the loop stable (no :attr:`unstabilizable_modes`)."""
+        """Some gain ``u = K x`` makes the loop stable (no ``unstabilizable_modes``)."""
         return self.unstabilizable_modes.size == 0
 
     # -- constructors ------------------------------------------------------

@@ -120,8 +120,9 @@ def unstabilizable_modes(F, G, *, discrete: bool = True) -> np.ndarray:
 def check_stabilizable(plant, name: str = "plant") -> None:
     """Raise :class:`~robustctl.errors.NotStabilizableError` if ``plant`` (a :class:`~robustctl.Plant`) is not stabilisable.
 
-    Every design (``lqr``, ``rlqr``, ``hinf``) calls this first: no gain ``u = K x``
-    stabilises such a plant, so there is no design to return.
+    ``lqr`` and ``rlqr`` call this first: no gain ``u = K x`` stabilises such a
+    plant, so there is no design to return. ``name`` names the plant in the
+    message (e.g. ``"vertices[0]"``).
     """
     stuck = plant.unstabilizable_modes  # cached on the plant
     if stuck.size:

@@ -292,6 +292,7 @@ def test_batch_broadcasting_and_shapes():
         ({"implementation": "fast"}, ValueError, "implementation must be"),
     ],
 )
+@pytest.mark.filterwarnings("ignore:rlqr\\(\\.\\.\\., horizon=N\\) is deprecated:DeprecationWarning")
 def test_rlqr_bad_input(generic_plant, kw, err, match):
     args = {"EF": [[0.1, 0.2, 0.2]], "EG": [[0.1]], "mu": 1e3}
     args.update(kw)

@@ -114,7 +114,7 @@ def asf_matrix(F_norm: np.ndarray, weights: np.ndarray) -> np.ndarray:
     F_norm : ndarray, shape (N, M)
         Normalised objective vectors (ideal point at the origin).
     weights : ndarray, shape (K, M)
-        Weight vectors; zero components are replaced by :data:`ZERO_WEIGHT`.
+        Weight vectors; zero components are replaced by ``ZERO_WEIGHT`` (1e-6).
 
     Returns
     -------

@@ -415,7 +415,7 @@ def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     Generic: ``[front (N), nominal, random]``; applied: ``[front (N), nominal,
     RLQR^A, random]`` (the paper's order, see the module docstring). The front
     and random designs are computed in one batched RLQR call
-    (:meth:`problem.gains`), with the problem's ``Q``, ``R``, ``alpha`` and
+    (:meth:`~moo.problems.generic.GenericRLQRProblem.gains`), with the problem's ``Q``, ``R``, ``alpha`` and
     ``max_iter``; a design that fails keeps NaN gains (``ok`` False) and can
     never win.
 

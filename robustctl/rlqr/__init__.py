@@ -69,10 +69,13 @@ depends on ``EF, EG``: the design is the nominal regulator (``S = mu^-1 I``),
 equal to the LQR as ``mu -> inf``. With ``EF = EG = 0`` and ``H != 0``,
 ``lambda`` has no effect.
 
-Errors. Like :func:`robustctl.lqr` and :func:`robustctl.hinf`, :func:`rlqr`
-raises :class:`~robustctl.errors.NotStabilizableError` for a plant that is not
-stabilisable (for finite ``mu`` the fictitious input ``v`` would otherwise
-"stabilise" ``L`` while no ``K`` stabilises ``F + G K``);
+Errors. :func:`rlqr` raises :class:`~robustctl.errors.NotStabilizableError`
+for a plant that is not stabilisable (PBH test,
+:func:`robustctl.stability.check_stabilizable`), as :func:`robustctl.lqr`
+does; :func:`robustctl.hinf` raises an ``InfeasibleError`` with the same
+message, and ``NotStabilizableError`` is one too. Without the check the
+recursion would not fail: for finite ``mu`` the fictitious input ``v``
+"stabilises" ``L`` while no ``K`` stabilises ``F + G K``.
 :func:`rlqr_gains` flags every design ``"unstabilizable"`` instead.
 
 References
@@ -331,8 +334,8 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     Raises
     ------
     NotStabilizableError
-        ``(F, G)`` is not stabilisable (as :func:`robustctl.lqr` and
-        :func:`robustctl.hinf` raise).
+        ``(F, G)`` is not stabilisable; :func:`robustctl.lqr` raises the same,
+        :func:`robustctl.hinf` an ``InfeasibleError`` (which this error also is).
     RankConditionError
         ``mu = inf`` and ``EG`` is not of full row rank (``[I -G; 0 -EG]`` is
         then not of full row rank and ``EF + EG K = 0`` may have no solution).

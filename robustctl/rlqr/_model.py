@@ -41,15 +41,11 @@ class Model:
     S: np.ndarray        # (B, n, n)
     lam_inv: np.ndarray  # (B,)
     soft: bool           # some mu of the batch is finite (S != 0); a selection keeps its batch's value
+    h_norm2: float       # ||H'H||_2
 
     @property
     def size(self) -> int:
         return self.mu.shape[0]
-
-    @property
-    def h_norm2(self) -> float:
-        """``||H'H||_2``."""
-        return _norm2(self.H)
 
     def lam(self) -> np.ndarray:
         """``lambda`` per design (0 without uncertainty, ``inf`` at ``mu = inf``)."""
@@ -62,7 +58,7 @@ class Model:
         if mask.dtype == bool and mask.all():
             return self
         return Model(self.F, self.G, self.Q, self.R, self.H, self.alpha, self.mu[mask], self.EF[mask],
-                     self.EG[mask], self.S[mask], self.lam_inv[mask], self.soft)
+                     self.EG[mask], self.S[mask], self.lam_inv[mask], self.soft, self.h_norm2)
 
     def rank_ok(self) -> np.ndarray:
         """Per design: unless ``mu = inf`` with ``H != 0``, True; else ``EG`` (l x m) has full row rank l."""
@@ -168,4 +164,4 @@ def build(plant, EF, EG, mu, *, Q, R, H, alpha, uncertainty=None, batch: bool) -
     else:  # S = mu^-1 (I - H H' / ((1 + alpha) ||H'H||)) >= 0
         lam_inv = mu_inv / ((1.0 + alpha) * hh)
         S = mu_inv[:, None, None] * (np.eye(n) - H @ H.T / ((1.0 + alpha) * hh))
-    return Model(plant.F, plant.G, Q, R, H, alpha, mu, EF, EG, S, lam_inv, bool(np.any(mu_inv > 0)))
+    return Model(plant.F, plant.G, Q, R, H, alpha, mu, EF, EG, S, lam_inv, bool(np.any(mu_inv > 0)), hh)

@@ -29,6 +29,7 @@ STEIN_TOL = 1e-17
 STEIN_MAX_SQUARINGS = 60
 
 StepFunction = Callable[[np.ndarray, Model], Step]
+_TINY = np.finfo(float).tiny
 
 
 class Evaluation(NamedTuple):
@@ -68,7 +69,7 @@ def _fro(X: np.ndarray) -> np.ndarray:
 
 
 def relchange(P_new: np.ndarray, P: np.ndarray) -> np.ndarray:
-    return _fro(P_new - P) / np.maximum(_fro(P_new), np.finfo(float).tiny)
+    return _fro(P_new - P) / np.maximum(_fro(P_new), _TINY)
 
 
 def healthy(P: np.ndarray) -> np.ndarray:
@@ -131,11 +132,11 @@ def doubling(d: Model, tol: float):
     n = d.F.shape[0]
     Rinv = np.linalg.inv(d.R)
     EGR = d.EG @ Rinv                                                  # (B, l, m)
-    Gam = solve(d.lam_inv[:, None, None] * np.eye(l) + EGR @ np.swapaxes(d.EG, 1, 2),
+    Gam = solve(d.lam_inv[:, None, None] * np.eye(l) + EGR @ d.EG.swapaxes(1, 2),
                 np.broadcast_to(np.eye(l), (B, l, l)))
-    A = d.F - d.G @ (np.swapaxes(EGR, 1, 2) @ Gam @ d.EF)
-    H = sym(d.Q + np.swapaxes(d.EF, 1, 2) @ Gam @ d.EF)
-    Gs = sym(d.G @ (Rinv - np.swapaxes(EGR, 1, 2) @ Gam @ EGR) @ d.G.T + d.S)
+    A = d.F - d.G @ (EGR.swapaxes(1, 2) @ Gam @ d.EF)
+    H = sym(d.Q + d.EF.swapaxes(1, 2) @ Gam @ d.EF)
+    Gs = sym(d.G @ (Rinv - EGR.swapaxes(1, 2) @ Gam @ EGR) @ d.G.T + d.S)
     steps = np.zeros(B, dtype=int)
     settled = np.zeros(B, dtype=bool)
     active = healthy(H) & healthy(Gs)
@@ -147,7 +148,7 @@ def doubling(d: Model, tol: float):
         a, g, h = A[idx], Gs[idx], H[idx]
         sol = solve(eye + g @ h, np.concatenate([a, g], axis=2))      # W^-1 [A, G]
         WA, WG = sol[..., :n], sol[..., n:]
-        aT = np.swapaxes(a, 1, 2)
+        aT = a.swapaxes(1, 2)
         h_new = sym(h + aT @ h @ WA)
         ok = healthy(h_new)
         change = np.where(ok, relchange(h_new, h), np.inf)
@@ -162,7 +163,7 @@ def stein(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     """Solve ``X = A' X A + C`` (batched, ``rho(A) < 1``) by Smith's doubling iteration."""
     X, Ak = C.copy(), A.copy()
     for _ in range(STEIN_MAX_SQUARINGS):
-        inc = np.swapaxes(Ak, 1, 2) @ X @ Ak
+        inc = Ak.swapaxes(1, 2) @ X @ Ak
         X = X + inc
         Ak = Ak @ Ak
         if np.all(np.abs(inc) <= STEIN_TOL * np.abs(X).max(axis=(1, 2), keepdims=True)):

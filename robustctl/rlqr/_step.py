@@ -21,7 +21,7 @@ class Step(NamedTuple):
 
 
 def sym(P: np.ndarray) -> np.ndarray:
-    return 0.5 * (P + np.swapaxes(P, -1, -2))
+    return 0.5 * (P + P.swapaxes(-1, -2))
 
 
 def solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -52,7 +52,7 @@ def kkt_step(P: np.ndarray, d: Model) -> Step:
     GtPt = d.G.T @ Pt                                              # (B, m, n)
     kkt = np.zeros((P.shape[0], m + l, m + l))
     kkt[:, :m, :m] = d.R + GtPt @ d.G
-    kkt[:, :m, m:] = np.swapaxes(d.EG, 1, 2)
+    kkt[:, :m, m:] = d.EG.swapaxes(1, 2)
     kkt[:, m:, :m] = d.EG
     kkt[:, m:, m:] = -d.lam_inv[:, None, None] * np.eye(l)
     sol = solve(kkt, -np.concatenate([GtPt @ d.F, d.EF], axis=1))  # (B, m + l, n)
@@ -60,8 +60,8 @@ def kkt_step(P: np.ndarray, d: Model) -> Step:
     Lc = d.F + d.G @ K
     L = solve(eye + d.S @ P, Lc) if soft else Lc
     # Q + K'RK + lambda^-1 nu'nu (= Q + K'RK + lambda ||EF + EG K||^2) + Lc' Pt Lc
-    stage = d.Q + np.swapaxes(K, 1, 2) @ d.R @ K + d.lam_inv[:, None, None] * (np.swapaxes(nu, 1, 2) @ nu)
-    return Step(sym(stage + np.swapaxes(Lc, 1, 2) @ Pt @ Lc), K, L)
+    stage = d.Q + K.swapaxes(1, 2) @ d.R @ K + d.lam_inv[:, None, None] * (nu.swapaxes(1, 2) @ nu)
+    return Step(sym(stage + Lc.swapaxes(1, 2) @ Pt @ Lc), K, L)
 
 
 def block_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float) -> Step:
