@@ -57,7 +57,7 @@ from ._validation import as_batch, as_float_array, check_positive_scalar
 
 __all__ = ["SimulationResult", "LinearSimulator", "simulate_linear", "check_gains", "DEFAULT_BOUND", "BACKENDS"]
 
-#: Divergence bound on |x - x_ref| (any component), in the states' units.
+#: Divergence bound on ``|x - x_ref|`` (any component), in the states' units.
 DEFAULT_BOUND = 1e3
 #: Names :meth:`LinearSimulator.run` accepts as ``backend``.
 BACKENDS = ("numba", "numpy")
@@ -126,7 +126,7 @@ class SimulationResult:
 
         Column ``j`` is the MSE of state ``objectives[j]`` (named
         ``objective_names[j]``), which is in general *not* column ``j`` of
-        :attr:`errors` (states in the plant's order; :meth:`state_mse` keeps
+        ``errors`` (states in the plant's order; :meth:`state_mse` keeps
         that order). Diverged runs get a large finite value (see the module
         docstring).
 

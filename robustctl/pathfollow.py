@@ -59,7 +59,7 @@ class PathFollowingResult(SimulationResult):
     :meth:`mse` reports the paper's ``[f1, f2, f3, f4]`` = MSE of the
     ``[rho, psidot, ydot, theta]`` errors (lateral displacement [m^2], yaw rate
     [(rad/s)^2], lateral velocity [(m/s)^2], orientation [rad^2];
-    :attr:`objective_names`), while :attr:`errors` and :meth:`state_mse` keep
+    :attr:`objective_names`), while ``errors`` and :meth:`state_mse` keep
     the model's state order ``[ydot, psidot, rho, theta]``
     (:data:`robustctl.models.truck.STATE_NAMES`). ``mse("zero")`` is the
     *regulation* error (MSE of the states themselves); for the truck it
