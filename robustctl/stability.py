@@ -39,8 +39,7 @@ from ._validation import as_float_array, as_matrix, check_square
 from .errors import NotStabilizableError
 
 __all__ = ["STABILITY_MARGIN", "spectral_radius", "spectral_abscissa", "is_schur_stable", "is_stable",
-           "immovable_modes",
-           "unstabilizable_modes", "check_stabilizable"]
+           "immovable_modes", "unstabilizable_modes", "check_stabilizable"]
 
 #: A discrete loop is stable when ``rho(A) < 1 - STABILITY_MARGIN``.
 STABILITY_MARGIN = 1e-9

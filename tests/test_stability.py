@@ -164,3 +164,31 @@ def test_every_stability_decision_uses_the_one_margin(discrete):
     assert stable.is_stabilizing() and not rc.worst_case(stable, rc.NormBounded([[0.0]], [[0.0]], [[0.0]]),
                                                          n_starts=0).destabilizing
     check_closed_loop(stable.K, [plant])
+
+
+def _rotation(r, phi):
+    """r times a rotation by phi: eigenvalues r e^(+-i phi), spectral radius r."""
+    return r * np.array([[np.cos(phi), -np.sin(phi)], [np.sin(phi), np.cos(phi)]])
+
+
+def test_spectral_radius_closed_forms():
+    A = np.stack([_rotation(r, 0.3) for r in (0.5, 0.999, 1.0, 1.7)])
+    np.testing.assert_allclose(rc.spectral_radius(A), [0.5, 0.999, 1.0, 1.7], rtol=1e-14)
+    # companion matrix of (z - 0.9)(z + 0.2)(z - 1.1): roots 0.9, -0.2, 1.1
+    c = np.poly([0.9, -0.2, 1.1])
+    comp = np.vstack([-c[1:], np.eye(3)[:2]])
+    assert rc.spectral_radius(comp) == pytest.approx(1.1, rel=1e-12)
+    assert rc.spectral_radius(np.ones((2, 3, 4, 4))).shape == (2, 3)
+
+
+def test_certificate_agrees_with_eigenvalues_on_hard_stacks():
+    """Radii just inside and just outside the circle, and a stable loop with a 1e4 transient."""
+    rng = np.random.default_rng(4)
+    A = rng.standard_normal((3000, 4, 4)) / 2.0
+    A[:1000] *= 0.999 / rc.spectral_radius(A[:1000])[:, None, None]
+    A[1000:2000] *= 1.001 / rc.spectral_radius(A[1000:2000])[:, None, None]
+    A[2000] = np.array([[0.95, 1e4, 0, 0], [0, 0.95, 0, 0], [0, 0, 0.1, 0], [0, 0, 0, 0.1]])
+    want = _rho(A) < 1.0 - STABILITY_MARGIN
+    np.testing.assert_array_equal(rc.is_schur_stable(A), want)
+    assert want[:1000].all() and not want[1000:2000].any() and want[2000]
+    np.testing.assert_array_equal(rc.is_schur_stable(A, margin=0.01), _rho(A) < 0.99)
