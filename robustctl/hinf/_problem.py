@@ -15,8 +15,8 @@ from ..regions import Region, as_regions, describe_regions
 from ..stability import check_stabilizable, immovable_modes
 from ..uncertainty import NormBounded, check_norm_bounded
 
-__all__ = ["Problem", "validate", "check_stabilisable", "check_poles_reachable",
-           "check_uncertainty"]
+__all__ = ["Problem", "validate", "check_stabilisable", "check_poles_reachable", "check_uncertainty",
+           "vertex_name"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,14 +108,15 @@ def check_uncertainty(uncertainty, plant: Plant) -> NormBounded | None:
     return uncertainty
 
 
-def _where(i: int) -> str:
+def vertex_name(i: int) -> str:
+    """How messages name ``plants[i]``: ``"plant"``, then ``"vertices[0]"``, ..."""
     return "plant" if i == 0 else f"vertices[{i - 1}]"
 
 
 def check_stabilisable(plants: Sequence[Plant]) -> None:
     """:func:`robustctl.stability.check_stabilizable` at every vertex (``NotStabilizableError``, an InfeasibleError)."""
     for i, p in enumerate(plants):
-        check_stabilizable(p, _where(i))
+        check_stabilizable(p, vertex_name(i))
 
 
 def check_poles_reachable(plants: Sequence[Plant], regions: Sequence[Region]) -> None:
@@ -143,6 +144,6 @@ def check_poles_reachable(plants: Sequence[Plant], regions: Sequence[Region]) ->
         stuck = immovable_modes(p.F, p.G, lambda z: ~np.all([r.contains(z) for r in regions], axis=0))
         if stuck.size:
             raise InfeasibleError(
-                f"{_where(i)}'s mode lambda = {complex(stuck[0]):.6g} lies outside the pole region "
+                f"{vertex_name(i)}'s mode lambda = {complex(stuck[0]):.6g} lies outside the pole region "
                 f"{describe_regions(regions)} and cannot be moved by the input G (PBH rank test), so no gain places every closed-loop pole "
                 "there")

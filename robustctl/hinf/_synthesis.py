@@ -32,7 +32,7 @@ from . import _tolerances as tol
 from ._coordinates import lqr_coordinates, normalised
 from ._gains import Gain, gain_at_level, gain_near_optimum
 from ._level import minimise_level
-from ._problem import Problem, validate
+from ._problem import Problem, validate, vertex_name
 
 __all__ = ["hinf", "HinfController", "check_closed_loop", "guaranteed_input_bound"]
 
@@ -214,7 +214,7 @@ def check_closed_loop(K: np.ndarray, plants, regions: Sequence[Region] = ()) -> 
         raise ConvergenceError("the gain K = Y X^-1 is not finite; increase backoff")
     for i, p in enumerate(plants):
         A = p.F + p.G @ K
-        where = "plant" if i == 0 else f"vertices[{i - 1}]"
+        where = vertex_name(i)
         if not is_stable(A, discrete=p.is_discrete):
             raise ConvergenceError(f"internal check failed: the LMI gain does not stabilise {where}; "
                                    "increase backoff")
