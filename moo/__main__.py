@@ -173,7 +173,7 @@ class _Progress:
 
     def __call__(self, done: int, total: int) -> None:
         frac = min(done / total, 1.0)
-        bar = "#" * int(round(frac * self.width))
+        bar = "#" * round(frac * self.width)
         sys.stderr.write(f"\r{self.label} [{bar:<{self.width}}] {done}/{total} evals")
         sys.stderr.flush()
 
@@ -207,7 +207,7 @@ def _cmd_run(args) -> int:
         if sys.stderr.isatty() else None
     try:
         result = job.run(progress=bar)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - the CLI's boundary: traceback, then one line naming it
         return _failure(exc, "the run failed")
     finally:
         if bar is not None:
@@ -241,7 +241,7 @@ def _cmd_experiment(args) -> int:
         return _error(f"{exc}; the records written stay, rerun to resume", 1)
     except ConnectionError as exc:
         return _error(str(exc), 1)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
     print(report, file=sys.stderr)
     if report.failed:

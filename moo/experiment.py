@@ -248,7 +248,7 @@ def _execute(spec: RunSpec) -> dict:
     try:
         result = runner.run(spec.problem, spec.algorithm, seed=spec.seed, evals=spec.evals, n_obj=spec.n_obj,
                             molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders)
-    except Exception as exc:           # recorded by the driver; KeyboardInterrupt etc. propagate
+    except Exception as exc:  # noqa: BLE001 - recorded by the driver; KeyboardInterrupt etc. propagate
         return {"status": "failed", "problem": spec.problem, "n_obj": spec.n_obj, "algorithm": spec.algorithm,
                 "molsp": spec.molsp, "seed": spec.seed, "run_index": spec.run_index, "budget": spec.evals,
                 "pop_size": spec.pop_size, "max_leaders": spec.max_leaders,

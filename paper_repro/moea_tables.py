@@ -56,14 +56,24 @@ import numpy as np
 if __package__ in (None, ""):                      # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from moo.algorithms import ALGORITHMS  # noqa: E402
-from moo.executors import open_executor  # noqa: E402
-from moo.experiment import run_experiment  # noqa: E402
-from moo.plots import plot_results  # noqa: E402
-from moo.stats import (INDICATORS, Comparison, analyse, friedman, ranks_to_csv, ranks_to_latex,  # noqa: E402
-                       ranks_to_markdown, to_csv, to_latex, to_markdown)
-from moo.store import load_records  # noqa: E402
-from paper_repro.paper_moea_values import PAPER_LABELS, PAPER_MOEA, paper_cell  # noqa: E402
+from moo.algorithms import ALGORITHMS
+from moo.executors import open_executor
+from moo.experiment import run_experiment
+from moo.plots import plot_results
+from moo.stats import (
+    INDICATORS,
+    Comparison,
+    analyse,
+    friedman,
+    ranks_to_csv,
+    ranks_to_latex,
+    ranks_to_markdown,
+    to_csv,
+    to_latex,
+    to_markdown,
+)
+from moo.store import load_records
+from paper_repro.paper_moea_values import PAPER_LABELS, PAPER_MOEA, paper_cell
 
 _LABELS = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
 
@@ -119,8 +129,8 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
         return ""
     algs = list(dict.fromkeys(c.algorithm for c in cells))
     by = {(c.algorithm, c.indicator): c for c in cells}
-    lines = [f"MO-LSP effect, paper vs ours ({problem}): sign of mean(MO-LSP) - mean(plain), "
-             "sig = significant at 95 % (paper: mark 'a'; ours: Tukey p < 0.05); '=' agree, 'x' differ", "",
+    lines = [(f"MO-LSP effect, paper vs ours ({problem}): sign of mean(MO-LSP) - mean(plain), "
+              "sig = significant at 95 % (paper: mark 'a'; ours: Tukey p < 0.05); '=' agree, 'x' differ"), "",
              "| MOEA | " + " | ".join(_LABELS[n] for n in INDICATORS) + " |",
              "|---|" + "---|" * len(INDICATORS)]
     for alg in algs:
@@ -150,11 +160,10 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
 
 
 def _agreement_csv(cells: Sequence[CellAgreement], path: Path) -> None:
-    rows = ["algorithm,indicator,paper_sign,paper_significant,our_sign,our_significant,our_p_tukey,"
-            "direction_agrees,full_agreement"]
-    for c in cells:
-        rows.append(f"{c.algorithm},{c.indicator},{c.paper_sign},{c.paper_significant},{c.our_sign},"
-                    f"{c.our_significant},{c.our_p_tukey!r},{c.direction_agrees},{c.full_agreement}")
+    rows = [("algorithm,indicator,paper_sign,paper_significant,our_sign,our_significant,our_p_tukey,"
+             "direction_agrees,full_agreement")]
+    rows += [f"{c.algorithm},{c.indicator},{c.paper_sign},{c.paper_significant},{c.our_sign},"
+             f"{c.our_significant},{c.our_p_tukey!r},{c.direction_agrees},{c.full_agreement}" for c in cells]
     path.write_text("\n".join(rows) + "\n", encoding="utf-8")
 
 

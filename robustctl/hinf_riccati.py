@@ -41,8 +41,8 @@ indefinite ``R`` without raising; every solution is therefore accepted only
 after its relative residual, symmetry, sign and the closed-loop spectrum are
 checked (the closed loop of the saddle point must be stable with the margin
 of :mod:`robustctl.stability`, like every stability test of the library:
-this module shares that definition, not the LMI code). The continuous case builds the Hamiltonian and its ordered Schur form
-directly (imaginary-axis eigenvalues mean ``gamma`` is too small).
+this module shares that definition, not the LMI code). The continuous case builds the Hamiltonian
+and its ordered Schur form directly (imaginary-axis eigenvalues mean ``gamma`` is too small).
 """
 
 from __future__ import annotations
@@ -108,7 +108,7 @@ def _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma):
 
 
 def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
-    n, m = G.shape
+    _n, m = G.shape
     B, Q, R, S = _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma)
     try:
         with np.errstate(all="ignore"):
@@ -124,7 +124,7 @@ def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
     except np.linalg.LinAlgError:
         return None
     res = F.T @ P @ F + Q + (F.T @ P @ B + S) @ L - P
-    scale = max(1.0, np.linalg.norm(P), np.linalg.norm(Q))
+    scale = max(1.0, float(np.linalg.norm(P)), float(np.linalg.norm(Q)))
     if not np.linalg.norm(res) <= _RES_TOL * scale:
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * scale:
@@ -149,10 +149,10 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     A = F - B @ Rinv @ S.T
     Ham = np.block([[A, -B @ Rinv @ B.T], [-(Q - S @ Rinv @ S.T), -A.T]])
     eig = np.linalg.eigvals(Ham)
-    scale = max(1.0, np.linalg.norm(Ham, 1))
+    scale = max(1.0, float(np.linalg.norm(Ham, 1)))
     if np.min(np.abs(eig.real)) <= 1e-10 * scale:
         return None  # eigenvalue on the imaginary axis: gamma too small
-    T, U, sdim = scipy.linalg.schur(Ham, output="real", sort="lhp")
+    _T, U, sdim = scipy.linalg.schur(Ham, output="real", sort="lhp")
     if sdim != n:
         return None
     U1, U2 = U[:n, :n], U[n:, :n]
@@ -162,8 +162,8 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     P = 0.5 * (P + P.T)
     L = -Rinv @ (B.T @ P + S.T)
     res = F.T @ P + P @ F + Q + (P @ B + S) @ L
-    pscale = max(1.0, np.linalg.norm(P), np.linalg.norm(Q))
-    if not np.linalg.norm(res) <= 1e-6 * pscale * max(1.0, np.linalg.norm(F)):
+    pscale = max(1.0, float(np.linalg.norm(P)), float(np.linalg.norm(Q)))
+    if not np.linalg.norm(res) <= 1e-6 * pscale * max(1.0, float(np.linalg.norm(F))):
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * pscale:
         return None

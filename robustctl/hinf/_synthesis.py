@@ -15,8 +15,9 @@
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -187,7 +188,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
                        w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
                        uncertainty=uncertainty)
-    w_scale = float(np.sqrt(problem.w_energy)) if problem.u_max is not None else 1.0
+    w_scale = 1.0 if problem.w_energy is None else math.sqrt(problem.w_energy)  # set exactly with u_max
     balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
                           problem.Dzu, problem.Dzw, w_scale, problem.uncertainty)
     lqr = None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
