@@ -78,10 +78,10 @@ import numpy as np
 from ._validation import as_float_array, check_bool
 from .batchsim import DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
 from .models import truck as _truck
-from .path import ReferencePath
+from .path import LaneChange, ReferencePath, Straight
 
 __all__ = ["PathFollowing", "PathFollowingResult", "PathFollowingSetup", "SETUPS", "get_setup", "simulate",
-           "DEFAULT_INITIAL_ERROR"]
+           "DEFAULT_INITIAL_ERROR", "code_manoeuvre"]
 
 #: Initial path-following error of the ``"ours"`` set-up: the truck starts 1 m to the
 #: left of the path, parallel to it, at steady speed ([ydot, psidot, rho, theta]).
@@ -272,6 +272,29 @@ def _scenarios(overloads, T: int) -> tuple:
                                  f"(the path's samples), got {a.shape}")
             out.append(a)
     return tuple(out)
+
+
+def code_manoeuvre(*, params: _truck.TruckParameters | None = None) -> ReferencePath:
+    """The reference manoeuvre of the authors' code, as a path: 30 s with two sine lane changes.
+
+    ``standard_formulation/parameters.m`` of Barbosa et al. (2019)'s code
+    (GitHub ``barbosafilipe/robust_lqr``) drives the nominal vehicle open
+    loop for 30 s on a straight road with the steering command ``0.01
+    sin(0.4 pi t)`` rad for 5 s from ``t = 10 s`` (a lane change to the left)
+    and its negative from ``t = 20 s`` (back). This is the path whose
+    steady-cornering steering (``alpha_per_kappa kappa``,
+    :func:`robustctl.models.truck.steady_state_cornering`, nominal payload)
+    is that command: straights and two :class:`~robustctl.path.LaneChange`
+    elements of ``5 v`` metres and offset ``0.01 L^2 / (2 pi alpha_per_kappa)``
+    (``L = 5 v``), so the ``"open_loop"`` reference of :data:`SETUPS` along it
+    is the code's ``x_ref`` (at our 0.1 s sampling, ZOH model).
+    """
+    p = _truck._params(params)
+    _, a_per_kappa = _truck.steady_state_cornering(0.0, params=p)
+    L = 5.0 * p.v
+    offset = 0.01 * L**2 / (2.0 * np.pi * a_per_kappa)
+    return ReferencePath.from_segments([Straight(2 * L), LaneChange(offset, L), Straight(L), LaneChange(-offset, L)],
+                                       duration=30.0, speed=p.v, dt=p.dt, name="code manoeuvre")
 
 
 class PathFollowing:

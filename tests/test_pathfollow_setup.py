@@ -7,8 +7,8 @@ import scipy.signal
 import robustctl as rc
 from robustctl.models import truck
 from robustctl.path import LaneChange, ReferencePath, Straight, Curve, default_route
-from robustctl.pathfollow import (DEFAULT_INITIAL_ERROR, SETUPS, PathFollowing, PathFollowingSetup, get_setup,
-                                  simulate)
+from robustctl.pathfollow import (DEFAULT_INITIAL_ERROR, SETUPS, PathFollowing, PathFollowingSetup, code_manoeuvre,
+                                  get_setup, simulate)
 
 OVERLOADS = (0.0, 200.0)
 
@@ -162,3 +162,19 @@ def test_bad_setup_fields(field, value, words):
     kwargs[field] = value
     with pytest.raises((ValueError, TypeError), match=words):
         PathFollowingSetup(**kwargs)
+
+
+def test_code_manoeuvre_is_the_codes_steering_command():
+    """Its steady-cornering steering is 0.01 sin(0.4 pi (t - 10)) on [10, 15) s, the negative on [20, 25) s."""
+    path = code_manoeuvre()
+    assert path.T == 300 and path.duration == pytest.approx(30.0)
+    _, u_ref = truck.open_loop_reference(path.kappa)
+    t = path.t
+    want = np.zeros(path.T)
+    for start, sign in ((10.0, 1.0), (20.0, -1.0)):
+        on = (t >= start - 1e-9) & (t < start + 5.0 - 1e-9)
+        # kappa is the mean over each sample: the mean of the sine over [t, t + dt]
+        a, b = 0.4 * np.pi * (t[on] - start), 0.4 * np.pi * (t[on] + path.dt - start)
+        want[on] = sign * 0.01 * (np.cos(a) - np.cos(b)) / (b - a)
+    np.testing.assert_allclose(u_ref, want, atol=1e-7)        # the path's trapezoidal heading on its 16x finer grid
+    np.testing.assert_allclose(path.heading[-1], 0.0, atol=1e-9)
