@@ -67,7 +67,7 @@ from .generic import GenericRLQRProblem
 __all__ = [
     "SelectionResult", "DesignSet", "DesignSelection", "monte_carlo_selection", "draw_deltas",
     "overload_from_delta", "generic_errors", "applied_errors", "build_designs", "select_design",
-    "MAX_OVERLOAD", "BRYSON_SCALES",
+    "MAX_OVERLOAD", "BRYSON_SCALES", "error_scales",
 ]
 
 #: Largest payload overload of the paper's robustness study [%] (Section 4.5.2: 0 to 300 %).
@@ -285,13 +285,20 @@ def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> n
     return E
 
 
+def error_scales(setup: str | PathFollowingSetup = "ours") -> np.ndarray:
+    """Default scales of :func:`applied_errors`: ``1 / sqrt(Q_ii)`` of the set-up's state weight, in the
+    objectives' order (``rho, psidot, ydot, theta``); ``"ours"`` gives :data:`BRYSON_SCALES`."""
+    setup = get_setup(setup)
+    q = np.asarray(setup.Q_diag, dtype=float)[list(truck.OBJECTIVE_STATES)]
+    if np.any(q <= 0):
+        raise ValueError(f"scales: the set-up's Q has a zero weight on an objective's state ({setup.Q_diag}); "
+                         "give scales")
+    return 1.0 / np.sqrt(q)
+
+
 def _as_scales(scales, setup: PathFollowingSetup) -> np.ndarray:
-    if scales is None:                  # 1 / sqrt(Q_ii): E is the quadratic state cost of the set-up's Q
-        q = np.asarray(setup.Q_diag, dtype=float)[list(truck.OBJECTIVE_STATES)]
-        if np.any(q <= 0):
-            raise ValueError(f"scales: the set-up's Q has a zero weight on an objective's state ({setup.Q_diag}); "
-                             "give scales")
-        return 1.0 / np.sqrt(q)
+    if scales is None:                  # E is the quadratic state cost of the set-up's Q
+        return error_scales(setup)
     s = as_matrix(scales, "scales", rows=1, cols=4, cols_what="one per objective: rho, psidot, ydot, theta").ravel()
     if np.any(s <= 0):
         raise ValueError(f"scales must be positive, got {s}")
