@@ -31,7 +31,7 @@ import numpy as np
 
 from .errors import ConvergenceError, InfeasibleError
 
-__all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "SOLVER_TOL"]
+__all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "totals", "SOLVER_TOL"]
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
@@ -81,6 +81,12 @@ class SolveReport:
                 f"{prefix}solver": self.solver, f"{prefix}tol": self.tol, f"{prefix}solve_time": self.solve_time,
                 f"{prefix}iterations": self.iterations,
                 f"{prefix}certificate": dict(self.certificate)}
+
+
+def totals(solves: Sequence[Mapping]) -> dict:
+    """``solve_time`` (s) and ``iterations`` summed over solves (each a ``SolveReport.as_dict()``)."""
+    return {"solve_time": float(sum(s["solve_time"] for s in solves)),
+            "iterations": int(sum(s["iterations"] or 0 for s in solves))}
 
 
 def certificate(lmis: Sequence[LMI]) -> dict[str, float]:

@@ -9,7 +9,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ._validation import as_float_array, as_matrix
-from .plant import Plant, _frozen
+from .plant import Plant, _frozen, check_plant
 from .stability import is_stable
 
 __all__ = ["Controller"]
@@ -40,8 +40,7 @@ class Controller:
     info: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self):
-        if not isinstance(self.plant, Plant):
-            raise TypeError(f"plant must be a robustctl.Plant, got {type(self.plant).__name__}")
+        check_plant(self.plant)
         K = as_matrix(self.K, "K", rows=self.plant.m, cols=self.plant.n,
                       rows_what="the number of inputs", cols_what="the number of states")
         object.__setattr__(self, "K", _frozen(K))
@@ -89,8 +88,7 @@ class Controller:
     def _plant(self, plant: Plant | None) -> Plant:
         if plant is None:
             return self.plant
-        if not isinstance(plant, Plant):
-            raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+        check_plant(plant)
         if (plant.n, plant.m) != (self.plant.n, self.plant.m):
             raise ValueError(f"plant must have n={self.plant.n} states and m={self.plant.m} inputs, "
                              f"got n={plant.n}, m={plant.m}")

@@ -50,16 +50,15 @@ import scipy.linalg
 from numpy.typing import ArrayLike
 
 from . import _cvx
-from ._validation import check_performance
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .hinf import _tolerances as tol
 from .hinf._coordinates import Coordinates, normalised, recentred
 from .hinf._lmis import Point, region_blocks, variables
-from .hinf._problem import check_backoff, check_poles_reachable, check_stabilisable, check_vertices
+from .hinf._problem import validate
 from .hinf._synthesis import check_closed_loop
 from .plant import Plant
-from .regions import Region, as_regions, describe_regions
+from .regions import Region, describe_regions
 
 __all__ = ["h2", "H2Controller"]
 
@@ -126,23 +125,20 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     Raises
     ------
     InfeasibleError
-        A vertex is not stabilisable, the pole regions cannot be reached
+        A vertex is not stabilisable (:class:`~robustctl.errors.NotStabilizableError`,
+        an ``InfeasibleError``), the pole regions cannot be reached
         (with the reason), or no common Lyapunov matrix exists.
     ValueError, TypeError
         Bad arguments (named in the message).
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    plants = check_vertices(plant, vertices)
-    Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
+    # the validation stage of the H-infinity synthesis, without its H-infinity-only options
+    problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=None, u_max=None,
+                       w_energy=None, backoff=backoff, extended=False, solver=solver, poles=poles)
+    plants, regions, solver, backoff = problem.plants, problem.regions, problem.solver, problem.backoff
+    Bw, Cz, Dzu, Dzw = problem.Bw, problem.Cz, problem.Dzu, problem.Dzw
     if not plant.is_discrete and np.any(Dzw):
         raise ValueError("Dzw must be zero for a continuous-time plant: a feedthrough from white noise w to z "
                          "makes the H2 norm infinite")
-    backoff = check_backoff(backoff)
-    solver = _cvx.check_solver(solver)
-    regions = as_regions(poles)
-    check_stabilisable(plants)
-    check_poles_reachable(plants, regions)
 
     data = normalised([p.F for p in plants], [p.G for p in plants], Bw, Cz, Dzu, Dzw)
     what = _infeasibility(plants, regions)
@@ -169,8 +165,7 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     info = {
         "h2_bound": h2_bound, "h2_opt": h2_opt, "h2_norms": norms, "backoff": backoff, "margin": margin,
         "certificate": cert, "solves": solves, "X": 0.5 * (X + X.T), "poles": regions, "vertices": len(plants),
-        "status": solves[-1]["status"], "solve_time": float(sum(s["solve_time"] for s in solves)),
-        "iterations": int(sum(s["iterations"] or 0 for s in solves)), "solver": solver,
+        "status": solves[-1]["status"], **_cvx.totals(solves), "solver": solver,
     }
     return H2Controller(K=K, method="h2", plant=plant, info=info, h2_bound=h2_bound, h2_opt=h2_opt)
 

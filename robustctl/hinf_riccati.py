@@ -39,7 +39,9 @@ Notes
 ``scipy.linalg.solve_discrete_are`` may return a wrong matrix for an
 indefinite ``R`` without raising; every solution is therefore accepted only
 after its relative residual, symmetry, sign and the closed-loop spectrum are
-checked. The continuous case builds the Hamiltonian and its ordered Schur form
+checked (the closed loop of the saddle point must be stable with the margin
+of :mod:`robustctl.stability`, like every stability test of the library:
+this module shares that definition, not the LMI code). The continuous case builds the Hamiltonian and its ordered Schur form
 directly (imaginary-axis eigenvalues mean ``gamma`` is too small).
 """
 
@@ -53,7 +55,8 @@ from numpy.typing import ArrayLike
 
 from ._validation import check_performance, check_positive_scalar
 from .errors import InfeasibleError
-from .plant import Plant
+from .plant import Plant, check_plant
+from .stability import is_stable
 
 __all__ = ["RiccatiHinf", "hinf_riccati", "riccati_level"]
 
@@ -90,8 +93,7 @@ class RiccatiHinf:
 
 
 def _data(plant, Bw, Cz, Dzu, Dzw):
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+    check_plant(plant)
     Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
     return plant.F, plant.G, Bw, Cz, Dzu, Dzw
 
@@ -127,7 +129,7 @@ def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * scale:
         return None
-    if np.max(np.abs(np.linalg.eigvals(F + B @ L))) >= 1.0:
+    if not is_stable(F + B @ L, discrete=True):
         return None
     Hww = H[m:, m:]
     if np.linalg.eigvalsh(0.5 * (Hww + Hww.T)).max() >= 0.0:
@@ -165,7 +167,7 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * pscale:
         return None
-    if np.max(np.linalg.eigvals(F + B @ L).real) >= 0.0:
+    if not is_stable(F + B @ L, discrete=False):
         return None
     return L[:m], P
 
@@ -213,6 +215,7 @@ def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, 
     """
     F, G, Bw, Cz, Dzu, Dzw = _data(plant, Bw, Cz, Dzu, Dzw)
     rtol = check_positive_scalar(rtol, "rtol")
+    gamma_max = check_positive_scalar(gamma_max, "gamma_max")
     level = _level_discrete if plant.is_discrete else _level_continuous
     lo = float(np.linalg.norm(Dzw, 2))
     hi = max(1.0, 2.0 * lo)

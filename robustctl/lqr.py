@@ -18,7 +18,7 @@ import scipy.linalg
 from ._validation import as_matrix, check_spd
 from .controller import Controller
 from .errors import ConvergenceError
-from .plant import Plant
+from .plant import Plant, check_plant
 from .stability import check_stabilizable
 
 __all__ = ["lqr", "dare"]
@@ -95,14 +95,11 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     ------
     NotStabilizableError
         ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`);
-        ``rlqr`` raises the same, ``hinf`` an ``InfeasibleError`` (which this error also is).
+        ``rlqr``, ``hinf`` and ``h2`` raise the same (it is also an ``InfeasibleError``).
     ConvergenceError
         No backend solves the Riccati equation (e.g. ``(F, Q)`` not detectable).
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    if not plant.is_discrete:
-        raise ValueError("plant must be discrete-time (dt > 0) for lqr; discretise it first")
+    check_plant(plant, discrete_for="lqr")
     Q, R = _weights(plant, Q, R)
     check_stabilizable(plant)
     P, backend = _dare(plant.F, plant.G, Q, R)

@@ -195,3 +195,26 @@ def test_perturb_rejects_booleans_strings_and_non_plants():
         unc.perturb(np.eye(2), 0.5)
     with pytest.raises(ValueError, match="^H must be a rectangular array"):
         rc.NormBounded([[1.0], [2.0, 3.0]], [[0.1, 0.2]], [[0.3]])
+
+
+def test_one_vertex_check_serves_hinf_h2_and_the_analysis():
+    from robustctl.validation import check_vertices
+
+    plant = rc.Plant(0.5 * np.eye(2), np.ones((2, 1)), 0.1)
+    other = rc.Plant(0.4 * np.eye(2), np.ones((2, 1)), 0.1)
+    assert check_vertices(plant, None) == [plant] and check_vertices(plant, []) == [plant]
+    assert check_vertices(plant, (other,)) == [plant, other]
+    for bad, err, match in (("ab", TypeError, "^vertices must be a list of robustctl.Plant"),
+                            (plant, TypeError, "^vertices must be a list"),
+                            ([other, 1.0], TypeError, r"^vertices\[1\] must be a robustctl.Plant, got float"),
+                            ([rc.Plant(np.eye(3), np.ones((3, 1)), 0.1)], ValueError,
+                             r"^vertices\[0\] must have n=2 states and m=1 inputs like plant, got n=3, m=1"),
+                            ([rc.Plant(np.eye(2), np.ones((2, 1)), None)], ValueError,
+                             r"^vertices\[0\] must have the sampling time of plant \(dt=0.1\), got dt=None")):
+        with pytest.raises(err, match=match):
+            check_vertices(plant, bad)
+    for empty in (None, []):
+        with pytest.raises(TypeError, match="^vertices must be a non-empty list"):
+            check_vertices(plant, empty, non_empty=True)
+    with pytest.raises(ValueError, match="like the controller's plant"):
+        rc.robust_stability((plant, np.zeros((1, 2))), vertices=[rc.Plant(np.eye(3), np.ones((3, 1)), 0.1)])

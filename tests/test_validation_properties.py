@@ -3,7 +3,7 @@ never a NaN, a hang or an exception from deep inside numpy."""
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import robustctl as rc
@@ -163,7 +163,65 @@ CASES = {
     "is_schur_stable": (lambda A=F2: rc.is_schur_stable(A), {"A": F2}),
     "unstabilizable_modes": (lambda F=F2, G=G2: unstabilizable_modes(F, G), {"F": F2, "G": G2}),
 }
-FLAGS, CHOICES, INTS = {"accelerate"}, {"method", "implementation", "fallback"}, {"max_iter", "horizon"}
+
+# ---- the LMI syntheses (hinf, h2, the Riccati reference), pole regions and the robust analysis
+from robustctl.hinf_riccati import hinf_riccati  # noqa: E402
+
+BW2, CZ2, DZU2 = np.array([[0.0], [1.0]]), np.vstack([np.eye(2), [[0.0, 0.0]]]), np.array([[0.0], [0.0], [1.0]])
+DZW2 = np.zeros((3, 1))
+PERF = {"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, "Dzw": DZW2}
+UNC_A = rc.NormBounded(0.1 * H2, EF2, EG2)   # small enough for CTRL to be robustly stable (margin 3.15)
+VERTEX = UNC_A.perturb(PLANT, 1.0)
+
+
+def _hinf(plant=PLANT, **kw):
+    return rc.hinf(plant, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+def _h2(plant=PLANT, **kw):
+    return rc.h2(plant, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+def _riccati(plant=PLANT, **kw):
+    return hinf_riccati(plant, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+def _hinf_bound(controller=CTRL, uncertainty=UNC_A, **kw):
+    return rc.robust_hinf_bound(controller, uncertainty, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+CASES.update({
+    "hinf": (_hinf, {"plant": PLANT, **PERF, "vertices": [VERTEX], "gamma": 10.0, "u_max": 100.0,
+                     "w_energy": 1.0, "backoff": 1e-3, "extended": False, "poles": rc.Disk(0.0, 0.999),
+                     "uncertainty": UNC_A, "solver": "CLARABEL"}),
+    "h2": (_h2, {"plant": PLANT, **PERF, "vertices": [VERTEX], "poles": rc.Disk(0.0, 0.999), "backoff": 1e-3,
+                 "solver": "CLARABEL"}),
+    "hinf_riccati": (_riccati, {"plant": PLANT, **PERF, "rtol": 1e-9, "gamma_max": 1e10}),
+    "Disk": (lambda center=0.0, radius=0.5: rc.Disk(center, radius), {"center": 0.0, "radius": 0.5}),
+    "HalfPlane": (lambda boundary=-1.0, side="left": rc.HalfPlane(boundary, side), {"boundary": -1.0, "side": "left"}),
+    "ConicSector": (lambda apex=0.0, angle=0.5: rc.ConicSector(apex, angle), {"apex": 0.0, "angle": 0.5}),
+    "robust_stability": (lambda controller=CTRL, uncertainty=UNC_A: rc.robust_stability(controller, uncertainty),
+                         {"controller": CTRL, "uncertainty": UNC_A}),
+    "robust_stability(vertices)": (lambda vertices=(VERTEX,): rc.robust_stability(CTRL, vertices=vertices),
+                                   {"vertices": [VERTEX]}),
+    "robust_stability((plant, K))": (lambda K=CTRL.K: rc.robust_stability((PLANT, K), UNC_A), {"K": CTRL.K}),
+    "guaranteed_cost": (lambda controller=CTRL, uncertainty=UNC_A, Q=np.eye(2), R=np.eye(1), x0=None:
+                        rc.guaranteed_cost(controller, uncertainty, Q, R, x0),
+                        {"controller": CTRL, "uncertainty": UNC_A, "Q": np.eye(2), "R": np.eye(1), "x0": np.ones(2)}),
+    "robust_hinf_bound": (_hinf_bound, {"controller": CTRL, "uncertainty": UNC_A, **PERF}),
+    "worst_case": (lambda controller=CTRL, uncertainty=UNC_A, seed=0, n_starts=2:
+                   rc.worst_case(controller, uncertainty, seed=seed, n_starts=n_starts),
+                   {"controller": CTRL, "uncertainty": UNC_A, "seed": 0, "n_starts": 2}),
+})
+FLAGS = {"accelerate", "extended"}
+CHOICES = {"method", "implementation", "fallback", "solver", "side"}
+INTS = {"max_iter", "horizon", "n_starts", "seed"}
+OBJECTS = {"vertices", "poles", "uncertainty", "controller"}   # drawn like a plant: anything but the right type
+VALID_NAMES = ("kkt", "block", "recursion", "newton", "zoh", "tustin", "euler", "lqr", "rlqr", "hinf", "h2",
+               "left", "right", "clarabel", "scs", "scipy", "highs", "osqp", "cvxopt", "mosek")
+# None is a documented value of these (default, identity, continuous time, the design plant, no bound, ...)
+NONE_OK = {"P_N", "P0", "H", "Q", "R", "dt", "Dzw", "vertices", "gamma", "u_max", "w_energy", "poles",
+           "uncertainty", "x0", "seed"}
 INF_OK = {"mu"}  # inf is a valid value of these
 CAUSES = ["bool", "string", "numeric string", "complex", "ragged", "None", "nan", "inf", "object"]
 _JUNK = st.sampled_from([{"key": 1}, object(), {1, 2}, b"bytes", print])
@@ -191,11 +249,12 @@ def _bad(valid, cause, name):
                 "complex": st.just(1j), "ragged": st.just([[True], []]), "nan": st.just(np.nan),
                 "inf": st.sampled_from([0, 1, 1.0])}[cause]
     if name in CHOICES:
-        return {"bool": st.booleans(), "string": st.text(max_size=6).filter(lambda t: t not in ("kkt", "block",
-                "recursion", "newton", "zoh", "tustin", "euler", "lqr", "rlqr", "hinf", "LQR", "RLQR", "HINF")),
+        return {"bool": st.booleans(), "string": st.text(max_size=6).filter(lambda t: t.lower() not in VALID_NAMES),
                 "numeric string": st.just("1"), "complex": st.just(1j), "ragged": st.just([["kkt"], []]),
                 "nan": st.just(np.nan), "inf": st.just(np.inf)}[cause]
-    if isinstance(valid, rc.Plant):
+    if name == "seed" and cause == "ragged":
+        return None  # numpy's SeedSequence takes nested sequences of integers as entropy
+    if isinstance(valid, rc.Plant) or name in OBJECTS:
         return {"bool": st.booleans(), "string": st.text(max_size=5), "numeric string": st.just("1"),
                 "complex": st.just(1j), "ragged": st.just([[1.0], [1.0, 2.0]]), "nan": st.just(np.nan),
                 "inf": st.just(np.inf)}[cause]
@@ -262,8 +321,8 @@ def _write_tally():
 def test_every_bad_argument_is_named(func, cause, data):
     call, args = CASES[func]
     for name, valid in args.items():
-        if cause == "None" and (name in ("P_N", "P0", "H", "Q", "R", "dt") or func.startswith("Controller.")):
-            continue  # None is a documented value there (default, identity, continuous time, the design plant)
+        if cause == "None" and (name in NONE_OK or func.startswith("Controller.")):
+            continue  # None is a documented value there
         if cause in ("nan", "inf") and func in ("spectral_radius", "is_schur_stable"):
             continue  # documented: radius inf, unstable (checked in test_stability)
         strategy = _bad(valid, cause, name)
@@ -309,6 +368,7 @@ def test_unstabilisable_plants_raise_in_every_design_and_flag_in_the_batch(seed,
 
 @SETTINGS
 @given(dt=st.floats(0.01, 1.0), other=st.floats(-5.0, 5.0), scale=st.floats(1e200, 1e300))
+@example(dt=0.8585158091592887, other=2.0, scale=1e200)  # I - A dt/2 = diag(eps/2, 0.14): cond 1.3e15 < 1/eps
 def test_discretisation_failures_name_A(dt, other, scale):
     """Cause 6 (tustin with I - A dt/2 singular) and 5 (A dt overflowing is A's fault, not F's)."""
     A = np.diag([2.0 / dt, other])
@@ -331,3 +391,29 @@ def test_controller_refuses_non_finite_states(shape, seed, value):
     with pytest.raises(ValueError, match="^x must have finite entries"):
         CTRL(x)
     TALLY[("Controller.__call__", "non-finite state")][1] += 1
+
+
+def test_issue_12_booleans_in_the_lmi_syntheses_and_the_analysis():
+    """Cause 3 for the LMI syntheses: u_max=True was accepted as a bound of 1."""
+    cases = [(lambda: _hinf(u_max=True), TypeError, "^u_max must be a positive number, got a boolean"),
+             (lambda: _hinf(u_max=[True]), TypeError, "^u_max must be a positive number, got booleans"),
+             (lambda: _hinf(backoff=True), TypeError, "^backoff must be a real number, got a boolean"),
+             (lambda: _h2(backoff="0.1"), TypeError, "^backoff must be a real number, got str"),
+             (lambda: _hinf(gamma=True), TypeError, r"^gamma must be a real number > 0, got a boolean"),
+             (lambda: _hinf(extended=1), TypeError, r"^extended must be a bool \(True or False\), got 1"),
+             (lambda: rc.Disk(0.0, True), TypeError, r"^radius must be a real number > 0, got a boolean"),
+             (lambda: rc.ConicSector(0.0, 1j), TypeError, "^angle must be a real number, got complex"),
+             (lambda: rc.worst_case(CTRL, UNC_A, seed=True), TypeError, "^seed must be None, an integer"),
+             (lambda: rc.worst_case(CTRL, UNC_A, seed="x"), TypeError, "^seed must be None, an integer"),
+             (lambda: _riccati(gamma_max=True), TypeError, "^gamma_max must be a real number > 0")]
+    for call, err, match in cases:
+        with pytest.raises(err, match=match):
+            call()
+    m2 = rc.Plant(F2, np.ones((2, 2)), 0.1)
+    kw = dict(Bw=BW2, Cz=np.vstack([np.eye(2), np.zeros((2, 2))]), Dzu=np.vstack([np.zeros((2, 2)), np.eye(2)]))
+    with pytest.raises(ValueError, match=r"^u_max must be a scalar or have 2 entries \(the number of inputs\)"):
+        rc.hinf(m2, **kw, u_max=[1.0, 2.0, 3.0])
+    with pytest.raises(TypeError, match="^u_max must be a positive number or 2 positive numbers, got str"):
+        rc.hinf(m2, **kw, u_max="1")
+    with pytest.raises(ValueError, match=r"^u_max must be > 0 for every entry, got \[1.0, -2.0\]"):
+        rc.hinf(m2, **kw, u_max=[1.0, -2.0])

@@ -7,13 +7,9 @@ absolute ones are on a known scale.
 
 from __future__ import annotations
 
-# ---------------------------------------------------------------- validation
-#: A mode counts as unstable if ``|lambda| >= 1 - UNSTABLE_MODE`` (discrete) or
-#: ``Re lambda >= -UNSTABLE_MODE * max(1, ||[F G]||)`` (continuous).
-UNSTABLE_MODE = 1e-12
-#: ... and as not stabilisable if the smallest singular value of
-#: ``[F - lambda I, G]`` is at most ``PBH_RANK * max(1, ||[F G]||)``.
-PBH_RANK = 1e-9
+# The validation's stabilisability and pole-region reachability (PBH test)
+# and the closed-loop stability check use the tolerances of
+# robustctl.stability (UNSTABLE_TOL, PBH_TOL, STABILITY_MARGIN).
 
 # ---------------------------------------------------------------- coordinates
 #: Singular values of ``[Cz Dzu Dzw]`` below ``Z_RANK * max(1, sigma_max)`` are

@@ -72,8 +72,8 @@ equal to the LQR as ``mu -> inf``. With ``EF = EG = 0`` and ``H != 0``,
 Errors. :func:`rlqr` raises :class:`~robustctl.errors.NotStabilizableError`
 for a plant that is not stabilisable (PBH test,
 :func:`robustctl.stability.check_stabilizable`), as :func:`robustctl.lqr`
-does; :func:`robustctl.hinf` raises an ``InfeasibleError`` with the same
-message, and ``NotStabilizableError`` is one too. Without the check the
+does, and so do :func:`robustctl.hinf` and :func:`robustctl.h2`
+(``NotStabilizableError`` is also an ``InfeasibleError``). Without the check the
 recursion would not fail: for finite ``mu`` the fictitious input ``v``
 "stabilises" ``L`` while no ``K`` stabilises ``F + G K``.
 :func:`rlqr_gains` flags every design ``"unstabilizable"`` instead.
@@ -103,7 +103,7 @@ from .._validation import as_matrix, check_bool, check_choice, check_int, check_
 from ..controller import Controller
 from ..errors import ConvergenceError
 from ..plant import Plant, _frozen
-from ..stability import STABILITY_MARGIN, _schur, check_stabilizable
+from ..stability import check_stabilizable, is_schur_stable
 from ._model import DEFAULT_ALPHA, Model, build
 from ._steady import DEFAULT_MAX_ITER, DEFAULT_TOL, steady_state
 from ._step import block_steps, kkt_step, rlqr_step, rlqr_step_block
@@ -276,7 +276,7 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
     ok = reason == "ok"
     K[~ok], P[~ok], L[~ok] = np.nan, np.nan, np.nan
     stabilizing = np.zeros(B, dtype=bool)
-    stabilizing[ok] = _schur(plant.F + plant.G @ K[ok], 1.0 - STABILITY_MARGIN)
+    stabilizing[ok] = is_schur_stable(plant.F + plant.G @ K[ok])
     return RLQRBatch(*(_frozen(a) for a in (K, P, L)), ok, reason, stabilizing, iterations, residual)
 
 
@@ -334,8 +334,8 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     Raises
     ------
     NotStabilizableError
-        ``(F, G)`` is not stabilisable; :func:`robustctl.lqr` raises the same,
-        :func:`robustctl.hinf` an ``InfeasibleError`` (which this error also is).
+        ``(F, G)`` is not stabilisable; :func:`robustctl.lqr`, :func:`robustctl.hinf`
+        and :func:`robustctl.h2` raise the same (it is also an ``InfeasibleError``).
     RankConditionError
         ``mu = inf`` and ``EG`` is not of full row rank (``[I -G; 0 -EG]`` is
         then not of full row rank and ``EF + EG K = 0`` may have no solution).

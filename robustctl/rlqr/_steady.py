@@ -7,7 +7,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from ..stability import STABILITY_MARGIN, _schur
+from ..stability import is_schur_stable
 from ._model import Model
 from ._step import Step, kkt_step, solve, sym
 
@@ -86,7 +86,7 @@ def evaluate(X: np.ndarray, d: Model, step: StepFunction) -> Evaluation:
     if good.any():
         idx = np.flatnonzero(good)
         new = step(X[idx], d.select(good))
-        ev.put(idx, Evaluation(*new, relchange(new.P, X[idx]), _schur(new.L, 1.0 - STABILITY_MARGIN)))
+        ev.put(idx, Evaluation(*new, relchange(new.P, X[idx]), is_schur_stable(new.L)))
     return ev
 
 
@@ -195,7 +195,7 @@ def newton(d: Model, P: np.ndarray, tol: float) -> tuple[Evaluation, np.ndarray]
             break
         P_old = P[idx]
         new = kkt_step(P_old, d.select(active))
-        ev = Evaluation(*new, relchange(new.P, P_old), _schur(new.L, 1.0 - STABILITY_MARGIN))
+        ev = Evaluation(*new, relchange(new.P, P_old), is_schur_stable(new.L))
         evaluations[idx] += 1
         better = ev.residual < best.residual[idx]
         best.put(idx[better], Evaluation(*(a[better] for a in ev)))
