@@ -61,8 +61,8 @@ import numpy as np
 
 from ._validation import as_matrix, check_int, check_positive_scalar, check_spd
 from .errors import ConvergenceError, InfeasibleError
-from .plant import Plant
-from .uncertainty import NormBounded
+from .plant import Plant, check_plant
+from .uncertainty import NormBounded, check_norm_bounded
 
 __all__ = ["HinfGame", "hinf_game", "with_input_memory"]
 
@@ -172,10 +172,7 @@ def hinf_game(plant: Plant, *, Bw, Q, R, gamma: float, horizon: int | None = Non
     ConvergenceError
         No stationary solution within ``max_iter`` steps.
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    if not plant.is_discrete:
-        raise ValueError("plant must be discrete-time (dt set): the game recursion is a difference equation")
+    check_plant(plant, discrete_for="the game Riccati recursion")
     n, m = plant.n, plant.m
     Bw = as_matrix(Bw, "Bw", rows=n, vector="column", rows_what="the number of states")
     Q = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
@@ -227,16 +224,14 @@ def with_input_memory(plant: Plant, uncertainty: NormBounded | None = None
     returned too: ``H_a = [H; 0]``, ``EF_a = [EF 0]``, ``EG`` unchanged
     (``u_prev`` is exactly known).
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+    check_plant(plant)
     n, m = plant.n, plant.m
     Fa = np.zeros((n + m, n + m))
     Fa[:n, :n] = plant.F
     aug = Plant(Fa, np.vstack([plant.G, np.eye(m)]), plant.dt)
     if uncertainty is None:
         return aug
-    if not isinstance(uncertainty, NormBounded):
-        raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
+    check_norm_bounded(uncertainty, plant)
     H, EF, EG = uncertainty.H, uncertainty.EF, uncertainty.EG
     return aug, NormBounded(np.vstack([H, np.zeros((m, H.shape[1]))]), np.hstack([EF, np.zeros((EF.shape[0], m))]),
                             EG)

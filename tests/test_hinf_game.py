@@ -191,7 +191,7 @@ def test_bad_arguments(kwargs, exc, words):
 def test_bad_plant():
     with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
         hinf_game(np.eye(2), Bw=np.ones(2), Q=np.eye(2), R=np.eye(1), gamma=1.0)
-    with pytest.raises(ValueError, match="discrete-time"):
+    with pytest.raises(ValueError, match="must be discrete-time"):
         hinf_game(Plant(np.eye(2), np.ones((2, 1)), None), Bw=np.ones(2), Q=np.eye(2), R=np.eye(1), gamma=1.0)
     with pytest.raises(TypeError, match="uncertainty must be"):
         with_input_memory(Plant(np.eye(2), np.ones((2, 1)), 0.1), "H")

@@ -153,7 +153,7 @@ def test_bad_setup(path, setup, exc, words):
 
 
 @pytest.mark.parametrize("field, value, words", [
-    ("reference", "closed", "reference must be"), ("feedforward", 1, "feedforward must be True or False"),
+    ("reference", "closed", "reference must be"), ("feedforward", 1, "feedforward must be a bool"),
     ("x0", (0.0, 1.0), "x0 must be 4 finite"), ("Q_diag", (1.0, 1.0, -1.0, 1.0), "Q_diag must be >= 0"),
     ("r", 0.0, "r must be positive"),
 ])
