@@ -110,7 +110,8 @@ from robustctl.batchsim import BACKENDS  # noqa: E402
 from robustctl.hinf_game import hinf_game, with_input_memory  # noqa: E402
 from robustctl.models import truck  # noqa: E402
 from robustctl.path import default_route  # noqa: E402
-from robustctl.pathfollow import SETUPS, PathFollowing, PathFollowingResult, PathFollowingSetup, code_manoeuvre  # noqa: E402,E501
+from robustctl.pathfollow import (SETUPS, PathFollowing, PathFollowingResult, PathFollowingSetup,  # noqa: E402
+                                  code_manoeuvre)
 
 from paper_repro.paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS, PAPER_MSE  # noqa: E402
 

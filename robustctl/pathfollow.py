@@ -75,7 +75,7 @@ from typing import Literal
 
 import numpy as np
 
-from ._validation import as_float_array, check_bool
+from ._validation import as_batch, as_float_array, check_bool, check_choice, check_positive_scalar
 from .batchsim import DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
 from .models import truck as _truck
 from .path import LaneChange, ReferencePath, Straight
@@ -128,17 +128,12 @@ class PathFollowingSetup:
     source: str = ""
 
     def __post_init__(self):
-        if self.reference not in ("steady", "open_loop"):
-            raise ValueError(f"reference must be 'steady' or 'open_loop', got {self.reference!r}")
+        check_choice(self.reference, "reference", ("steady", "open_loop"))
         check_bool(self.feedforward, "feedforward")
-        for field, size in (("x0", 4), ("Q_diag", 4)):
-            value = np.asarray(getattr(self, field), dtype=float)
-            if value.shape != (size,) or not np.all(np.isfinite(value)):
-                raise ValueError(f"{field} must be {size} finite numbers, got {getattr(self, field)!r}")
-        if min(self.Q_diag) < 0:
+        as_batch(self.x0, "x0", (4,))
+        if np.any(as_batch(self.Q_diag, "Q_diag", (4,)) < 0):
             raise ValueError(f"Q_diag must be >= 0, got {self.Q_diag}")
-        if not (np.isfinite(self.r) and self.r > 0):
-            raise ValueError(f"r must be positive and finite, got {self.r}")
+        check_positive_scalar(self.r, "r")
 
     def weights(self, *, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """``Q`` (4, 4) and ``R``: ``[[r]]``, or ``2 r I2`` on the doubled steering column."""
@@ -385,7 +380,10 @@ class PathFollowing:
             Fa = np.zeros(F.shape[:-2] + (5, 5))
             Fa[..., :4, :4] = F
             Ga = np.concatenate([G, np.ones(G.shape[:-2] + (1, 1))], axis=-2)
-            pad = lambda v: np.concatenate([v, np.zeros(v.shape[:-1] + (1,))], axis=-1)  # noqa: E731
+
+            def pad(v):                              # the memory state's entry: zero reference, disturbance, start
+                return np.concatenate([v, np.zeros(v.shape[:-1] + (1,))], axis=-1)
+
             self._memory = LinearSimulator(
                 Fa, Ga, pad(a["x_ref"]), u_ff=a["u_ff"][:, None], w=pad(a["w"]), x0=pad(a["x0"]),
                 u_limit=a["steer_limit"], bound=a["bound"], objectives=_truck.OBJECTIVE_STATES,

@@ -153,9 +153,10 @@ def test_bad_setup(path, setup, exc, words):
 
 
 @pytest.mark.parametrize("field, value, words", [
-    ("reference", "closed", "reference must be"), ("feedforward", 1, "feedforward must be a bool"),
-    ("x0", (0.0, 1.0), "x0 must be 4 finite"), ("Q_diag", (1.0, 1.0, -1.0, 1.0), "Q_diag must be >= 0"),
-    ("r", 0.0, "r must be positive"),
+    ("reference", "closed", "reference must be one of"), ("feedforward", 1, "feedforward must be a bool"),
+    ("x0", (0.0, 1.0), "x0 must have size 4"), ("x0", (0.0, 0.0, np.nan, 0.0), "x0 must have finite"),
+    ("Q_diag", (1.0, 1.0, -1.0, 1.0), "Q_diag must be >= 0"), ("r", 0.0, "r must be > 0"),
+    ("r", "1", "r must be"),
 ])
 def test_bad_setup_fields(field, value, words):
     kwargs = dict(name="x", reference="steady", feedforward=True, x0=(0.0,) * 4, Q_diag=(1.0,) * 4, r=1.0)
