@@ -13,8 +13,10 @@ results directory) followed by :meth:`PreparedExperiment.run`.
 Resuming
 --------
 A rerun skips every run whose file holds the expected record: the same
-problem, objectives, algorithm, variant, seed, budget, population size (the
-one the algorithm uses) and MO-LSP cap. An interrupted experiment therefore
+problem, its set-up (``applied``: ``ours`` or ``authors``; a record written
+before set-ups existed counts as the default), objectives, algorithm, variant,
+seed, budget, population size (the one the algorithm uses) and MO-LSP cap.
+An interrupted experiment therefore
 continues where it stopped and never recomputes a finished run. A file that
 holds a run with *other* settings (say another budget) is an error naming the
 file and the setting, raised before any run starts: results of two settings
@@ -94,6 +96,7 @@ class RunSpec:
     evals: int
     pop_size: int = POP_SIZE
     max_leaders: int | None = None
+    setup: str | None = None
 
     @property
     def variant(self) -> str:
@@ -170,7 +173,7 @@ def _algorithms(algorithms: str | Sequence[str]) -> list[str]:
 
 def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int, n_obj: int | None = None,
          base_seed: int = 0, pop_size: int = POP_SIZE, max_leaders: int | None = None,
-         variants: Sequence[bool] = (False, True)) -> list[RunSpec]:
+         variants: Sequence[bool] = (False, True), setup: str | None = None) -> list[RunSpec]:
     """The grid as a list of :class:`RunSpec`, ordered run index first.
 
     Parameters
@@ -193,6 +196,8 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
         MO-LSP's cap on candidates per generation (MO-LSP runs only).
     variants : sequence of bool
         Which variants to run: ``False`` plain, ``True`` with MO-LSP.
+    setup : str, optional
+        The problem's set-up (``applied`` only, see :func:`moo.runner.prepare`).
     """
     from moo.problems import PROBLEMS
 
@@ -210,14 +215,18 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
         raise ValueError("variants must hold at least one of False (plain), True (MO-LSP)")
     seeds = run_seeds(runs, base_seed)
     return [RunSpec(problem=problem.lower(), n_obj=n_obj, algorithm=name, molsp=v, run_index=i, seed=s,
-                    evals=evals, pop_size=pop_size, max_leaders=max_leaders if v else None)
+                    evals=evals, pop_size=pop_size, max_leaders=max_leaders if v else None, setup=setup)
             for i, s in enumerate(seeds) for name in names for v in variants]
 
 
 # ---------------------------------------------------------------------------- the store scan
 
-def _is_done(spec: RunSpec, out: Path, expected: dict) -> bool:
-    """True if the spec's file holds its record; False if absent or unreadable; error if another run."""
+def _is_done(spec: RunSpec, out: Path, expected: dict, legacy_setup=None) -> bool:
+    """True if the spec's file holds its record; False if absent or unreadable; error if another run.
+
+    ``legacy_setup``: the set-up a record without a ``setup`` field (written before set-ups existed)
+    stands for (the problem's default set-up when the grid asks for the default, else no match).
+    """
     path = spec.path(out)
     if not path.is_file():
         return False
@@ -225,7 +234,8 @@ def _is_done(spec: RunSpec, out: Path, expected: dict) -> bool:
         rec = read_record(path, required=(*_MATCH, "F"))
     except ValueError:
         return False                      # unreadable (not written by us): recompute and replace
-    wrong = {k: (rec[k], v) for k, v in expected.items() if rec[k] != v}
+    got = {k: rec.get(k, legacy_setup) if k == "setup" else rec[k] for k in expected}
+    wrong = {k: (got[k], v) for k, v in expected.items() if got[k] != v}
     if wrong:
         what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, (got, want) in wrong.items())
         raise ValueError(f"{path} holds a run with other settings: {what}; use another out directory "
@@ -233,8 +243,9 @@ def _is_done(spec: RunSpec, out: Path, expected: dict) -> bool:
     return True
 
 
-def _expected(spec: RunSpec, n_obj: int, pop_sizes: dict[str, int]) -> dict:
-    return {"problem": spec.problem, "n_obj": n_obj, "algorithm": spec.algorithm, "molsp": spec.molsp,
+def _expected(spec: RunSpec, n_obj: int, pop_sizes: dict[str, int], setup: str | None) -> dict:
+    return {"problem": spec.problem, "setup": setup, "n_obj": n_obj, "algorithm": spec.algorithm,
+            "molsp": spec.molsp,
             "seed": spec.seed, "budget": spec.evals, "pop_size": pop_sizes[spec.algorithm],
             "max_leaders": spec.max_leaders}
 
@@ -247,9 +258,11 @@ def _execute(spec: RunSpec) -> dict:
 
     try:
         result = runner.run(spec.problem, spec.algorithm, seed=spec.seed, evals=spec.evals, n_obj=spec.n_obj,
-                            molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders)
+                            molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders,
+                            setup=spec.setup)
     except Exception as exc:  # noqa: BLE001 - recorded by the driver; KeyboardInterrupt etc. propagate
-        return {"status": "failed", "problem": spec.problem, "n_obj": spec.n_obj, "algorithm": spec.algorithm,
+        return {"status": "failed", "problem": spec.problem, "setup": spec.setup, "n_obj": spec.n_obj,
+                "algorithm": spec.algorithm,
                 "molsp": spec.molsp, "seed": spec.seed, "run_index": spec.run_index, "budget": spec.evals,
                 "pop_size": spec.pop_size, "max_leaders": spec.max_leaders,
                 "error": f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}".rstrip(": "),
@@ -388,7 +401,8 @@ class PreparedExperiment:
 
 def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int, out: str | os.PathLike,
             n_obj: int | None = None, base_seed: int = 0, pop_size: int = POP_SIZE,
-            max_leaders: int | None = None, variants: Sequence[bool] = (False, True)) -> PreparedExperiment:
+            max_leaders: int | None = None, variants: Sequence[bool] = (False, True),
+            setup: str | None = None) -> PreparedExperiment:
     """Check the grid of :func:`plan`, create ``out`` and find the runs already recorded there.
 
     Every check happens here, before any run: the arguments of :func:`plan`,
@@ -403,15 +417,18 @@ def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: 
         grid with other settings (the message names the file).
     """
     from moo.problems import make_problem
-    from moo.runner import check_budget
+    from moo.runner import check_budget, setup_name
 
     specs = plan(problem, algorithms, runs=runs, evals=evals, n_obj=n_obj, base_seed=base_seed,
-                 pop_size=pop_size, max_leaders=max_leaders, variants=variants)
-    prob = make_problem(problem, n_obj)
+                 pop_size=pop_size, max_leaders=max_leaders, variants=variants, setup=setup)
+    prob = make_problem(problem, n_obj, setup=setup)
+    name = setup_name(prob)
+    # a record without a set-up was written before set-ups existed, with the problem's default one
+    legacy = name if setup is None else setup_name(make_problem(problem, n_obj))
     pop_sizes = {name: int(check_budget(prob, name, evals=specs[0].evals, pop_size=specs[0].pop_size).pop_size)
                  for name in dict.fromkeys(s.algorithm for s in specs)}
     out = prepare_results_dir(out)
-    todo = tuple(s for s in specs if not _is_done(s, out, _expected(s, prob.n_obj, pop_sizes)))
+    todo = tuple(s for s in specs if not _is_done(s, out, _expected(s, prob.n_obj, pop_sizes, name), legacy))
     retried = sum(s.failed_path(out).is_file() for s in todo)
     return PreparedExperiment(specs=tuple(specs), out=out, todo=todo, retried=retried)
 
@@ -420,7 +437,7 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
                    out: str | os.PathLike, n_obj: int | None = None, base_seed: int = 0, pop_size: int = POP_SIZE,
                    max_leaders: int | None = None, variants: Sequence[bool] = (False, True),
                    workers: int = 1, executor: Executor | None = None, keep_going: bool = False,
-                   progress: bool | None = None) -> ExperimentReport:
+                   progress: bool | None = None, setup: str | None = None) -> ExperimentReport:
     """Run the grid of :func:`plan` into ``out``, skipping runs already recorded.
 
     Parameters are those of :func:`plan`, plus:
@@ -458,7 +475,7 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
     if executor is not None and workers != 1:
         raise ValueError("give workers (a local process pool) or executor, not both")
     grid = prepare(problem, algorithms, runs=runs, evals=evals, out=out, n_obj=n_obj, base_seed=base_seed,
-                   pop_size=pop_size, max_leaders=max_leaders, variants=variants)
+                   pop_size=pop_size, max_leaders=max_leaders, variants=variants, setup=setup)
     if executor is not None:
         return grid.run(executor, keep_going=keep_going, progress=progress)
     with open_executor("process", workers=workers if len(grid.todo) > 1 else 1) as pool:

@@ -99,7 +99,8 @@ def fake_run(monkeypatch):
     calls = []
     state = {"fail_after": None}
 
-    def run(problem, algorithm, *, seed, evals, n_obj=None, molsp=False, pop_size=92, max_leaders=None):
+    def run(problem, algorithm, *, seed, evals, n_obj=None, molsp=False, pop_size=92, max_leaders=None,
+            setup=None):  # runner.run's signature
         if state["fail_after"] is not None and len(calls) >= state["fail_after"]:
             raise KeyboardInterrupt
         calls.append((algorithm, molsp, seed))
