@@ -4,8 +4,15 @@ from __future__ import annotations
 
 import csv
 import json
+import multiprocessing
+import os
+import signal
 import subprocess
 import sys
+import threading
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -328,8 +335,6 @@ def test_cli_failures_exit_1_with_one_line(tmp_path, failing_run, capsys):
 
 
 def test_any_executor_thread_pool_gives_the_serial_records(tmp_path):
-    from concurrent.futures import ThreadPoolExecutor
-
     kw = dict(runs=2, evals=60, pop_size=20, progress=False)
     run_experiment("zdt1", "nsga2", out=tmp_path / "serial", **kw)
     with ThreadPoolExecutor(2) as pool:
@@ -345,9 +350,6 @@ def test_any_executor_thread_pool_gives_the_serial_records(tmp_path):
 
 
 def test_executor_stops_at_a_failure_and_keeps_what_finished(tmp_path, failing_run, monkeypatch):
-    import time
-    from concurrent.futures import ThreadPoolExecutor
-
     from moo.experiment import RunFailedError
 
     calls, _ = failing_run
@@ -363,6 +365,62 @@ def test_executor_stops_at_a_failure_and_keeps_what_finished(tmp_path, failing_r
     with ThreadPoolExecutor(1) as pool, pytest.raises(RunFailedError):
         run_experiment("zdt1", "nsga2", runs=4, evals=300, out=tmp_path / "b", executor=pool, progress=False)
     assert len(load_records(tmp_path / "b")) == 7
+
+
+def test_killed_pool_process_is_replaced_and_its_runs_recomputed(tmp_path, capsys):
+    """SIGKILL of a pool process mid-grid: a fresh pool reruns what the broken one lost; nothing is missing."""
+    kw = dict(runs=2, evals=4000, pop_size=20, progress=False)
+    run_experiment("zdt1", "nsga2", out=tmp_path / "serial", **kw)
+    done = {}
+    driver = threading.Thread(target=lambda: done.setdefault(
+        "report", run_experiment("zdt1", "nsga2", out=tmp_path / "pool", workers=2, **kw)))
+    driver.start()
+    deadline = time.monotonic() + 120
+    while not any((tmp_path / "pool").rglob("seed_*.json")) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    victims = multiprocessing.active_children()              # the pool's two spawned processes
+    assert len(victims) == 2, "the pool's processes were not found when the first record arrived"
+    os.kill(victims[0].pid, signal.SIGKILL)                  # mid-grid: 3 of the 4 runs are not recorded yet
+    driver.join(timeout=180)
+    assert not driver.is_alive()
+    assert done["report"].completed == 4
+    err = capsys.readouterr().err
+    assert "a pool process died; resubmitting the " in err and "(restart 1 of 3)" in err
+    key = ("molsp", "seed", "F", "X", "hv_history", "n_evals")
+    assert [[r[k] for k in key] for r in load_records(tmp_path / "serial")] == \
+           [[r[k] for k in key] for r in load_records(tmp_path / "pool")]
+
+
+def test_pool_restarts_are_bounded_and_other_executors_stop(tmp_path, capsys):
+    from moo.executors import POOL_RESTARTS, _RestartingPool
+
+    def broken(*args, **kwargs) -> Future:
+        fut: Future = Future()
+        fut.set_exception(BrokenProcessPool("a process in the pool was terminated abruptly"))
+        return fut
+
+    class DiesEveryTime(_RestartingPool):
+        """Every run loses its process (a thread pool stands in for the processes)."""
+
+        pools = 0
+
+        def _new(self):
+            DiesEveryTime.pools += 1
+            return ThreadPoolExecutor(1)
+
+        submit = staticmethod(broken)
+
+    class CannotRestart(ThreadPoolExecutor):
+        submit = staticmethod(broken)
+
+    kw = dict(runs=1, evals=300, pop_size=20, progress=False)
+    with pytest.raises(BrokenProcessPool, match=f"died again after {POOL_RESTARTS} restarts of the pool"):
+        run_experiment("zdt1", "nsga2", out=tmp_path / "a", executor=DiesEveryTime(2), **kw)
+    assert DiesEveryTime.pools == 1 + POOL_RESTARTS and not load_records(tmp_path / "a")
+    assert capsys.readouterr().err.count("resubmitting the 2 runs lost with it") == POOL_RESTARTS
+    with CannotRestart(1) as pool, pytest.raises(BrokenProcessPool, match="terminated abruptly"):
+        run_experiment("zdt1", "nsga2", out=tmp_path / "b", executor=pool, **kw)
+    assert "resubmitting" not in capsys.readouterr().err
 
 
 # ----------------------------------------------------------------------------- CLI: --out, corrupt records, help
