@@ -31,8 +31,9 @@ Exit codes (the same for every command):
 * 1 - the work failed: a run raised (``experiment``: without ``--keep-going``
   the grid stops there; with it, the grid finishes and the failed runs are
   listed), or the executor failed (pool processes killed more often than
-  the pool restarts, the scheduler unreachable). One line on stderr says what and where the traceback is; the
-  records already written stay, and rerunning the command resumes;
+  the pool restarts, the scheduler unreachable). One line on stderr says
+  what and where the traceback is; the records already written stay, and
+  rerunning the command resumes;
 * 2 - bad arguments (a one-line message on stderr; nothing was run or written),
   including an unusable ``--out``, a results directory holding runs with
   other settings, and a corrupt record read by ``stats`` or ``plot``;
