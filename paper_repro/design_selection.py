@@ -57,14 +57,14 @@ import numpy as np
 if __package__ in (None, ""):                      # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from moo.algorithms import ALGORITHMS  # noqa: E402
-from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
-from moo.problems.generic import GenericRLQRProblem  # noqa: E402
-from moo.runner import run as run_moea  # noqa: E402
-from moo.problems.selection import DesignSelection, error_scales, select_design  # noqa: E402
-from robustctl.pathfollow import SETUPS  # noqa: E402
-import robustctl as rc  # noqa: E402
-from paper_repro.mse_table import Design, margins  # noqa: E402
+import robustctl as rc
+from moo.algorithms import ALGORITHMS
+from moo.problems.applied import AppliedRLQRProblem
+from moo.problems.generic import GenericRLQRProblem
+from moo.problems.selection import DesignSelection, error_scales, select_design
+from moo.runner import run as run_moea
+from paper_repro.mse_table import Design, margins
+from robustctl.pathfollow import SETUPS
 
 DEFAULT_SIMS = {"generic": 1000, "applied": 200}
 PAPER = {"generic": "paper: design 49 of 92 won 222/1000; random 1, nominal 0",

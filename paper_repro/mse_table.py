@@ -105,15 +105,13 @@ import numpy as np
 if __package__ in (None, ""):  # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import robustctl as rc  # noqa: E402
-from robustctl.batchsim import BACKENDS  # noqa: E402
-from robustctl.hinf_game import hinf_game, with_input_memory  # noqa: E402
-from robustctl.models import truck  # noqa: E402
-from robustctl.path import default_route  # noqa: E402
-from robustctl.pathfollow import (SETUPS, PathFollowing, PathFollowingResult, PathFollowingSetup,  # noqa: E402
-                                  code_manoeuvre)
-
-from paper_repro.paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS, PAPER_MSE  # noqa: E402
+import robustctl as rc
+from paper_repro.paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS, PAPER_MSE
+from robustctl.batchsim import BACKENDS
+from robustctl.hinf_game import hinf_game, with_input_memory
+from robustctl.models import truck
+from robustctl.path import default_route
+from robustctl.pathfollow import SETUPS, PathFollowing, PathFollowingResult, PathFollowingSetup, code_manoeuvre
 
 OBJECTIVE_LABELS = {
     "f1": ("lateral displacement error", "m"),
@@ -317,9 +315,7 @@ def design_controllers(z=truck.RLQR_MOP_Z, uncertainty: str = "printed",
                                  f"{', the code' + chr(39) + 's EG' if eg == 'code' else ''}): "
                                  f"EF = {np.array2string(u.EF[0], precision=4)}, "
                                  f"EG = {np.array2string(EG[0], precision=4)}, mu = {u.mu:.3g}"))
-        elif name == "Hinf" and ts.hinf == "game":
-            designs.append(_hinf_game(name, ts))
-        elif name == "Hinf_game":
+        elif (name == "Hinf" and ts.hinf == "game") or name == "Hinf_game":
             designs.append(_hinf_game(name, ts))
         elif name == "Hinf":
             designs.append(_hinf(name, lmi, f"LMI H-infinity, nominal payload, {form}, "
@@ -439,8 +435,8 @@ def compare_setups(*, duration: float | None = None, measure: str = "tracking", 
 
 
 def write_comparison(out: Path, rows: list[tuple[str, str, Agreement]]) -> None:
-    lines = ["| set-up | switched to the other set-up's | winners (of 16) | pairwise order | ratio median | "
-             "ratio range |", "|---|---|---:|---:|---:|---|"]
+    lines = [("| set-up | switched to the other set-up's | winners (of 16) | pairwise order | ratio median | "
+              "ratio range |"), "|---|---|---:|---:|---:|---|"]
     for base, label, a in rows:
         lines.append(f"| {base} | {label} | {a.winners} | {a.pairwise:.3f} | {a.ratio_median:.3g} | "
                      f"{a.ratio_min:.3g} .. {a.ratio_max:.3g} |")
@@ -523,8 +519,8 @@ def _margin_text(m) -> str:
 
 def write_margins(out: Path, table: dict[str, dict]) -> str:
     head = f"{'controller':<18}" + "".join(f"{k:>26}" for k in MARGINS)
-    lines = ["Certified robust-stability margins (robustctl.robust_stability): the largest r with stability "
-             "certified for r x the uncertainty; >= 1 certifies it all", head, "-" * len(head)]
+    lines = [("Certified robust-stability margins (robustctl.robust_stability): the largest r with stability "
+              "certified for r x the uncertainty; >= 1 certifies it all"), head, "-" * len(head)]
     md = ["| controller | " + " | ".join(MARGINS) + " |", "|---|" + "---:|" * len(MARGINS)]
     with open(out / "margins.csv", "w", newline="") as fh:
         w = csv.writer(fh)
@@ -567,7 +563,7 @@ def format_table(mse: dict, names: list[str], measure: str = "tracking") -> str:
     for obj in OBJECTIVES:
         for name in names:
             row = f"{obj:<4}{name:<17}"
-            for i, ov in enumerate(OVERLOADS):
+            for i in range(len(OVERLOADS)):
                 paper = PAPER_MSE[obj].get(name, (None,) * 4)[i]
                 row += f"{mse[obj][name][i]:>12.4e}" + (f"{paper:>11.3e}" if paper is not None else f"{'':>11}")
             lines.append(row)
@@ -576,8 +572,9 @@ def format_table(mse: dict, names: list[str], measure: str = "tracking") -> str:
             continue
         ours = [_winner({c: mse[obj][c][i] for c in cs}) for i in range(4)]
         paper = [_winner({c: PAPER_MSE[obj][c][i] for c in cs}) for i in range(4)]
-        agree += sum(a == b for a, b in zip(ours, paper))
-        lines.append(f"{'':<4}{'best (ours/paper)':<17}" + "".join(f"{f'{a}/{b}':>23}" for a, b in zip(ours, paper)))
+        agree += sum(a == b for a, b in zip(ours, paper, strict=True))
+        lines.append(f"{'':<4}{'best (ours/paper)':<17}"
+                     + "".join(f"{f'{a}/{b}':>23}" for a, b in zip(ours, paper, strict=True)))
         lines.append("")
     lines.append(f"Best controller agrees with the paper in {agree} of 16 cells "
                  f"(winners among {', '.join(_compared(mse))}).")
@@ -640,9 +637,7 @@ def write_latex(path: Path, mse: dict, names: list[str]) -> None:
         cs = _compared(mse) or names
         best = [_winner({c: mse[obj][c][i] for c in cs}) for i in range(4)]
         for j, name in enumerate(names):
-            cells = []
-            for i in range(4):
-                cells.append(_sci_tex(mse[obj][name][i], bold=best[i] == name))
+            cells = [_sci_tex(mse[obj][name][i], bold=best[i] == name) for i in range(4)]
             first = rf"\multirow{{{len(names)}}}{{*}}{{$f_{obj[1]}$}}" if j == 0 else ""
             lines.append(f"{first} & {tex_name.get(name, name)} & " + " & ".join(cells) + r" \\")
         lines.append(r"\hline")
@@ -685,7 +680,7 @@ def make_figures(out: Path, res, designs: list[Design], path, ts: TableSetup) ->
             ax.plot(X_ref[sel], Y_ref[sel], color="k", lw=3, alpha=0.3, label="reference")
         for b in shown:
             d = designs[b]
-            c = COLORS.get(d.name, None)
+            c = COLORS.get(d.name)
             ls = "--" if d.name not in CONTROLLERS else "-"
             ax_xy.plot(X[b, s], Y[b, s], color=c, lw=1, ls=ls, label=d.name)
             ax_start.plot(X[b, s, start], Y[b, s, start], color=c, lw=1.3, ls=ls, label=d.name)
@@ -703,7 +698,8 @@ def make_figures(out: Path, res, designs: list[Design], path, ts: TableSetup) ->
         for ax, title in ((ax_u, "Steering angle"), (ax_u0, f"Steering angle, first {t_zoom:.0f} s")):
             ax.axhline(lim, color="k", ls=":", lw=1.2, label="saturation ±0.45 rad")
             ax.axhline(-lim, color="k", ls=":", lw=1.2)
-            ax.set(xlabel="time [s]", ylabel="steering angle α [rad]", title=title, ylim=(-0.5, 0.5))
+            ax.set(xlabel="time [s]", title=title, ylim=(-0.5, 0.5),
+                   ylabel="steering angle α [rad]")  # noqa: RUF001 (the Greek letter is meant)
         for ax in (ax_xy, ax_start, ax_bend, ax_u, ax_u0):
             ax.grid(alpha=0.3)
         ax_start.legend(loc="upper right", fontsize=8)
@@ -716,7 +712,7 @@ def make_figures(out: Path, res, designs: list[Design], path, ts: TableSetup) ->
         files.append(f)
 
         fig, axes = plt.subplots(4, 1, figsize=(12, 10), sharex=True, layout="constrained")
-        for ax, obj in zip(axes, OBJECTIVES):
+        for ax, obj in zip(axes, OBJECTIVES, strict=True):
             idx = truck.OBJECTIVE_STATES[OBJECTIVES.index(obj)]
             for b in shown:
                 d = designs[b]
@@ -776,8 +772,8 @@ def _limit_text(limit: dict) -> str:
 
 def _write_agreement(out: Path, rows: list[tuple[str, Agreement]], measure: str) -> None:
     lines = [f"Agreement with the paper's MSE table ({measure} errors, the paper's four controllers)", "",
-             "| set-up | winners (of 16) | pairwise order (chance 0.5) | ratio median | ratio range | "
-             "ratio median f1 / f2 / f3 / f4 |", "|---|---:|---:|---:|---|---|"]
+             ("| set-up | winners (of 16) | pairwise order (chance 0.5) | ratio median | ratio range | "
+              "ratio median f1 / f2 / f3 / f4 |"), "|---|---:|---:|---:|---|---|"]
     for name, a in rows:
         by = " / ".join(f"{v:.3g}" for v in a.ratio_median_by_objective.values())
         lines.append(f"| {name} | {a.winners} | {a.pairs_agree}/{a.pairs} = {a.pairwise:.3f} | "
@@ -819,14 +815,15 @@ def run(out: Path, *, setup: str | TableSetup = DEFAULT_SETUP, course: str | Non
     for b, d in enumerate(designs):
         flags = []
         if res.diverged[b].any():
-            flags.append("DIVERGED at " + ", ".join(f"{ov} %" for ov, dv in zip(OVERLOADS, res.diverged[b]) if dv))
+            flags.append("DIVERGED at "
+                         + ", ".join(f"{ov} %" for ov, dv in zip(OVERLOADS, res.diverged[b], strict=True) if dv))
         sat = res.saturated_steps[b]
         if sat.any():
             flags.append("saturated steps " + "/".join(str(int(x)) for x in sat))
         if flags:
             log(f"      {d.name}: {'; '.join(flags)}")
     diverged = [f"{d.name} at {ov} %" for b, d in enumerate(designs)
-                for ov, dv in zip(OVERLOADS, res.diverged[b]) if dv]
+                for ov, dv in zip(OVERLOADS, res.diverged[b], strict=True) if dv]
     div_note = ("Diverged runs (stopped at the divergence bound; their MSE is large but finite): "
                 + ", ".join(diverged) + ".") if diverged else ""
     log("[3/5] writing tables ...")

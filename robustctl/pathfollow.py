@@ -192,17 +192,26 @@ class PathFollowingResult(SimulationResult):
     path: ReferencePath | None = None
     overloads: tuple | None = None
 
+    def _path(self) -> ReferencePath:
+        if self.path is None:
+            raise ValueError("this result has no path (path=None): the poses need the reference path")
+        return self.path
+
     def reference_pose(self) -> tuple[np.ndarray, np.ndarray]:
-        """Global position ``(X, Y)`` of the reference, each (T,) or (S, T): the path displaced by
-        ``rho_ref`` along its left normal (the path itself for the ``"steady"`` reference)."""
-        h = self.path.heading[: self.T]
+        """Global position ``(X, Y)`` of the reference, each (T,) or (S, T).
+
+        The path displaced by ``rho_ref`` along its left normal (the path itself for the ``"steady"`` reference).
+        """
+        path = self._path()
+        h = path.heading[: self.T]
         rho = self.x_ref[..., 2]
-        return self.path.X[: self.T] - rho * np.sin(h), self.path.Y[: self.T] + rho * np.cos(h)
+        return path.X[: self.T] - rho * np.sin(h), path.Y[: self.T] + rho * np.cos(h)
 
     @property
     def steering(self) -> np.ndarray:
         """Applied steering angle, shape (B, S, T)."""
         self._need_trajectories()
+        assert self.inputs is not None                 # kept with the errors
         return self.inputs[..., 0]
 
     def pose(self, method: Literal["path", "integrated"] = "path") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -225,15 +234,16 @@ class PathFollowingResult(SimulationResult):
         self._need_trajectories()
         x = self.states
         rho, theta = x[..., 2], x[..., 3]
-        h = self.path.heading[: self.T]
-        X0 = self.path.X[0] - rho[..., 0] * np.sin(h[0])
-        Y0 = self.path.Y[0] + rho[..., 0] * np.cos(h[0])
+        path = self._path()
+        h = path.heading[: self.T]
+        X0 = path.X[0] - rho[..., 0] * np.sin(h[0])
+        Y0 = path.Y[0] + rho[..., 0] * np.cos(h[0])
         if method == "path":
-            return (self.path.X[: self.T] - rho * np.sin(h), self.path.Y[: self.T] + rho * np.cos(h),
+            return (path.X[: self.T] - rho * np.sin(h), path.Y[: self.T] + rho * np.cos(h),
                     h + theta)
         if method != "integrated":
             raise ValueError(f"method must be 'path' or 'integrated', got {method!r}")
-        dt, v = self.path.dt, self.path.speed
+        dt, v = path.dt, path.speed
 
         def integrate(rate, start):
             steps = 0.5 * (rate[..., 1:] + rate[..., :-1]) * dt
@@ -256,7 +266,7 @@ def _scenarios(overloads, T: int) -> tuple:
     items = list(overloads)
     if not items:
         raise ValueError("overloads must not be empty")
-    out = []
+    out: list[float | np.ndarray] = []
     for i, ov in enumerate(items):
         if np.ndim(ov) == 0:
             out.append(float(_truck.check_overload(ov, f"overloads[{i}]")))
@@ -358,7 +368,7 @@ class PathFollowing:
         self._linear = LinearSimulator(
             F, G, x_ref, u_ff=u_ff[:, None], w=w, x0=x0, u_limit=steer_limit, input_map=input_map, bound=bound,
             objectives=_truck.OBJECTIVE_STATES, state_names=_truck.STATE_NAMES, dt=p.dt)
-        self._memory = None                            # the plant augmented by the previous steering angle
+        self._memory: LinearSimulator | None = None    # the plant augmented by the previous steering angle
         self._memory_args = dict(F=F, G=G, x_ref=x_ref, u_ff=u_ff, w=w, x0=np.asarray(x0, dtype=float),
                                  steer_limit=steer_limit, bound=bound, dt=p.dt)
         self.path = path
@@ -366,10 +376,12 @@ class PathFollowing:
 
     @property
     def S(self) -> int:
+        """Number of payload scenarios."""
         return self._linear.S
 
     @property
     def T(self) -> int:
+        """Number of samples along the path."""
         return self._linear.T
 
     def _memory_simulator(self) -> LinearSimulator:
@@ -377,17 +389,17 @@ class PathFollowing:
         if self._memory is None:
             a = self._memory_args
             F, G = a["F"], a["G"]
-            Fa = np.zeros(F.shape[:-2] + (5, 5))
+            Fa = np.zeros((*F.shape[:-2], 5, 5))
             Fa[..., :4, :4] = F
-            Ga = np.concatenate([G, np.ones(G.shape[:-2] + (1, 1))], axis=-2)
+            Ga = np.concatenate([G, np.ones((*G.shape[:-2], 1, 1))], axis=-2)
 
             def pad(v):                              # the memory state's entry: zero reference, disturbance, start
-                return np.concatenate([v, np.zeros(v.shape[:-1] + (1,))], axis=-1)
+                return np.concatenate([v, np.zeros((*v.shape[:-1], 1))], axis=-1)
 
             self._memory = LinearSimulator(
                 Fa, Ga, pad(a["x_ref"]), u_ff=a["u_ff"][:, None], w=pad(a["w"]), x0=pad(a["x0"]),
                 u_limit=a["steer_limit"], bound=a["bound"], objectives=_truck.OBJECTIVE_STATES,
-                state_names=_truck.STATE_NAMES + ("alpha_prev",), dt=a["dt"])
+                state_names=(*_truck.STATE_NAMES, "alpha_prev"), dt=a["dt"])
         return self._memory
 
     def run(self, K, *, K_input=None, keep_trajectories: bool = True, nan_gains: Literal["raise", "flag"] = "raise",
@@ -420,6 +432,7 @@ class PathFollowing:
         if K_input is not None:
             return self._run_with_memory(K, K_input, keep_trajectories, nan_gains, backend)
         sim = self._linear
+        shape: tuple[int, ...]
         try:
             shape = np.shape(K) if not isinstance(K, (str, bytes)) else ()
         except ValueError:                          # ragged nested lists: check_gains names K

@@ -1,5 +1,7 @@
 """Path-following set-ups ("ours", "authors") and laws with input memory, against independent loops."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 import scipy.signal
@@ -129,6 +131,13 @@ def test_reference_pose(path, K_authors):
     np.testing.assert_allclose(Y, path.Y + x_ol[:, 2] * np.cos(path.heading), rtol=1e-9, atol=1e-9)
     ours = PathFollowing(path, 0.0).run(K_authors)
     np.testing.assert_allclose(ours.reference_pose()[0], path.X, atol=1e-12)
+
+
+def test_poses_without_a_path_name_it(path, K_authors):
+    res = dataclasses.replace(PathFollowing(path, 0.0).run(K_authors), path=None)
+    for pose in (res.reference_pose, res.pose):
+        with pytest.raises(ValueError, match=r"no path \(path=None\)"):
+            pose()
 
 
 def test_open_loop_reference_drifts_on_the_default_route():

@@ -40,13 +40,14 @@ GENERIC_Z = np.array([
 RANDOM_Z = np.random.default_rng(0).uniform(0.0, 200.0, (10, 5))
 
 
-def _generic_reference(z, *, deltas, x0s, horizon, Q=np.eye(3), R=np.eye(1), aggregate="mean",
-                       penalty=1e6):
+def _generic_reference(z, *, deltas, x0s, horizon, Q=None, R=None, aggregate="mean", penalty=1e6):
     """One individual at a time: design with robustctl.design, simulate with plain loops.
 
     Applies the documented penalty rule: not computable -> 2 penalty; unstable for
     some delta (spectral radius rho >= 1) -> penalty * min(rho, 2); else min(error, penalty).
     """
+    Q = np.eye(3) if Q is None else Q
+    R = np.eye(1) if R is None else R
     out = []
     for zi in np.atleast_2d(z):
         try:
@@ -364,7 +365,7 @@ def test_applied_paper_optimum_is_finite_and_sensible():
     # stable at every payload of the paper's comparison, 0 to 300 % overload
     K = p.gains(p.paper_optimum[None]).K[0]
     F_s, G_s, _ = truck.discretise([0.0, 100.0, 200.0, 300.0])
-    for Fd, Gd in zip(F_s, G_s):
+    for Fd, Gd in zip(F_s, G_s, strict=True):
         assert np.max(np.abs(np.linalg.eigvals(Fd + Gd @ K.sum(axis=0, keepdims=True)))) < 1.0
     # the truck ends up on the path: RMS lateral error well below the 1 m start offset
     assert np.sqrt(f[0]) < 0.5

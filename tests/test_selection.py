@@ -16,12 +16,21 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 import moo.problems.selection as selection
+import robustctl as rc
 from moo.problems.applied import AppliedRLQRProblem
 from moo.problems.generic import GenericRLQRProblem
-from moo.problems.selection import (BRYSON_SCALES, applied_errors, build_designs, draw_deltas, error_scales,
-                                    generic_errors, monte_carlo_selection, overload_from_delta, select_design)
+from moo.problems.selection import (
+    BRYSON_SCALES,
+    applied_errors,
+    build_designs,
+    draw_deltas,
+    error_scales,
+    generic_errors,
+    monte_carlo_selection,
+    overload_from_delta,
+    select_design,
+)
 from paper_repro import design_selection
-import robustctl as rc
 from robustctl.models import truck
 from robustctl.path import default_route
 from robustctl.simulate import simulate

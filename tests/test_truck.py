@@ -18,7 +18,7 @@ def _hand_model(m, J, p=P):
     rho' = ydot + v theta;  theta' = r - v kappa.
     """
     def f(x, alpha, kappa):
-        ydot, r, rho, theta = x
+        ydot, r, _rho, theta = x
         Ff = p.c1 * (alpha - (ydot + p.a * r) / p.v)
         Fr = p.c2 * (-(ydot - p.b * r) / p.v)
         return np.array([(Ff + Fr) / m - p.v * r, (p.a * Ff - p.b * Fr) / J,
@@ -113,6 +113,7 @@ def test_batched_discretisation_equals_single():
     for i, ov in enumerate([0.0, 150.0, 300.0]):
         F1, G1, Gk1 = truck.discretise(ov)
         np.testing.assert_allclose(F[i], F1[0], rtol=1e-13)
+        np.testing.assert_allclose(G[i], G1[0], rtol=1e-13)
         np.testing.assert_allclose(Gk[i], Gk1[0], rtol=1e-13)
 
 
@@ -253,7 +254,7 @@ def test_open_loop_reference_matches_dlsim(overload):
     np.testing.assert_allclose(u_ref, a_per_kappa * kappa, rtol=1e-15)
     A, B, E = truck.continuous_model(overload)
     sysd = scipy.signal.cont2discrete((A, np.column_stack([B, E]), np.eye(4), np.zeros((4, 2))), P.dt, "zoh")
-    _, y, _ = scipy.signal.dlsim(sysd[:4] + (P.dt,), np.column_stack([u_ref, kappa]))
+    _, y, _ = scipy.signal.dlsim((*sysd[:4], P.dt), np.column_stack([u_ref, kappa]))
     np.testing.assert_allclose(x_ref, y, rtol=1e-9, atol=1e-12 * np.abs(y).max())
 
 

@@ -28,7 +28,7 @@ vehicles", Control Engineering Practice 85 (2019) (the doubled steering column).
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 
@@ -176,8 +176,10 @@ class AppliedRLQRProblem(RLQRTuningProblem):
 
     paper_optimum = np.array(truck.RLQR_MOP_Z)
 
-    _HV_REF = {"ours": np.square([0.25, 0.0125, 0.15, 0.01]), "authors": np.square([0.25, 0.035, 0.35, 0.0125])}
-    _MOLSP_REF = {"ours": np.square([0.5, 0.02, 0.2, 0.015]), "authors": np.square([1.0, 0.04, 0.4, 0.02])}
+    _HV_REF: ClassVar[dict[str, np.ndarray]] = {
+        "ours": np.square([0.25, 0.0125, 0.15, 0.01]), "authors": np.square([0.25, 0.035, 0.35, 0.0125])}
+    _MOLSP_REF: ClassVar[dict[str, np.ndarray]] = {
+        "ours": np.square([0.5, 0.02, 0.2, 0.015]), "authors": np.square([1.0, 0.04, 0.4, 0.02])}
 
     def __init__(
         self,

@@ -238,8 +238,7 @@ class GenericRLQRProblem(RLQRTuningProblem):
 
     def _simulate(self, K: np.ndarray) -> np.ndarray:
         S, n0, n = self.deltas.size, self.initial_states.shape[0], self.plant.n
-        # self.backend is a checked str until _rlqr_problem (branch authors) types it as the Literal
-        sums = self._regulation.run(K, keep_trajectories=False, backend=self.backend).sq_state_sum  # type: ignore[arg-type]
+        sums = self._regulation.run(K, keep_trajectories=False, backend=self.backend).sq_state_sum
         return sums.reshape(K.shape[0], S, n0, n).sum(axis=2)
 
     def __repr__(self) -> str:

@@ -55,9 +55,9 @@ from dataclasses import dataclass
 import numpy as np
 
 import robustctl as rc
+from robustctl.batchsim import check_gains
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
-from robustctl.batchsim import check_gains
 from robustctl.pathfollow import PathFollowing, PathFollowingSetup, get_setup
 
 from .._validation import as_matrix, check_int
@@ -106,10 +106,12 @@ class SelectionResult:
 
     @property
     def n_designs(self) -> int:
+        """Number of candidate designs D."""
         return int(self.counts.size)
 
     @property
     def n_simulations(self) -> int:
+        """Number of simulations (realisations) S."""
         return int(self.winners.size)
 
     @property
@@ -286,8 +288,10 @@ def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> n
 
 
 def error_scales(setup: str | PathFollowingSetup = "ours") -> np.ndarray:
-    """Default scales of :func:`applied_errors`: ``1 / sqrt(Q_ii)`` of the set-up's state weight, in the
-    objectives' order (``rho, psidot, ydot, theta``); ``"ours"`` gives :data:`BRYSON_SCALES`."""
+    """Default scales of :func:`applied_errors`: ``1 / sqrt(Q_ii)`` of the set-up's state weight.
+
+    In the objectives' order (``rho, psidot, ydot, theta``); ``"ours"`` gives :data:`BRYSON_SCALES`.
+    """
     setup = get_setup(setup)
     q = np.asarray(setup.Q_diag, dtype=float)[list(truck.OBJECTIVE_STATES)]
     if np.any(q <= 0):
@@ -407,6 +411,7 @@ class DesignSet:
 
     @property
     def n_front(self) -> int:
+        """Number of designs taken from the front (the others are the extra designs)."""
         return self.kinds.count("front")
 
     def index(self, kind: str) -> int:
@@ -417,7 +422,7 @@ class DesignSet:
         return self.kinds.index(kind)
 
     def __repr__(self) -> str:
-        extras = [lab for lab, k in zip(self.labels, self.kinds) if k != "front"]
+        extras = [lab for lab, k in zip(self.labels, self.kinds, strict=True) if k != "front"]
         return (f"DesignSet(D={len(self)}, front={self.n_front}, extras={extras}, "
                 f"failed={int((~self.ok).sum())})")
 
@@ -450,7 +455,7 @@ def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     X = as_matrix(X_front, "X_front", cols=problem.n_var, cols_what="the problem's number of variables")
     if np.any(X[:, -1] < 0):
         raise ValueError(f"X_front's last variable, (log10 mu)^2, must be >= 0, got {X[:, -1].min():g}")
-    z_random = _rng(seed).uniform(problem.xl, problem.xu)
+    z_random = np.asarray(_rng(seed).uniform(problem.xl, problem.xu))      # (n_var,): pymoo's bounds are arrays
     batch = problem.gains(np.vstack([X, z_random]))
     K_rlqr = np.where(batch.ok[:, None, None], batch.K, np.nan)
     K_nom = rc.lqr(problem.plant, Q=problem.Q, R=problem.R).K
@@ -501,6 +506,7 @@ class DesignSelection:
 
     @property
     def best(self) -> int:
+        """Index of the selected design (the result's ``best``)."""
         return self.result.best
 
     @property

@@ -178,7 +178,7 @@ def _params(params) -> TruckParameters:
     return params
 
 
-def _continuous_batch(p: TruckParameters, load: np.ndarray):
+def _continuous_batch(p: TruckParameters, load: float | np.ndarray):
     """A (k,4,4), B (k,4,1), E (4,) for payload multipliers ``load`` (k,)."""
     load = np.atleast_1d(np.asarray(load, dtype=float))
     m = p._mass(load)
