@@ -30,9 +30,10 @@ Exit codes (the same for every command):
 * 0 - done;
 * 1 - the work failed: a run raised (``experiment``: without ``--keep-going``
   the grid stops there; with it, the grid finishes and the failed runs are
-  listed), or the executor failed (a pool process killed, the scheduler
-  unreachable). One line on stderr says what and where the traceback is; the
-  records already written stay, and rerunning the command resumes;
+  listed), or the executor failed (pool processes killed more often than
+  the pool restarts, the scheduler unreachable). One line on stderr says
+  what and where the traceback is; the records already written stay, and
+  rerunning the command resumes;
 * 2 - bad arguments (a one-line message on stderr; nothing was run or written),
   including an unusable ``--out``, a results directory holding runs with
   other settings, and a corrupt record read by ``stats`` or ``plot``;
@@ -176,7 +177,7 @@ class _Progress:
 
     def __call__(self, done: int, total: int) -> None:
         frac = min(done / total, 1.0)
-        bar = "#" * int(round(frac * self.width))
+        bar = "#" * round(frac * self.width)
         sys.stderr.write(f"\r{self.label} [{bar:<{self.width}}] {done}/{total} evals")
         sys.stderr.flush()
 
@@ -210,7 +211,7 @@ def _cmd_run(args) -> int:
         if sys.stderr.isatty() else None
     try:
         result = job.run(progress=bar)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - the CLI's boundary: traceback, then one line naming it
         return _failure(exc, "the run failed")
     finally:
         if bar is not None:
@@ -244,7 +245,7 @@ def _cmd_experiment(args) -> int:
         return _error(f"{exc}; the records written stay, rerun to resume", 1)
     except ConnectionError as exc:
         return _error(str(exc), 1)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
     print(report, file=sys.stderr)
     if report.failed:

@@ -44,8 +44,11 @@ where they run. ``executor=None`` runs them in this process (or, with
 (:func:`moo.executors.open_executor` opens the first two). Workers compute and
 *return* records; only this process (the driver) writes them, atomically, so
 the workers need no shared file system. A Dask worker lost mid-grid has its
-runs recomputed on the others by the scheduler; the driver keeps every
-record that arrived.
+runs recomputed on the others by the scheduler; a process of the ``"process"``
+pool of :func:`~moo.executors.open_executor` killed mid-grid breaks the pool,
+and the driver starts a fresh pool and resubmits the runs lost with it (at
+most :data:`~moo.executors.POOL_RESTARTS` times, with a message on stderr).
+Either way the driver keeps every record that arrived.
 
 Failures
 --------
@@ -54,8 +57,10 @@ A run that raises is recorded beside its cell as ``seed_<s>.failed.json``
 the grid (:class:`RunFailedError`; queued runs are cancelled, the records
 already written stay, and a rerun resumes); with ``keep_going`` the grid goes
 on and the report lists the failures. A failure of the executor itself
-(``BrokenProcessPool`` when a pool process is killed, Dask's ``KilledWorker``
-when a run has killed several workers) stops the grid in the same way.
+(``BrokenProcessPool`` when the pool broke once more after its last restart,
+or when a pool that cannot restart - an executor passed in - lost a process;
+Dask's ``KilledWorker`` when a run has killed several workers) stops the grid
+in the same way.
 """
 
 from __future__ import annotations
@@ -66,6 +71,7 @@ import time
 import traceback
 from collections.abc import Sequence
 from concurrent.futures import Executor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -74,6 +80,7 @@ import numpy as np
 from moo._validation import check_int
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
+from moo.executors import POOL_RESTARTS, _RestartingPool, open_executor
 from moo.store import FAILED_SUFFIX, load_records, prepare_results_dir, read_record, write_json_atomic
 
 __all__ = ["RunSpec", "ExperimentReport", "PreparedExperiment", "RunFailedError", "plan", "run_seeds",
@@ -257,10 +264,10 @@ def _execute(spec: RunSpec) -> dict:
     from moo import runner
 
     try:
-        options = {} if spec.setup is None else {"setup": spec.setup}      # only problems with set-ups take one
         result = runner.run(spec.problem, spec.algorithm, seed=spec.seed, evals=spec.evals, n_obj=spec.n_obj,
-                            molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders, **options)
-    except Exception as exc:           # recorded by the driver; KeyboardInterrupt etc. propagate
+                            molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders,
+                            setup=spec.setup)
+    except Exception as exc:  # noqa: BLE001 - recorded by the driver; KeyboardInterrupt etc. propagate
         return {"status": "failed", "problem": spec.problem, "setup": spec.setup, "n_obj": spec.n_obj,
                 "algorithm": spec.algorithm,
                 "molsp": spec.molsp, "seed": spec.seed, "run_index": spec.run_index, "budget": spec.evals,
@@ -326,17 +333,49 @@ class _Recorder:
 
 
 def _run_on(executor: Executor, specs: Sequence[RunSpec], recorder: _Recorder) -> None:
-    """Submit every spec, record results as they arrive; on any error cancel the rest, keep what finished."""
+    """Run every spec on ``executor``; resubmit the runs lost to a broken pool if the pool can restart."""
+    todo = list(specs)
+    while todo:
+        lost, broken = _submit_and_record(executor, todo, recorder)
+        if broken is None:
+            return
+        if not isinstance(executor, _RestartingPool):
+            raise broken
+        if not executor.restart():
+            raise BrokenProcessPool(f"a pool process died again after {POOL_RESTARTS} restarts of the pool "
+                                    "(a run may be killing its process)") from broken
+        restart = POOL_RESTARTS - executor.restarts_left
+        print("\n" * (recorder.bar is not None) + f"moo.experiment: a pool process died; resubmitting the "
+              f"{len(lost)} runs lost with it to a fresh pool (restart {restart} of {POOL_RESTARTS})",
+              file=sys.stderr)
+        todo = lost
+
+
+def _submit_and_record(executor: Executor, specs: Sequence[RunSpec],
+                       recorder: _Recorder) -> tuple[list[RunSpec], BrokenProcessPool | None]:
+    """Submit every spec, record results as they arrive; on any error cancel the rest, keep what finished.
+
+    Returns the specs lost to a broken process pool (every run in flight or queued when a pool process
+    died) and the pool's error, or ``([], None)``.
+    """
     futures = {executor.submit(_execute, spec): spec for spec in specs}
+    lost, broken = [], None
     try:
         for fut in as_completed(list(futures)):
-            recorder.add(futures.pop(fut), fut.result())
+            spec = futures.pop(fut)
+            exc = fut.exception()
+            if isinstance(exc, BrokenProcessPool):
+                lost.append(spec)
+                broken = exc
+            else:
+                recorder.add(spec, fut.result())
     finally:
         for fut in futures:
             fut.cancel()
         for fut, spec in futures.items():          # finished while we were stopping: keep them
             if fut.done() and not fut.cancelled() and fut.exception() is None:
                 recorder.keep(spec, fut.result())
+    return lost, broken
 
 
 @dataclass(frozen=True, repr=False)
@@ -469,8 +508,6 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
     RunFailedError
         A run raised (without ``keep_going``); the records written stay.
     """
-    from moo.executors import open_executor
-
     workers = check_int(workers, "workers", 1)
     if executor is not None and workers != 1:
         raise ValueError("give workers (a local process pool) or executor, not both")

@@ -62,8 +62,10 @@ from importlib.metadata import PackageNotFoundError, version
 
 import moocore
 import numpy as np
+from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
 from pymoo.core.population import Population
+from pymoo.core.problem import Problem
 
 from moo._validation import check_int
 from moo.algorithms import make_algorithm
@@ -179,8 +181,10 @@ class _HVHistory(Callback):
 
 
 def check_budget(problem, algorithm: str, *, evals: int, pop_size: int = POP_SIZE):
-    """The algorithm ``algorithm`` built for ``problem`` (a pymoo problem); ``ValueError`` if
-    ``evals`` is below the population size it uses."""
+    """The algorithm ``algorithm`` built for ``problem`` (a pymoo problem).
+
+    Raises ``ValueError`` if ``evals`` is below the population size it uses.
+    """
     alg = make_algorithm(algorithm, n_obj=problem.n_obj, pop_size=pop_size)
     if evals < alg.pop_size:
         raise ValueError(f"evals must be at least the population size of {algorithm} ({alg.pop_size}), "
@@ -198,8 +202,8 @@ class PreparedRun:
     evals: int
     molsp: bool
     max_leaders: int | None
-    problem: object
-    algorithm: object
+    problem: Problem
+    algorithm: Algorithm
     setup: str | None = None
 
     def __repr__(self) -> str:

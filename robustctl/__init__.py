@@ -15,20 +15,27 @@ True
 Sign convention everywhere: ``u = K x``.
 """
 
+from .analysis import (
+    CostBound,
+    HinfBound,
+    RobustStability,
+    WorstCase,
+    guaranteed_cost,
+    robust_hinf_bound,
+    robust_stability,
+    worst_case,
+)
 from .controller import Controller
 from .design import design
 from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, RankConditionError, RobustCtlError
-from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .h2 import H2Controller, h2
-from .regions import ConicSector, Disk, HalfPlane
+from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .lqr import lqr
 from .plant import Plant
+from .regions import ConicSector, Disk, HalfPlane
 from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
 from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
-from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guaranteed_cost, robust_hinf_bound,
-                       robust_stability, worst_case)
-
 
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",

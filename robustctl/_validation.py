@@ -129,7 +129,7 @@ def as_batch(value, name: str, shape: Sequence[int | None], what: Sequence[str] 
     if arr.ndim != len(shape):
         raise ValueError(f"{name} must be a {len(shape)}-D array of shape "
                          f"{tuple('B' if s is None else s for s in shape)}, got shape {arr.shape}")
-    for axis, (want, got) in enumerate(zip(shape, arr.shape)):
+    for axis, (want, got) in enumerate(zip(shape, arr.shape, strict=True)):
         if want is not None and want != got:
             label = f" ({what[axis]})" if axis < len(what) and what[axis] else ""
             raise ValueError(f"{name} must have size {want} along axis {axis}{label}, "
@@ -244,7 +244,7 @@ def check_choice(value, name: str, choices: Collection[str]) -> str:
     return value
 
 
-def check_performance(n: int, m: int, Bw, Cz, Dzu, Dzw):
+def check_performance(n: int, m: int, Bw, Cz, Dzu, Dzw) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Disturbance and performance channels of ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u``.
 
     Returns float arrays ``(Bw, Cz, Dzu, Dzw)``; ``Dzw=None`` is zero; a 1-D ``Bw`` is one column.

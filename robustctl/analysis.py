@@ -96,9 +96,10 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -392,7 +393,7 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     lmis = [_cvx.LMI("lyapunov", _block(Ah, Hh, P, N, discrete)), _cvx.LMI("P", P)]
     rep = _cvx.solve_sdp(cp.Minimize(mu), lmis, infeasible_msg="the bounded-real LMI of the uncertainty loop is "
                                                                "infeasible")
-    mu_opt = max(float(mu.value), 0.0)
+    mu_opt = max(float(_cvx.value(mu)), 0.0)
     no_reach = not (np.any(H) and np.any(E))
     margin = np.inf if no_reach or mu_opt == 0.0 else 1.0 / (np.sqrt(mu_opt) * hh * eh)
     radius = 1.0 if margin > 1.0 else margin / (1.0 + _BACKOFF)
@@ -401,16 +402,15 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     # strictly feasible for small eps > 0 at any radius below the margin; the
     # LMI gains delta = 1 / (radius hh eh)^2 - mu_opt in its q block. The
     # plant's coordinates with multiplier 1 need P = eh^2 L (P^* + eps I) L'.
-    P_opt = 0.5 * (P.value + P.value.T)
+    P_val = _cvx.value(P)
+    P_opt = 0.5 * (P_val + P_val.T)
     delta = 1.0 / (radius * hh * eh) ** 2 - mu_opt
-    best = None
+    candidates = []
     for eps in max(delta, 1e-12) * 10.0 ** -np.arange(7.0):
         P_c = eh**2 * T.P(P_opt + eps * np.eye(n))
         blocks = _stability_blocks(A, H, E, P_c, radius, discrete)
-        score = _relative_min_eig(blocks)
-        if best is None or score > best[0]:
-            best = (score, P_c, blocks)
-    score, P_c, blocks = best
+        candidates.append((_relative_min_eig(blocks), P_c, blocks))
+    score, P_c, blocks = max(candidates, key=lambda c: c[0])  # the first of the best scores
     cert = {k: _min_eig(M) for k, M in blocks.items()}
     info = {"nominal_radius": nominal, "mu": mu_opt, **_solve_info([rep])}
     return RobustStability(bool(radius == 1.0 and score > _STRICT), float(margin), float(radius), _frozen(P_c),
@@ -446,7 +446,8 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
         except (InfeasibleError, ConvergenceError):
             return None
         reports.append(rep)
-        return 0.5 * (P.value + P.value.T) if t.value > _POLY_T else None
+        P_val = _cvx.value(P)
+        return 0.5 * (P_val + P_val.T) if float(_cvx.value(t)) > _POLY_T else None
 
     if not any(np.any(Di) for Di in D):
         margin, (lo, P_lo) = np.inf, (1.0, np.eye(n))
@@ -588,7 +589,7 @@ def _balanced(Hh: np.ndarray, Eh: np.ndarray) -> tuple[np.ndarray, np.ndarray, f
 
 def _multiplier(lam, p: int, c: float) -> float:
     """The multiplier in the plant's scaling: ``lam^ (|E^ x^|^2 - |q^|^2) = lam^ (|E x|^2 - |q|^2) / c^2``."""
-    return float(lam.value) / c**2 if p else 0.0
+    return float(_cvx.value(lam)) / c**2 if p else 0.0
 
 
 def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertainty: NormBounded, Q: ArrayLike,
@@ -653,7 +654,7 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
         xh = xh / (np.linalg.norm(xh) or 1.0)   # x0' P x0 = |L' x0|^2 xh' P^ xh: the direction only
         objective = cp.Minimize(xh @ P @ xh)
     rep = _cvx.solve_sdp(objective, lmis, infeasible_msg="the guaranteed-cost LMI is infeasible")
-    P_orig = T.P(P.value)
+    P_orig = T.P(_cvx.value(P))
     bound = float(x0 @ P_orig @ x0) if x0 is not None else float(np.linalg.eigvalsh(P_orig)[-1])
     return CostBound(bound, _frozen(P_orig), _multiplier(lam, p, c), None if x0 is None else _frozen(x0),
                      MappingProxyType(dict(rep.certificate)), MappingProxyType(_solve_info([rep])))
@@ -706,8 +707,8 @@ def robust_hinf_bound(controller: Controller | tuple[Plant, ArrayLike], uncertai
          - mu * _diag(np.zeros((n + p, n + p)), np.eye(q)))
     lmis = [_cvx.LMI("hinf", _block(Ah, np.hstack([Hh, Bh]), P, N, plant.is_discrete)), _cvx.LMI("P", P)]
     rep = _cvx.solve_sdp(cp.Minimize(mu), lmis, infeasible_msg="the robust H-infinity LMI is infeasible")
-    gamma = b * float(np.sqrt(max(float(mu.value), 0.0)))
-    return HinfBound(gamma, _frozen(T.P(P.value)), _multiplier(lam, p, c),
+    gamma = b * float(np.sqrt(max(float(_cvx.value(mu)), 0.0)))
+    return HinfBound(gamma, _frozen(T.P(_cvx.value(P))), _multiplier(lam, p, c),
                      MappingProxyType(dict(rep.certificate)), MappingProxyType(_solve_info([rep])))
 
 
@@ -822,14 +823,14 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     nominal, g0 = obj.value_grad(np.zeros((p, l)))
     starts = []
     if np.any(g0):
-        U, s, Vt = np.linalg.svd(g0)
+        U, _, Vt = np.linalg.svd(g0)
         starts += [_polar(g0), np.outer(U[:, 0], Vt[0])]
     if is_stable(A, discrete=discrete) and np.any(H) and np.any(E):
         sys = control.ss(A, H, E, np.zeros((l, p)), plant.dt if discrete else 0)
         _, w = control.linfnorm(sys)
         z = np.exp(1j * w * plant.dt) if discrete else 1j * w
         Tz = E @ np.linalg.solve(z * np.eye(plant.n) - A, H)
-        U, s, Vh = np.linalg.svd(Tz)
+        U, _s, Vh = np.linalg.svd(Tz)
         Dc = np.outer(Vh[0].conj(), U[:, 0].conj()).real  # Re(v u^H)
         if np.any(Dc):
             starts.append(Dc / np.linalg.norm(Dc, 2))

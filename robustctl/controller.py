@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -62,11 +63,14 @@ class Controller:
         return p.F + p.G @ self.K
 
     def closed_loop_poles(self, plant: Plant | None = None) -> np.ndarray:
+        """Eigenvalues of :meth:`closed_loop`."""
         return np.linalg.eigvals(self.closed_loop(plant))
 
     def is_stabilizing(self, plant: Plant | None = None) -> bool:
-        """``F + G K`` is stable: spectral radius below ``1 - 1e-9`` (discrete) or every real part below
-        ``-1e-9`` (continuous), the margin of :mod:`robustctl.stability`."""
+        """Whether ``F + G K`` is stable, with the margin of :mod:`robustctl.stability`.
+
+        Spectral radius below ``1 - 1e-9`` (discrete) or every real part below ``-1e-9`` (continuous).
+        """
         p = self._plant(plant)
         return is_stable(self.closed_loop(p), discrete=p.is_discrete)
 

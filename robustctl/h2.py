@@ -44,8 +44,8 @@ reported (``info["h2_norms"]``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 import scipy.linalg
@@ -194,7 +194,7 @@ def h2_blocks(data: Coordinates, V: Point, W, discrete: bool, margin=0.0, z_scal
     X, Y = V.X, V.Y
     BB = data.Bw @ data.Bw.T
     out = []
-    for i, (F, G) in enumerate(zip(data.F, data.G)):
+    for i, (F, G) in enumerate(zip(data.F, data.G, strict=True)):
         AX = F @ X + G @ Y
         M = cp.bmat([[X - BB, AX], [AX.T, X]]) if discrete else -(AX + AX.T) - BB
         out.append(_cvx.LMI(f"gramian[{i}]", M, margin))
@@ -214,7 +214,7 @@ def _minimise(data: Coordinates, discrete: bool, regions, solver: str, what: str
     lmis = h2_blocks(data, V, W, discrete) + region_blocks(regions, data, V)
     rep = _cvx.solve_sdp(cp.Minimize(cp.trace(W)), lmis, solver=solver, tol=tol.LEVEL_TOL,
                          infeasible_msg=f"no H2 state feedback: {what}")
-    return V.values(), float(np.trace(W.value)), rep
+    return V.values(), float(np.trace(_cvx.value(W))), rep
 
 
 def _centre(data: Coordinates, discrete: bool, regions, solver: str, h2_opt: float, const: float,
@@ -247,7 +247,7 @@ def _centre(data: Coordinates, discrete: bool, regions, solver: str, h2_opt: flo
             continue
         solves.append({**rep.as_dict(), "centring": "margin"})
         if all(v > 0 for v in rep.certificate.values()):
-            return V.values(), float(t.value), rep, used, solves
+            return V.values(), float(_cvx.value(t)), rep, used, solves
         failure = ConvergenceError(f"{msg} (smallest eigenvalues {dict(rep.certificate)})")
     raise failure or ConvergenceError("no centring attempt")
 

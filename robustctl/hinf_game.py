@@ -109,7 +109,10 @@ class HinfGame:
                 f"state_feedback={self.state_feedback})")
 
 
-def _step(F, G, Bw, Q, R, gamma, P, where: str):
+_Gains = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]   # K, K_x, K_w, K_e, K_u
+
+
+def _step(F, G, Bw, Q, R, gamma, P, where: str) -> tuple[np.ndarray, _Gains, bool]:
     """One backward step from ``P = P[k+1]``: ``(P[k], gains, state-feedback condition)``; raises if no value."""
     m, q = G.shape[1], Bw.shape[1]
     scale = max(1.0, float(np.abs(P).max()))
@@ -194,15 +197,16 @@ def hinf_game(plant: Plant, *, Bw, Q, R, gamma: float, horizon: int | None = Non
             gains.append(g)
             state_feedback &= sf
         Ps, gains = Ps[::-1], gains[::-1]
-        stacked = [np.stack([g[i] for g in gains]) for i in range(5)]
-        return HinfGame(gamma, np.stack(Ps), *stacked, state_feedback=state_feedback, horizon=N, iterations=N)
+        K, K_x, K_w, K_e, K_u = (np.stack([g[i] for g in gains]) for i in range(5))
+        return HinfGame(gamma, np.stack(Ps), K, K_x, K_w, K_e, K_u, state_feedback=state_feedback, horizon=N,
+                        iterations=N)
     tol = check_positive_scalar(tol, "tol")
     max_iter = check_int(max_iter, "max_iter", 1)
     change = np.inf
     for it in range(1, max_iter + 1):
         P_new, _, sf = _step(F, G, Bw, Q, R, gamma, P, f"iteration {it}")
         state_feedback &= sf
-        change = np.linalg.norm(P_new - P) / max(np.linalg.norm(P_new), np.finfo(float).tiny)
+        change = float(np.linalg.norm(P_new - P)) / max(float(np.linalg.norm(P_new)), np.finfo(float).tiny)
         P = P_new
         if change <= tol:
             _, g, sf = _step(F, G, Bw, Q, R, gamma, P, f"iteration {it + 1}")    # the gains of the settled P

@@ -41,8 +41,8 @@ indefinite ``R`` without raising; every solution is therefore accepted only
 after its relative residual, symmetry, sign and the closed-loop spectrum are
 checked (the closed loop of the saddle point must be stable with the margin
 of :mod:`robustctl.stability`, like every stability test of the library:
-this module shares that definition, not the LMI code). The continuous case builds the Hamiltonian and its ordered Schur form
-directly (imaginary-axis eigenvalues mean ``gamma`` is too small).
+this module shares that definition, not the LMI code). The continuous case builds the Hamiltonian
+and its ordered Schur form directly (imaginary-axis eigenvalues mean ``gamma`` is too small).
 
 The equations are solved in unit-sized channels, ``w~ = ||Bw|| w`` and
 ``z~ = z / ||[Cz Dzu Dzw~]||`` (the level is homogeneous in both scalings
@@ -76,6 +76,9 @@ __all__ = ["RiccatiHinf", "hinf_riccati", "riccati_level"]
 # plant: gamma 8e-6 too low with 1e-7 here).
 _RES_TOL = 1e-10
 
+# (F, G, Bw, Cz, Dzu, Dzw)
+_Data = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
 
 @dataclass(frozen=True, eq=False)
 class RiccatiHinf:
@@ -102,7 +105,7 @@ class RiccatiHinf:
     iterations: int
 
 
-def _data(plant, Bw, Cz, Dzu, Dzw):
+def _data(plant, Bw, Cz, Dzu, Dzw) -> tuple[_Data, float, float]:
     """``(F, G, Bw~, Cz~, Dzu~, Dzw~), b, c``: ``w~ = b w`` and ``z~ = z / c`` of unit size (1 for zero matrices).
 
     A level of the scaled data is ``gamma / (b c)``, its Riccati solution ``P / c^2``; the gain is the same.
@@ -125,7 +128,7 @@ def _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma):
 
 
 def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
-    n, m = G.shape
+    _n, m = G.shape
     B, Q, R, S = _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma)
     try:
         with np.errstate(all="ignore"):
@@ -141,7 +144,7 @@ def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
     except np.linalg.LinAlgError:
         return None
     res = F.T @ P @ F + Q + (F.T @ P @ B + S) @ L - P
-    scale = max(1.0, np.linalg.norm(P), np.linalg.norm(Q))
+    scale = max(1.0, float(np.linalg.norm(P)), float(np.linalg.norm(Q)))
     if not np.linalg.norm(res) <= _RES_TOL * scale:
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * scale:
@@ -166,10 +169,10 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     A = F - B @ Rinv @ S.T
     Ham = np.block([[A, -B @ Rinv @ B.T], [-(Q - S @ Rinv @ S.T), -A.T]])
     eig = np.linalg.eigvals(Ham)
-    scale = max(1.0, np.linalg.norm(Ham, 1))
+    scale = max(1.0, float(np.linalg.norm(Ham, 1)))
     if np.min(np.abs(eig.real)) <= 1e-10 * scale:
         return None  # eigenvalue on the imaginary axis: gamma too small
-    T, U, sdim = scipy.linalg.schur(Ham, output="real", sort="lhp")
+    _T, U, sdim = scipy.linalg.schur(Ham, output="real", sort="lhp")
     if sdim != n:
         return None
     U1, U2 = U[:n, :n], U[n:, :n]
@@ -179,8 +182,8 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     P = 0.5 * (P + P.T)
     L = -Rinv @ (B.T @ P + S.T)
     res = F.T @ P + P @ F + Q + (P @ B + S) @ L
-    pscale = max(1.0, np.linalg.norm(P), np.linalg.norm(Q))
-    if not np.linalg.norm(res) <= 1e-6 * pscale * max(1.0, np.linalg.norm(F)):
+    pscale = max(1.0, float(np.linalg.norm(P)), float(np.linalg.norm(Q)))
+    if not np.linalg.norm(res) <= 1e-6 * pscale * max(1.0, float(np.linalg.norm(F))):
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * pscale:
         return None

@@ -38,7 +38,7 @@ def _weights(plant: Plant, Q, R) -> tuple[np.ndarray, np.ndarray]:
 def _residual(F, G, Q, R, P) -> float:
     GP = G.T @ P
     res = F.T @ P @ F - F.T @ P @ G @ np.linalg.solve(R + GP @ G, GP @ F) + Q - P
-    return float(np.linalg.norm(res) / max(1.0, np.linalg.norm(P)))
+    return float(np.linalg.norm(res)) / max(1.0, float(np.linalg.norm(P)))
 
 
 def dare(F, G, Q=None, R=None) -> tuple[np.ndarray, str]:
@@ -62,7 +62,8 @@ def _dare(F, G, Q, R) -> tuple[np.ndarray, str]:
                 P = np.asarray(control.dare(F, G, Q, R, method="slycot")[0])
             else:
                 P = scipy.linalg.solve_discrete_are(F, G, Q, R)
-        except Exception as exc:  # slycot missing or failed, or scipy failed: try the next
+        except (ImportError, RuntimeError, ValueError, ArithmeticError) as exc:
+            # slycot missing (ImportError) or failed (SlycotError is a RuntimeError), or scipy failed: try the next
             reasons.append(f"{backend}: {exc}")
             continue
         P = 0.5 * (P + P.T)

@@ -29,8 +29,10 @@ def _frozen_complex(arr: np.ndarray) -> np.ndarray:
 
 
 def _singular(M: np.ndarray, scale: float) -> bool:
-    """``M`` is singular up to the rounding of forming it from terms of norm ``scale``:
-    smallest singular value at most ``n eps scale`` (or ``M`` not finite)."""
+    """Whether ``M`` is singular up to the rounding of forming it from terms of norm ``scale``.
+
+    Smallest singular value at most ``n eps scale`` (or ``M`` not finite).
+    """
     if not np.all(np.isfinite(M)):
         return True
     return bool(np.linalg.svd(M, compute_uv=False)[-1] <= M.shape[0] * np.finfo(float).eps * scale)
@@ -77,6 +79,7 @@ class Plant:
 
     @property
     def is_discrete(self) -> bool:
+        """Whether the plant is discrete-time (``dt`` given)."""
         return self.dt is not None
 
     @cached_property
@@ -94,7 +97,7 @@ class Plant:
 
     # -- constructors ------------------------------------------------------
     @classmethod
-    def from_continuous(cls, A, B, dt: float | None, method: str = "zoh") -> "Plant":
+    def from_continuous(cls, A, B, dt: float | None, method: str = "zoh") -> Plant:
         """Discretise ``dx/dt = A x + B u`` with sampling time ``dt``.
 
         ``method`` is ``"zoh"`` (exact for piecewise-constant inputs, via
@@ -117,7 +120,8 @@ class Plant:
             if method == "euler":
                 F, G = np.eye(n) + A * dt, B * dt
             else:
-                if method == "tustin" and _singular(np.eye(n) - A * (dt / 2), 1.0 + np.linalg.norm(A, 2) * dt / 2):
+                half = A * (dt / 2)
+                if method == "tustin" and _singular(np.eye(n) - half, 1.0 + float(np.linalg.norm(half, 2))):
                     raise ValueError(f"method='tustin' needs I - A dt/2 invertible, but A has an eigenvalue at "
                                      f"2/dt = {2 / dt:g} (dt={dt:g}); use method='zoh' or another dt")
                 import control
@@ -130,7 +134,7 @@ class Plant:
         return cls(F, G, dt)
 
     @classmethod
-    def from_statespace(cls, sys) -> "Plant":
+    def from_statespace(cls, sys) -> Plant:
         """Build a plant from a python-control ``StateSpace`` (its C and D are ignored)."""
         import control
 
@@ -168,7 +172,7 @@ def check_plant(value, name: str = "plant", *, discrete_for: str | None = None) 
 
 
 def check_vertices(plant: Plant, vertices, *, reference: str = "plant", non_empty: bool = False) -> list[Plant]:
-    """``[plant, *vertices]`` after checking that every vertex is a :class:`~robustctl.Plant` of ``plant``'s size and ``dt``.
+    """``[plant, *vertices]``, each vertex checked to be a :class:`~robustctl.Plant` of ``plant``'s size and ``dt``.
 
     The vertices of a polytope ``conv{plant, *vertices}`` (e.g. the ``vertices``
     of :func:`robustctl.hinf` and :func:`robustctl.robust_stability`).

@@ -25,8 +25,8 @@ placement constraints: an LMI approach", IEEE Trans. Automatic Control
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -40,10 +40,12 @@ class Region:
 
     @property
     def L(self) -> np.ndarray:  # pragma: no cover - every region defines it
+        """The symmetric characteristic matrix ``L``."""
         raise NotImplementedError
 
     @property
     def M(self) -> np.ndarray:  # pragma: no cover
+        """The characteristic matrix ``M``."""
         raise NotImplementedError
 
     def real_interval(self) -> tuple[float, float]:  # pragma: no cover
@@ -73,13 +75,16 @@ class Disk(Region):
 
     @property
     def L(self) -> np.ndarray:
+        """The characteristic matrix ``L`` (class docstring)."""
         return np.array([[-self.radius, -self.center], [-self.center, -self.radius]])
 
     @property
     def M(self) -> np.ndarray:
+        """The characteristic matrix ``M`` (class docstring)."""
         return np.array([[0.0, 1.0], [0.0, 0.0]])
 
     def real_interval(self) -> tuple[float, float]:
+        """The open interval of real points in the region."""
         return self.center - self.radius, self.center + self.radius
 
 
@@ -104,13 +109,16 @@ class HalfPlane(Region):
 
     @property
     def L(self) -> np.ndarray:
+        """The characteristic matrix ``L`` (class docstring)."""
         return np.array([[-2.0 * self._sign * self.boundary]])
 
     @property
     def M(self) -> np.ndarray:
+        """The characteristic matrix ``M`` (class docstring)."""
         return np.array([[self._sign]])
 
     def real_interval(self) -> tuple[float, float]:
+        """The open interval of real points in the region."""
         return (-math.inf, self.boundary) if self.side == "left" else (self.boundary, math.inf)
 
 
@@ -136,14 +144,17 @@ class ConicSector(Region):
 
     @property
     def L(self) -> np.ndarray:
+        """The characteristic matrix ``L`` (class docstring)."""
         return -2.0 * self.apex * math.sin(self.angle) * np.eye(2)
 
     @property
     def M(self) -> np.ndarray:
+        """The characteristic matrix ``M`` (class docstring)."""
         s, c = math.sin(self.angle), math.cos(self.angle)
         return np.array([[s, c], [-c, s]])
 
     def real_interval(self) -> tuple[float, float]:
+        """The open interval of real points in the region."""
         return -math.inf, self.apex
 
 

@@ -175,7 +175,7 @@ def unstabilizable_modes(F, G, *, discrete: bool = True) -> np.ndarray:
 
 
 def check_stabilizable(plant, name: str = "plant") -> None:
-    """Raise :class:`~robustctl.errors.NotStabilizableError` if ``plant`` (a :class:`~robustctl.Plant`) is not stabilisable.
+    """Raise :class:`~robustctl.errors.NotStabilizableError` if ``plant`` (a ``Plant``) is not stabilisable.
 
     ``lqr``, ``rlqr``, ``hinf`` and ``h2`` call this first (the latter two at
     every vertex): no gain ``u = K x`` stabilises such a plant, so there is no

@@ -43,10 +43,12 @@ class NormBounded:
 
     @property
     def n(self) -> int:
+        """Columns of EF (the number of states)."""
         return self.EF.shape[1]
 
     @property
     def m(self) -> int:
+        """Columns of EG (the number of inputs)."""
         return self.EG.shape[1]
 
     @property
@@ -103,7 +105,10 @@ class NormBounded:
 
 
 def check_norm_bounded(value, plant: Plant, name: str = "uncertainty") -> NormBounded:
-    """``value`` if it is a :class:`~robustctl.NormBounded` of ``plant``'s size; ``TypeError``/``ValueError`` naming ``name``."""
+    """``value`` if it is a :class:`~robustctl.NormBounded` of ``plant``'s size.
+
+    Otherwise a ``TypeError`` or ``ValueError`` naming ``name``.
+    """
     if not isinstance(value, NormBounded):
         raise TypeError(f"{name} must be a robustctl.NormBounded, got {type(value).__name__}")
     value.check_plant(plant)

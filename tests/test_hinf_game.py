@@ -130,7 +130,7 @@ def test_delayed_law_applies_the_full_information_input_one_step_late():
     plant, Bw, Q, R = _random_case(4)
     g = hinf_game(plant, Bw=Bw, Q=Q, R=R, gamma=50.0)
     rng = np.random.default_rng(0)
-    x, u_prev = rng.normal(size=4), np.zeros(2)
+    x = rng.normal(size=4)
     for _ in range(10):
         w = rng.normal(size=2)
         u_fi = g.K_x @ x + g.K_w @ w
@@ -189,7 +189,7 @@ def test_bad_arguments(kwargs, exc, words):
 
 
 def test_bad_plant():
-    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+    with pytest.raises(TypeError, match=r"plant must be a robustctl\.Plant"):
         hinf_game(np.eye(2), Bw=np.ones(2), Q=np.eye(2), R=np.eye(1), gamma=1.0)
     with pytest.raises(ValueError, match="must be discrete-time"):
         hinf_game(Plant(np.eye(2), np.ones((2, 1)), None), Bw=np.ones(2), Q=np.eye(2), R=np.eye(1), gamma=1.0)

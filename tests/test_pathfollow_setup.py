@@ -6,9 +6,16 @@ import scipy.signal
 
 import robustctl as rc
 from robustctl.models import truck
-from robustctl.path import LaneChange, ReferencePath, Straight, Curve, default_route
-from robustctl.pathfollow import (DEFAULT_INITIAL_ERROR, SETUPS, PathFollowing, PathFollowingSetup, code_manoeuvre,
-                                  get_setup, simulate)
+from robustctl.path import Curve, LaneChange, ReferencePath, Straight, default_route
+from robustctl.pathfollow import (
+    DEFAULT_INITIAL_ERROR,
+    SETUPS,
+    PathFollowing,
+    PathFollowingSetup,
+    code_manoeuvre,
+    get_setup,
+    simulate,
+)
 
 OVERLOADS = (0.0, 200.0)
 
@@ -25,7 +32,7 @@ def _reference(path, overload=0.0):
     _, a_per_kappa = truck.steady_state_cornering(overload)
     u_ref = a_per_kappa * path.kappa
     sysd = scipy.signal.cont2discrete((A, np.column_stack([B, E]), np.eye(4), np.zeros((4, 2))), path.dt, "zoh")
-    _, x_ol, _ = scipy.signal.dlsim(sysd[:4] + (path.dt,), np.column_stack([u_ref, path.kappa]))
+    _, x_ol, _ = scipy.signal.dlsim((*sysd[:4], path.dt), np.column_stack([u_ref, path.kappa]))
     return x_ol, u_ref
 
 

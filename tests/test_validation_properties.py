@@ -1,12 +1,21 @@
 """Property-based checks: any malformed input gives ValueError/TypeError naming the argument,
 never a NaN, a hang or an exception from deep inside numpy."""
 
+import collections
+import functools
+import os
+import re
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import robustctl as rc
+from robustctl.hinf_riccati import hinf_riccati
+from robustctl.lqr import dare
+from robustctl.rlqr import rlqr_step, rlqr_step_block
+from robustctl.stability import unstabilizable_modes
 
 dims = st.integers(1, 4)
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -63,9 +72,13 @@ def test_non_finite_entries_are_named(where, value):
             "EG": np.array([[1.0, 0.5]]), "Q": np.eye(2), "R": np.eye(2), "H": np.ones((2, 1))}
     data[where] = data[where].copy()
     data[where][0, 0] = value
+
+    def design():  # Plant (F, G) or rlqr (the others) refuses the entry
+        rc.rlqr(rc.Plant(data["F"], data["G"], 0.1), data["EF"], data["EG"], 10.0, Q=data["Q"], R=data["R"],
+                H=data["H"])
+
     with pytest.raises(ValueError, match=rf"^{where} must have finite entries"):
-        plant = rc.Plant(data["F"], data["G"], 0.1)
-        rc.rlqr(plant, data["EF"], data["EG"], 10.0, Q=data["Q"], R=data["R"], H=data["H"])
+        design()
 
 
 @SETTINGS
@@ -89,10 +102,6 @@ def test_batch_never_returns_unflagged_nan(B, seed):
 # entry, a junk object. Handled well = ValueError/TypeError whose message starts with the argument's name
 # (the project's subclasses count). TALLY counts cases tried / handled well per (function, cause); set
 # ROBUSTCTL_TALLY=<file> to write the table.
-import collections
-import os
-import re
-
 TALLY = collections.defaultdict(lambda: [0, 0])
 
 F2, G2 = np.array([[1.1, 0.2], [0.0, 0.9]]), np.array([[0.0], [1.0]])
@@ -101,6 +110,7 @@ EF2, EG2, H2 = np.array([[0.1, 0.2]]), np.array([[0.1]]), np.ones((2, 1))
 UNC = rc.NormBounded(H2, EF2, EG2)
 CTRL = rc.rlqr(PLANT, EF2, EG2, 1e4)
 A2 = np.array([[0.0, 1.0], [-2.0, -3.0]])
+I1, I2, X2, DELTA2 = np.eye(1), np.eye(2), np.ones(2), np.array([0.5, -0.5])   # valid default values
 RLQR_ARGS = {"EF": EF2, "EG": EG2, "mu": 1e4, "Q": np.eye(2), "R": np.eye(1), "H": H2, "alpha": 0.1,
              "tol": 1e-10, "max_iter": 100}
 
@@ -127,10 +137,6 @@ def _step(**kw):
     return rlqr_step(**a), rlqr_step_block(**a)
 
 
-from robustctl.lqr import dare  # noqa: E402
-from robustctl.rlqr import rlqr_step, rlqr_step_block  # noqa: E402
-from robustctl.stability import unstabilizable_modes  # noqa: E402
-
 # function -> {argument: (valid value, kind)}; kind "matrix", "scalar" (inf allowed where the function says),
 # "int", "flag", "choice"
 CASES = {
@@ -139,16 +145,16 @@ CASES = {
                               {"A": A2, "B": G2, "dt": 0.1, "method": "zoh"}),
     "NormBounded": (lambda H=H2, EF=EF2, EG=EG2: rc.NormBounded(H, EF, EG), {"H": H2, "EF": EF2, "EG": EG2}),
     "NormBounded.perturb": (lambda plant=PLANT, Delta=0.5: UNC.perturb(plant, Delta), {"plant": PLANT, "Delta": 0.5}),
-    "NormBounded.perturbed_matrices": (lambda Delta=np.array([0.5, -0.5]): UNC.perturbed_matrices(PLANT, Delta),
+    "NormBounded.perturbed_matrices": (lambda Delta=DELTA2: UNC.perturbed_matrices(PLANT, Delta),
                                        {"Delta": np.array([0.5, -0.5])}),
     "Controller": (lambda K=CTRL.K, plant=PLANT: rc.Controller(K, "x", plant), {"K": CTRL.K, "plant": PLANT}),
-    "Controller.__call__": (lambda x=np.ones(2): CTRL(x), {"x": np.ones(2)}),
+    "Controller.__call__": (lambda x=X2: CTRL(x), {"x": np.ones(2)}),
     "Controller.closed_loop": (lambda plant=PLANT: CTRL.closed_loop(plant), {"plant": PLANT}),
     "Controller.to_statespace": (lambda plant=PLANT: CTRL.to_statespace(plant), {"plant": PLANT}),
     "design": (lambda method="lqr": rc.design(method, PLANT), {"method": "lqr"}),
-    "lqr": (lambda plant=PLANT, Q=np.eye(2), R=np.eye(1): rc.lqr(plant, Q=Q, R=R),
+    "lqr": (lambda plant=PLANT, Q=I2, R=I1: rc.lqr(plant, Q=Q, R=R),
             {"plant": PLANT, "Q": np.eye(2), "R": np.eye(1)}),
-    "dare": (lambda F=F2, G=G2, Q=np.eye(2), R=np.eye(1): dare(F, G, Q, R),
+    "dare": (lambda F=F2, G=G2, Q=I2, R=I1: dare(F, G, Q, R),
              {"F": F2, "G": G2, "Q": np.eye(2), "R": np.eye(1)}),
     "rlqr": (_rlqr, {**RLQR_ARGS, "accelerate": True, "implementation": "kkt", "fallback": "newton",
                      "P_N": np.eye(2)}),
@@ -165,8 +171,6 @@ CASES = {
 }
 
 # ---- the LMI syntheses (hinf, h2, the Riccati reference), pole regions and the robust analysis
-from robustctl.hinf_riccati import hinf_riccati  # noqa: E402
-
 BW2, CZ2, DZU2 = np.array([[0.0], [1.0]]), np.vstack([np.eye(2), [[0.0, 0.0]]]), np.array([[0.0], [0.0], [1.0]])
 DZW2 = np.zeros((3, 1))
 PERF = {"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, "Dzw": DZW2}
@@ -205,7 +209,7 @@ CASES.update({
     "robust_stability(vertices)": (lambda vertices=(VERTEX,): rc.robust_stability(CTRL, vertices=vertices),
                                    {"vertices": [VERTEX]}),
     "robust_stability((plant, K))": (lambda K=CTRL.K: rc.robust_stability((PLANT, K), UNC_A), {"K": CTRL.K}),
-    "guaranteed_cost": (lambda controller=CTRL, uncertainty=UNC_A, Q=np.eye(2), R=np.eye(1), x0=None:
+    "guaranteed_cost": (lambda controller=CTRL, uncertainty=UNC_A, Q=I2, R=I1, x0=None:
                         rc.guaranteed_cost(controller, uncertainty, Q, R, x0),
                         {"controller": CTRL, "uncertainty": UNC_A, "Q": np.eye(2), "R": np.eye(1), "x0": np.ones(2)}),
     "robust_hinf_bound": (_hinf_bound, {"controller": CTRL, "uncertainty": UNC_A, **PERF}),
@@ -300,7 +304,7 @@ def _handled_well(call, name) -> bool:
     except (TypeError, ValueError) as exc:
         return re.match(rf"{re.escape(name)}\b", str(exc)) is not None or (
             name == "plant" and str(exc).startswith("plant must"))
-    except Exception:  # anything else (numpy, scipy, AttributeError, ...) is not handled well
+    except Exception:  # noqa: BLE001 - anything else (numpy, scipy, AttributeError, ...) is not handled well
         return False
     return False  # a bad value accepted
 
@@ -310,8 +314,8 @@ def _write_tally():
     yield
     if os.environ.get("ROBUSTCTL_TALLY") and TALLY:
         with open(os.environ["ROBUSTCTL_TALLY"], "w") as fh:
-            for (func, cause), (tried, good) in sorted(TALLY.items()):
-                fh.write(f"{func}\t{cause}\t{tried}\t{good}\n")
+            fh.writelines(f"{func}\t{cause}\t{tried}\t{good}\n"
+                          for (func, cause), (tried, good) in sorted(TALLY.items()))
 
 
 @pytest.mark.parametrize("func", sorted(CASES))
@@ -330,7 +334,7 @@ def test_every_bad_argument_is_named(func, cause, data):
             continue
         value = data.draw(strategy, label=name)
         TALLY[(func, cause)][0] += 1
-        ok = _handled_well(lambda: call(**{name: value}), name)
+        ok = _handled_well(functools.partial(call, **{name: value}), name)
         TALLY[(func, cause)][1] += ok
         assert ok, (func, name, cause, value)
 
@@ -388,7 +392,7 @@ def test_controller_refuses_non_finite_states(shape, seed, value):
     x = np.random.default_rng(seed).standard_normal(shape)
     x.flat[seed % x.size] = value
     TALLY[("Controller.__call__", "non-finite state")][0] += 1
-    with pytest.raises(ValueError, match="^x must have finite entries"):
+    with pytest.raises(ValueError, match=r"^x must have finite entries"):
         CTRL(x)
     TALLY[("Controller.__call__", "non-finite state")][1] += 1
 
@@ -413,7 +417,7 @@ def test_issue_12_booleans_in_the_lmi_syntheses_and_the_analysis():
     kw = dict(Bw=BW2, Cz=np.vstack([np.eye(2), np.zeros((2, 2))]), Dzu=np.vstack([np.zeros((2, 2)), np.eye(2)]))
     with pytest.raises(ValueError, match=r"^u_max must be a scalar or have 2 entries \(the number of inputs\)"):
         rc.hinf(m2, **kw, u_max=[1.0, 2.0, 3.0])
-    with pytest.raises(TypeError, match="^u_max must be a positive number or 2 positive numbers, got str"):
+    with pytest.raises(TypeError, match=r"^u_max must be a positive number or 2 positive numbers, got str"):
         rc.hinf(m2, **kw, u_max="1")
     with pytest.raises(ValueError, match=r"^u_max must be > 0 for every entry, got \[1.0, -2.0\]"):
         rc.hinf(m2, **kw, u_max=[1.0, -2.0])

@@ -21,8 +21,8 @@ factors, only the solver's path (iterations, accuracy) changes.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import Sequence
 
 import numpy as np
 import scipy.linalg
@@ -79,7 +79,7 @@ class Coordinates:
     def p(self) -> int:
         return self.Cz.shape[0]
 
-    def to(self, T: np.ndarray) -> "Coordinates":
+    def to(self, T: np.ndarray) -> Coordinates:
         """The same data in the coordinates ``x = T x^`` (``T`` relative to the original states)."""
         Fs, Gs, Bw, Cz, H, EF = self.original
         return replace(self, T=T, F=tuple(np.linalg.solve(T, F @ T) for F in Fs),
@@ -160,7 +160,7 @@ def _balance(F, Bw, G, Cz) -> np.ndarray:
 
         _, _, _, _, d = tb01id(n, B.shape[1], Cz.shape[0], 0.0, F.copy(), B.copy(), Cz.copy(), job="A")
         d = np.asarray(d, dtype=float)
-    except Exception:  # slycot missing or failed: no scaling
+    except (ImportError, RuntimeError, ValueError, ArithmeticError):  # slycot missing or failed: no scaling
         return np.ones(n)
     if d.shape != (n,) or not np.all(np.isfinite(d)) or np.any(d <= 0):
         return np.ones(n)
@@ -182,8 +182,8 @@ def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
     F, G, C, D = data.F[0], data.G[0], data.Cz, data.Dzu
     n, m = data.n, data.m
     Q, R, S = C.T @ C, D.T @ D, C.T @ D
-    Q = Q + tol.LQR_REG * max(1.0, np.linalg.norm(Q, 2)) * np.eye(n)
-    R = R + tol.LQR_REG * max(1.0, np.linalg.norm(R, 2)) * np.eye(m)
+    Q = Q + tol.LQR_REG * max(1.0, float(np.linalg.norm(Q, 2))) * np.eye(n)
+    R = R + tol.LQR_REG * max(1.0, float(np.linalg.norm(R, 2))) * np.eye(m)
     are = scipy.linalg.solve_discrete_are if discrete else scipy.linalg.solve_continuous_are
     try:
         with np.errstate(all="ignore"):
@@ -195,7 +195,9 @@ def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
         return None
     X = np.linalg.inv(0.5 * (P + P.T) + max(0.0, tol.RECENTRE_REG * lam[-1] - lam[0]) * np.eye(n))
     moved = recentred(data, X, tol.RECENTRE_REG)  # X > 0 by construction
-    bw = np.linalg.norm(moved[0].Bw, 2) if moved is not None else 0.0
+    if moved is None:
+        return None
+    bw = float(np.linalg.norm(moved[0].Bw, 2))
     if not (bw > 0 and np.isfinite(bw)):  # no disturbance: nothing to normalise by
         return None
     return moved[0].to(moved[0].T * bw)

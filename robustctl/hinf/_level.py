@@ -91,7 +91,7 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
                          solver=problem.solver, tol=tol.LEVEL_TOL if preconditioned else tol.LEVEL_TOL_GENERAL,
                          infeasible_msg=f"no H-infinity state feedback: {problem.infeasibility()}",
                          fast=preconditioned)
-    return Solved(V.values(), float(level_sq.value), rep)
+    return Solved(V.values(), float(_cvx.value(level_sq)), rep)
 
 
 def minimise_level(problem: Problem, balanced: Coordinates, lqr: Coordinates | None) -> Optimum:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -145,5 +145,5 @@ def check_poles_reachable(plants: Sequence[Plant], regions: Sequence[Region]) ->
         if stuck.size:
             raise InfeasibleError(
                 f"{vertex_name(i)}'s mode lambda = {complex(stuck[0]):.6g} lies outside the pole region "
-                f"{describe_regions(regions)} and cannot be moved by the input G (PBH rank test), so no gain places every closed-loop pole "
-                "there")
+                f"{describe_regions(regions)} and cannot be moved by the input G (PBH rank test), so no gain "
+                "places every closed-loop pole there")

@@ -53,7 +53,7 @@ class Model:
             return np.zeros_like(self.mu)
         return (1.0 + self.alpha) * self.mu * self.h_norm2
 
-    def select(self, mask: np.ndarray) -> "Model":
+    def select(self, mask: np.ndarray) -> Model:
         """The designs selected by the boolean ``mask`` (or index array)."""
         if mask.dtype == bool and mask.all():
             return self
@@ -148,7 +148,7 @@ def build(plant, EF, EG, mu, *, Q, R, H, alpha, uncertainty=None, batch: bool) -
     H = np.ones((n, l)) if H is None else as_matrix(H, "H", rows=n, vector="column",
                                                    rows_what="the number of states")
     alpha = check_positive_scalar(alpha, "alpha")
-    EF, EG, mu = (np.broadcast_to(a, (B,) + a.shape[1:]) for a in (EF, EG, mu))
+    EF, EG, mu = (np.broadcast_to(a, (B, *a.shape[1:])) for a in (EF, EG, mu))
     with np.errstate(divide="ignore"):
         mu_inv = np.where(np.isinf(mu), 0.0, 1.0 / mu)
     hh = _norm2(H)
