@@ -241,16 +241,13 @@ def _hinf(name: str, ts: TableSetup, note: str, *, vertices=(), uncertainty=None
         Bw = np.column_stack([[0.0, 0.0, HINF_RHO_IMPULSE, 0.0], Gk[0] * HINF_KAPPA_SCALE])
     else:
         Bw = H_ONES
-    # z = [sqrt(Q) x; sqrt(R) u] / sqrt(r): the gain does not depend on the scale of z, and Clarabel fails
-    # on the unscaled authors' weights (R = 33535); gamma is reported in the unscaled units
-    s = 1.0 / np.sqrt(R[0, 0])
-    Cz = s * np.vstack([np.sqrt(Q), np.zeros((1, 4))])
-    Dzu = s * np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+    Cz = np.vstack([np.sqrt(Q), np.zeros((1, 4))])                 # z = [sqrt(Q) x; sqrt(R) u]
+    Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
     bound = ours if input_bound is None else input_bound
     extra = dict(u_max=truck.STEER_LIMIT, w_energy=1.0) if bound else {}
     ctrl = rc.design("hinf", truck.truck_plant(0.0), Bw=Bw, Cz=Cz, Dzu=Dzu, vertices=list(vertices) or None,
                      uncertainty=uncertainty, **extra)
-    text = f"{note}; gamma = {ctrl.gamma / s:.5g}"
+    text = f"{note}; gamma = {ctrl.gamma:.5g}"
     if bound:
         text += f", guaranteed |alpha| <= {float(np.max(ctrl.info['u_bound'])):.3g} rad for unit-energy w"
     return Design(name, ctrl.K, text)

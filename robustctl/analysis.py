@@ -55,7 +55,12 @@ Numerics
   Lyapunov solution ``P_L = L L'`` of the nominal loop (weight: the
   problem's state weight plus ``1e-3`` of its norm times ``I``) becomes
   ``I``, with ``H`` and ``E`` scaled to comparable norms (the margin problem:
-  unit norms). Results are mapped back; margins and bounds are unchanged.
+  unit norms), ``Bw`` to unit norm and the guaranteed-cost objective to
+  unit size. Results are mapped back; margins and bounds are unchanged.
+  Every bound is then independent of the units of the weights, of ``w``,
+  ``z`` and ``x0`` (scaling ``Q, R`` by ``a^2`` scales the cost by ``a^2``;
+  unscaled, the authors' truck weights ``R = 33535`` made the
+  guaranteed-cost LMI fail).
 * The margin minimisation is non-strict (it computes the infimum); the
   returned ``P`` comes from its optimum ``P*`` as ``P* + eps P_L``, which
   is strictly feasible at any radius below the margin for small ``eps``
@@ -640,11 +645,13 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     lmis = [_cvx.LMI("cost", _block(Ah, Hh, P, N, plant.is_discrete)), _cvx.LMI("P", P)]
     if x0 is None:
         s = cp.Variable(name="s")
-        # lambda_max(L P^ L') <= s  <=>  s (L L')^-1 - P^ >= 0
-        lmis.append(_cvx.LMI("P_upper", s * T.Q(np.eye(n)) - P))
+        # lambda_max(L P^ L') <= s / c  <=>  s (L L')^-1 / c - P^ >= 0, c = ||(L L')^-1|| (s of unit size)
+        M = T.Q(np.eye(n))
+        lmis.append(_cvx.LMI("P_upper", s * (M / np.linalg.norm(M, 2)) - P))
         objective = cp.Minimize(s)
     else:
         xh = T.L.T @ x0
+        xh = xh / (np.linalg.norm(xh) or 1.0)   # x0' P x0 = |L' x0|^2 xh' P^ xh: the direction only
         objective = cp.Minimize(xh @ P @ xh)
     rep = _cvx.solve_sdp(objective, lmis, infeasible_msg="the guaranteed-cost LMI is infeasible")
     P_orig = T.P(_cvx.value(P))

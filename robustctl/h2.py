@@ -30,8 +30,10 @@ the stabilising Riccati solution: the tests check the LMI optimum against
 scipy's DARE / CARE.
 
 Numerics: the data go through the coordinates of :mod:`robustctl.hinf`
-(balancing, ``||Bw|| = 1``, ``z`` compressed to a factor with the same
-Gram matrix, which is all the H2 norm depends on). The minimisation uses
+(``w`` and ``z`` scaled to unit size, since ``||T_zw||_2`` is homogeneous
+in both and the gain does not depend on them; balancing, ``||Bw|| = 1``,
+``z`` compressed to a factor with the same Gram matrix, which is all the H2
+norm depends on). The minimisation uses
 non-strict LMIs (the infimum); unless ``backoff=0`` the gain comes from a
 second problem at ``h2_bound = (1 + backoff) h2_opt`` that maximises the
 smallest eigenvalue of every block (a strictly feasible, well-centred point),
@@ -53,7 +55,7 @@ from . import _cvx
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .hinf import _tolerances as tol
-from .hinf._coordinates import Coordinates, normalised, recentred
+from .hinf._coordinates import Coordinates, channel_scales, normalised, recentred
 from .hinf._lmis import Point, region_blocks, variables
 from .hinf._problem import validate
 from .hinf._synthesis import check_closed_loop
@@ -119,8 +121,9 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     H2Controller
         ``K``, ``h2_bound``, ``h2_opt`` and ``info`` with ``h2_norms`` (the
         H2 norm of the closed loop at every vertex, from its Gramian),
-        ``certificate``, ``margin``, ``solves``, ``X``, ``poles``, ``status``,
-        ``solve_time``, ``iterations``, ``backoff``.
+        ``certificate``, ``margin``, ``solves``, ``X`` (the Lyapunov matrix,
+        ``X >= `` the closed-loop controllability Gramian at every vertex),
+        ``poles``, ``status``, ``solve_time``, ``iterations``, ``backoff``.
 
     Raises
     ------
@@ -140,23 +143,26 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
         raise ValueError("Dzw must be zero for a continuous-time plant: a feedthrough from white noise w to z "
                          "makes the H2 norm infinite")
 
-    data = normalised([p.F for p in plants], [p.G for p in plants], Bw, Cz, Dzu, Dzw)
+    w_scale, z_unit = channel_scales(Bw, Cz, Dzu, Dzw)
+    data = normalised([p.F for p in plants], [p.G for p in plants], Bw, Cz, Dzu, Dzw, w_scale, z_unit=z_unit)
     what = _infeasibility(plants, regions)
     const = float(np.sum(data.Dzw**2))          # trace(Dzw' Dzw), invariant under the compression
     point, cost, rep = _minimise(data, plant.is_discrete, regions, solver, what)
-    h2_opt = float(np.sqrt(max(cost, 0.0) + const))
+    scaled_opt = float(np.sqrt(max(cost, 0.0) + const))     # ||T_zw||_2 of the scaled channels
     solves = [rep.as_dict()]
     if backoff == 0:
         cert, margin = dict(rep.certificate), 0.0
     else:
         home = recentred(data, point.X, tol.RECENTRE_REG)
         data = data if home is None else home[0]
-        point, margin, rep, backoff, centring = _centre(data, plant.is_discrete, regions, solver, h2_opt, const,
-                                                        backoff)
+        point, margin, rep, backoff, centring = _centre(data, plant.is_discrete, regions, solver, scaled_opt,
+                                                        const, backoff)
         cert = dict(rep.certificate)
         solves += centring
     K, X = data.to_original(point.gain(), point.X)
+    X = X / w_scale**2                           # the Gramian bound of the caller's w
     check_closed_loop(K, plants, regions)
+    h2_opt = scaled_opt / data.level_scale
     h2_bound = (1.0 + backoff) * h2_opt
     norms = np.array([_h2_norm(p, K, Bw, Cz, Dzu, Dzw) for p in plants])
     if np.any(norms > h2_bound * (1.0 + tol.U_BOUND_CHECK)):
@@ -215,10 +221,11 @@ def _centre(data: Coordinates, discrete: bool, regions, solver: str, h2_opt: flo
             backoff: float):
     """A well-centred strictly feasible point at ``(1 + backoff) h2_opt``, the backoff raised if needed.
 
-    Maximises the common margin ``t <= 1`` of every block with ``z`` scaled
-    so that the bound on ``trace(W)`` is 1 (``data``: coordinates where the
-    optimal ``X`` is ~ I, so one margin suits every block). Returns
-    ``(point, t, report, backoff used, solves)``.
+    ``h2_opt`` and ``const`` in ``data``'s units. Maximises the common
+    margin ``t <= 1`` of every block with ``z`` scaled so that the bound on
+    ``trace(W)`` is 1 (``data``: coordinates where the optimal ``X`` is ~ I,
+    so one margin suits every block). Returns ``(point, t, report, backoff
+    used, solves)``.
     """
     import cvxpy as cp
 

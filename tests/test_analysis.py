@@ -339,6 +339,38 @@ def test_guaranteed_cost_is_infeasible_without_robust_stability():
                            np.eye(2), [[1.0]])
 
 
+def test_bounds_do_not_depend_on_the_units_of_the_weights_and_channels():
+    """Q, R times a^2 and x0 times b scale the cost by (a b)^2; z times a and w times b scale gamma by a b.
+
+    With the weights of the authors' code (R = 33535) the guaranteed-cost LMI without x0 was infeasible,
+    with Q, R times 1e3 the solver stopped (user_limit) and with x0 times 1e-6 the bound came out 4x too high.
+    References: the LQ cost (scipy's Lyapunov solver) and linfnorm at every constant Delta of a grid.
+    """
+    plant = truck.truck_plant(0.0)
+    Q, R = truck.authors_weights()
+    ctrl = rc.lqr(plant, Q=Q, R=R)
+    unc = rc.NormBounded(plant.G, [[0.1, 0.0, 0.0, 0.0]], [[0.1]])
+    x0 = np.array([0.1, 0.0, 0.05, 0.01])
+    Bw, Cz = np.ones((4, 1)), np.vstack([np.sqrt(Q), np.zeros((1, 4))])
+    Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+    given, worst_unit = rc.guaranteed_cost(ctrl, unc, Q, R, x0), rc.guaranteed_cost(ctrl, unc, Q, R)
+    hinf = rc.robust_hinf_bound(ctrl, unc, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    A, H, E = loop(plant, ctrl.K, unc)
+    QK, C = Q + ctrl.K.T @ R @ ctrl.K, Cz + Dzu @ ctrl.K
+    for d in np.linspace(-1.0, 1.0, 21):
+        AD = A + d * H @ E
+        assert lq_cost(AD, QK, x0, True) <= given.bound * (1 + 1e-7)
+        assert np.linalg.eigvalsh(scipy.linalg.solve_discrete_lyapunov(AD.T, QK)).max() <= worst_unit.bound * (1 + 1e-7)
+        assert hinf_norm(AD, Bw, C, np.zeros((5, 1)), plant) <= hinf.gamma * (1 + 1e-6)
+    for a, b in [(1e-6, 1.0), (1e-3, 1e3), (1e3, 1e-3), (1e6, 1e6), (1.0, 1e-6), (1e-6, 1e6)]:
+        res = rc.guaranteed_cost(ctrl, unc, a**2 * Q, a**2 * R, b * x0)
+        assert res.bound / (a * b) ** 2 == pytest.approx(given.bound, rel=1e-6), (a, b)
+        res = rc.guaranteed_cost(ctrl, unc, a**2 * Q, a**2 * R)
+        assert res.bound / a**2 == pytest.approx(worst_unit.bound, rel=1e-6), (a, b)
+        res = rc.robust_hinf_bound(ctrl, unc, Bw=b * Bw, Cz=a * Cz, Dzu=a * Dzu)
+        assert res.gamma / (a * b) == pytest.approx(hinf.gamma, rel=1e-6), (a, b)
+
+
 # ---------------------------------------------------------------- robust H-infinity bound
 def hinf_norm(A, Bw, C, Dzw, plant) -> float:
     return float(control.linfnorm(control.ss(A, Bw, C, Dzw, plant.dt if plant.is_discrete else 0))[0])

@@ -109,7 +109,7 @@ def optimum_certified(problem: Problem, opt: Optimum, backoff: float) -> Attempt
     if not problem.discrete or problem.extended or problem.polytopic or problem.uncertainty is not None:
         return Attempt()
     data = opt.data
-    z_scale = 1.0 / (data.w_scale * opt.gamma_opt * (1.0 + backoff))
+    z_scale = 1.0 / (data.level_scale * opt.gamma_opt * (1.0 + backoff))
     K = opt.point.gain()
     A = data.F[0] + data.G[0] @ K
     B, C, D = data.Bw, z_scale * (data.Cz + data.Dzu @ K), z_scale * data.Dzw
@@ -204,7 +204,7 @@ def _max_margin(problem: Problem, data: Coordinates, gamma: float, infeasible_ms
 
     V = variables(data.n, data.m, len(data.F), problem.extended, uncertain=problem.uncertainty is not None)
     t = cp.Variable(name="t")
-    z_scale = 1.0 / (data.w_scale * gamma)  # the scaled level is then 1
+    z_scale = 1.0 / (data.level_scale * gamma)  # the scaled level is then 1
     if x_upper is None:
         lmis = blocks(problem, data, V, 1.0, margin=t, z_scale=z_scale)
         cons = [t <= 1.0]

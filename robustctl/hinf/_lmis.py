@@ -85,7 +85,7 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
                 z_scale: float = 1.0) -> list[_cvx.LMI]:
     """The bounded-real-lemma block of every vertex, ``hinf[i]``, at the scaled level ``level_sq``.
 
-    ``level_sq`` is ``(w_scale z_scale gamma)^2`` (a float or a cvxpy
+    ``level_sq`` is ``(level_scale z_scale gamma)^2`` (a float or a cvxpy
     variable); ``z_scale`` multiplies ``z``. The constant disturbance block
     ``I`` is eliminated by a Schur complement (``q`` rows smaller, still
     linear). With an uncertainty in ``data`` (and multipliers in ``V``) the

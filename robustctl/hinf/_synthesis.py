@@ -1,8 +1,9 @@
 """The H-infinity synthesis driver: the stages in order.
 
 1. :func:`._problem.validate` - every argument, and stabilisability (PBH);
-2. :func:`._coordinates.normalised` and :func:`._coordinates.lqr_coordinates`
-   - the balanced coordinates, and for one plant the LQR ones;
+2. :func:`._coordinates.channel_scales`, :func:`._coordinates.normalised` and
+   :func:`._coordinates.lqr_coordinates` - the units of ``w`` and ``z``, the
+   balanced coordinates, and for one plant the LQR ones;
 3. :mod:`._lmis` - the named LMI blocks (used by every solve and every
    certificate);
 4. :func:`._level.minimise_level` - ``gamma_opt`` (or, with a fixed ``gamma``,
@@ -15,7 +16,6 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -30,7 +30,7 @@ from ..regions import Region
 from ..stability import is_stable
 from ..uncertainty import NormBounded
 from . import _tolerances as tol
-from ._coordinates import lqr_coordinates, normalised
+from ._coordinates import channel_scales, lqr_coordinates, normalised
 from ._gains import Gain, gain_at_level, gain_near_optimum
 from ._level import minimise_level
 from ._problem import Problem, validate, vertex_name
@@ -145,10 +145,12 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         returned point), ``gain_from`` (``"optimum-certified"``,
         ``"optimum"`` for ``backoff=0``, or the centring variant),
         ``X_min_eig``, ``margin`` (centring margin ``t``), ``solves``
-        (per-solve diagnostics), ``X`` (Lyapunov matrix; ``P`` of the
-        nominal vertex when ``extended``), ``u_bound`` (guaranteed
-        ``max |u_j|`` for ``w_energy``, when ``u_max`` is given),
-        ``scaling`` (state balancing), ``lmi``, ``vertices``, ``backoff``
+        (per-solve diagnostics), ``X`` (Lyapunov matrix, ``x' X^-1 x <= 1``
+        on the states reached by disturbances of energy ``w_energy``, 1
+        without ``u_max``; ``P`` of the nominal vertex when ``extended``),
+        ``u_bound`` (guaranteed ``max |u_j|`` for ``w_energy``, when
+        ``u_max`` is given), ``scaling`` (state balancing), ``lmi``,
+        ``vertices``, ``backoff``
         (the value used), ``poles`` (the regions), ``uncertainty`` and, with
         one, ``multipliers`` (the S-procedure multipliers). Each entry of
         ``solves`` has the solver's ``status``, ``value``, ``tol``,
@@ -188,9 +190,9 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
                        w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
                        uncertainty=uncertainty)
-    w_scale = 1.0 if problem.w_energy is None else math.sqrt(problem.w_energy)  # set exactly with u_max
+    w_scale, z_unit = channel_scales(problem.Bw, problem.Cz, problem.Dzu, problem.Dzw, problem.w_energy)
     balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
-                          problem.Dzu, problem.Dzw, w_scale, problem.uncertainty)
+                          problem.Dzu, problem.Dzw, w_scale, problem.uncertainty, z_unit=z_unit)
     lqr = None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
     if problem.gamma is not None:
         gain, solves = gain_at_level(problem, lqr or balanced, problem.gamma)
@@ -200,6 +202,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         gain, used_backoff, centring = gain_near_optimum(problem, opt)
         level, gamma_opt, solves = opt.gamma_opt * (1.0 + used_backoff), opt.gamma_opt, opt.solves + centring
     K, X = gain.data.to_original(gain.point.gain(), gain.point.nominal_lyapunov())
+    X = X * (problem.w_energy or 1.0) / w_scale**2  # the reachable set of disturbances of energy w_energy (1)
     check_closed_loop(K, problem.plants, problem.regions)
     info = _info(problem, gain, K, X, level, gamma_opt, used_backoff, solves)
     return HinfController(K=K, method="hinf", plant=plant, info=info, gamma=float(level), gamma_opt=gamma_opt)

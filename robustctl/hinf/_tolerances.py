@@ -1,8 +1,8 @@
 """Every tolerance of the LMI state-feedback syntheses, in one place.
 
 Each constant says what it is relative to. The LMI data are normalised
-(:mod:`._coordinates`: ``||Bw~|| = 1``, level 1 or unit energy), so the
-absolute ones are on a known scale.
+(:mod:`._coordinates`: ``||Bw~|| = 1``, ``||[Cz~ Dzu~ Dzw~]|| = 1``, level 1 or unit
+energy), so the absolute ones are on a known scale.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from __future__ import annotations
 # robustctl.stability (UNSTABLE_TOL, PBH_TOL, STABILITY_MARGIN).
 
 # ---------------------------------------------------------------- coordinates
-#: Singular values of ``[Cz Dzu Dzw]`` below ``Z_RANK * max(1, sigma_max)`` are
+#: Singular values of ``[Cz Dzu Dzw]`` below ``Z_RANK * sigma_max`` are
 #: dropped when ``z`` is replaced by a factor with the same Gram matrix.
 Z_RANK = 1e-13
 #: Both weights of the preconditioning LQR Riccati equation get
