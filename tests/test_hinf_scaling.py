@@ -67,14 +67,26 @@ def relative_change(K, K_ref) -> float:
     return float(np.max(np.abs(K - K_ref)) / np.max(np.abs(K_ref)))
 
 
-def hinf_cases():
+def one_plant_cases():
+    """``(name, plant, channels)`` of every synthesis: a discrete plant with Dzw, a continuous one, the truck."""
     plant, Bw, Cz, Dzu, Dzw = random_case(1, 4, 2, 2, discrete=True, cross=True)
-    yield "discrete, Dzw", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw), {}
+    yield "discrete, Dzw", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw)
     plant, Bw, Cz, Dzu, _ = random_case(2, 5, 2, 2, discrete=False)
-    yield "continuous", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu), {}
+    yield "continuous", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu)
     plant, Bw, Cz, Dzu = authors_truck()
-    yield "truck, authors' weights", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu), {}
-    yield "truck polytope", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu), dict(vertices=[truck.truck_plant(300.0)])
+    yield "truck, authors' weights", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu)
+
+
+def truck_polytope():
+    plant, Bw, Cz, Dzu = authors_truck()
+    return "truck polytope", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu), dict(vertices=[truck.truck_plant(300.0)])
+
+
+def hinf_cases():
+    for case in one_plant_cases():
+        yield (*case, {})
+    yield truck_polytope()
+    plant, Bw, Cz, Dzu = authors_truck()
     yield "msd polytope", msd(1.0), dict(Bw=MSD_BW, Cz=MSD_CZ, Dzu=MSD_DZU), dict(vertices=[msd(4.0)])
     yield "msd extended", msd(1.0), dict(Bw=MSD_BW, Cz=MSD_CZ, Dzu=MSD_DZU), dict(vertices=[msd(4.0)],
                                                                                   extended=True)
@@ -143,16 +155,21 @@ def test_the_authors_truck_weights_need_no_scaling_by_hand():
     assert ric.gamma_low <= cl_norm(plant, ctrl.K, Bw, Cz, Dzu) * (1 + 1e-8)
 
 
-def riccati_cases():
-    plant, Bw, Cz, Dzu, Dzw = random_case(1, 4, 2, 2, discrete=True, cross=True)
-    yield "discrete, Dzw", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw)
-    plant, Bw, Cz, Dzu, _ = random_case(2, 5, 2, 2, discrete=False)
-    yield "continuous", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu)
+def test_a_fixed_level_with_a_pole_region_does_not_depend_on_the_units():
+    """``gamma`` given in the caller's units (times a b) and a pole region: the same gain, which meets both."""
     plant, Bw, Cz, Dzu = authors_truck()
-    yield "truck, authors' weights", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu)
+    perf, region = dict(Bw=Bw, Cz=Cz, Dzu=Dzu), rc.Disk(0.0, 0.9999)
+    ref = rc.hinf(plant, **perf, gamma=10500.0, poles=region)
+    for a, b in SCALES:
+        ctrl = rc.hinf(plant, **scaled(perf, a, b), gamma=10500.0 * a * b, poles=region)
+        assert ctrl.gamma == 10500.0 * a * b and relative_change(ctrl.K, ref.K) <= GAIN_RTOL, (a, b)
+        assert cl_norm(plant, ctrl.K, **perf) <= 10500.0
+        assert np.all(region.contains(np.linalg.eigvals(plant.F + plant.G @ ctrl.K)))
+        with pytest.raises(rc.InfeasibleError, match="gamma="):   # below the optimum 10431.2
+            rc.hinf(plant, **scaled(perf, a, b), gamma=10400.0 * a * b)
 
 
-@pytest.mark.parametrize("name,plant,perf", [pytest.param(*c, id=c[0]) for c in riccati_cases()])
+@pytest.mark.parametrize("name,plant,perf", [pytest.param(*c, id=c[0]) for c in one_plant_cases()])
 def test_riccati_bisection_does_not_depend_on_the_units(name, plant, perf):
     ref = hinf_riccati(plant, **perf)
     for a, b in SCALES:
@@ -165,13 +182,9 @@ def test_riccati_bisection_does_not_depend_on_the_units(name, plant, perf):
 
 
 def h2_cases():
-    plant, Bw, Cz, Dzu, Dzw = random_case(1, 4, 2, 2, discrete=True, cross=True)
-    yield "discrete, Dzw", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw), {}
-    plant, Bw, Cz, Dzu, _ = random_case(2, 5, 2, 2, discrete=False)
-    yield "continuous", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu), {}
-    plant, Bw, Cz, Dzu = authors_truck()
-    yield "truck, authors' weights", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu), {}
-    yield "truck polytope", plant, dict(Bw=Bw, Cz=Cz, Dzu=Dzu), dict(vertices=[truck.truck_plant(300.0)])
+    for case in one_plant_cases():
+        yield (*case, {})
+    yield truck_polytope()
 
 
 def lqr_cost(plant, Bw, Cz, Dzu, Dzw=None) -> float:
