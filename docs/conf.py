@@ -84,6 +84,11 @@ sphinx_gallery_conf = {
     "download_all_examples": False,
     "within_subsection_order": "gallery_order.ExampleOrder",   # the user guide's order
     "matplotlib_animations": False,
+    # moo.plots draws Figures without pyplot; _ext/figure_scraper.py shows them too (it runs
+    # first, while the pyplot figures it must leave to "matplotlib" are still open)
+    "image_scrapers": ("figure_scraper.figure_scraper", "matplotlib"),
+    # the examples print what they show; no repr of a block's last value (``<Legend ...>``)
+    "capture_repr": (),
     "reset_modules": ("matplotlib",),
     "show_memory": False,
     "min_reported_time": 1,

@@ -120,16 +120,19 @@ def canonical_names(infos: dict[str, ModuleInfo]) -> dict[tuple[str, str], str]:
 
     A function or class listed by several modules gets the shortest of its
     public names (the package's re-export), a private module's name only if
-    it has no public one; data are documented where listed.
+    it has no public one, and among names of equal length the one in its
+    defining module (``moo.store.load_records``, not its re-export
+    ``moo.experiment.load_records``); data are documented where listed.
     """
-    def rank(full: str) -> tuple[bool, int]:
-        return (not _public(full.rpartition(".")[0]), full.count("."))
+    def rank(full: str, obj) -> tuple[bool, int, bool]:
+        module = full.rpartition(".")[0]
+        return (not _public(module), full.count("."), module != getattr(obj, "__module__", None))
 
     best: dict[int, str] = {}
     for info in infos.values():
         for name in info.names:
             obj, full = getattr(info.module, name), f"{info.name}.{name}"
-            if _is_api_object(obj) and (id(obj) not in best or rank(full) < rank(best[id(obj)])):
+            if _is_api_object(obj) and (id(obj) not in best or rank(full, obj) < rank(best[id(obj)], obj)):
                 best[id(obj)] = full
     out = {}
     for info in infos.values():
