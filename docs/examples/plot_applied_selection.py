@@ -32,13 +32,16 @@ order = np.lexsort(moea.F.T[::-1])                 # designs numbered by f1
 X, F = moea.X[order], moea.F[order]
 print(f"{len(F)} non-dominated designs after {moea.n_evals} evaluations")
 
-names = [r"$f_1$ ($\rho$)", r"$f_2$ ($\dot\psi$)", r"$f_3$ ($\dot y$)", r"$f_4$ ($\theta$)"]
+names = [r"$f_1$ ($\rho$)", r"$f_2$ ($\dot\psi$)", r"$f_3$ ($\dot y$)",
+         r"$f_4$ ($\theta$)"]
 fig, axes = plt.subplots(1, 3, figsize=(11, 3.4), layout="constrained")
 for ax, (i, j) in zip(axes, [(0, 1), (0, 2), (0, 3)], strict=True):
-    sc = ax.scatter(F[:, i], F[:, j], c=np.arange(len(F)), cmap="viridis", s=14)
+    sc = ax.scatter(F[:, i], F[:, j], c=np.arange(len(F)), cmap="viridis",
+                    s=14)
     ax.set(xlabel=names[i], ylabel=names[j])
 fig.colorbar(sc, ax=axes, label="design index (by $f_1$)")
-fig.suptitle("front of the applied MOP (MSE, averaged over 0 and 100 % overload)")
+fig.suptitle("front of the applied MOP "
+             "(MSE, averaged over 0 and 100 % overload)")
 
 # %%
 # Monte Carlo selection
@@ -46,7 +49,8 @@ fig.suptitle("front of the applied MOP (MSE, averaged over 0 and 100 % overload)
 # The candidates are the front plus the paper's extra designs (the nominal
 # LQR, RLQR^A of the appendix, a random z); each realisation is one payload.
 problem = AppliedRLQRProblem()
-sel = select_design(problem, X, n_sims=100, seed=1, path=problem.path.truncated(120.0))
+sel = select_design(problem, X, n_sims=100, seed=1,
+                    path=problem.path.truncated(120.0))
 d, counts = sel.designs, sel.result.counts
 print(sel)
 
@@ -56,8 +60,11 @@ x = np.arange(1, len(d) + 1)
 fig, ax = plt.subplots(figsize=(9, 3.2), layout="constrained")
 ax.bar(x, counts, color=colors)
 ax.set_xticks([1, *range(10, d.n_front + 1, 10)])
-extras = ", ".join(f"{lab} ({int(counts[i])})" for i, (lab, k) in enumerate(zip(d.labels, d.kinds, strict=True))
-                   if k != "front")
-ax.set(xlabel=f"design: 1-{d.n_front} the front by $f_1$; then, in orange, {extras} wins",
-       ylabel="wins", title=f"z* = design {d.labels[sel.best]}: {int(counts[sel.best])} of {len(sel.deltas)} wins")
+extras = ", ".join(f"{d.labels[i]} ({int(counts[i])})"
+                   for i, k in enumerate(d.kinds) if k != "front")
+best, wins = d.labels[sel.best], int(counts[sel.best])
+ax.set(xlabel=f"design: 1-{d.n_front} the front by $f_1$; "
+              f"then, in orange, {extras} wins",
+       ylabel="wins",
+       title=f"z* = design {best}: {wins} of {len(sel.deltas)} wins")
 print("z* =", np.array2string(sel.z, precision=4))

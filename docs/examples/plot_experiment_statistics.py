@@ -23,11 +23,13 @@ from moo import plots, stats
 from moo.experiment import run_experiment
 from moo.store import load_records
 
-tmp = tempfile.TemporaryDirectory(prefix="moo-example-")     # removed at the end
+tmp = tempfile.TemporaryDirectory(prefix="moo-example-")  # removed at the end
 out = Path(tmp.name)
-grid = dict(problem="zdt1", algorithms="nsga2,theta-dea", runs=8, evals=1500, out=out)
+grid = dict(problem="zdt1", algorithms="nsga2,theta-dea", runs=8, evals=1500,
+            out=out)
 print(run_experiment(**grid))
-print(sorted(str(p.relative_to(out)) for p in out.glob("*/*/*.json"))[:3], "...")
+files = sorted(str(p.relative_to(out)) for p in out.glob("*/*/*.json"))
+print(len(files), "records:", files[:2], "...")
 
 # %%
 # A rerun finds every record and runs nothing; a larger ``runs`` would run
@@ -53,8 +55,9 @@ table = stats.compare(runs)
 print(stats.to_markdown(table))
 for c in table:
     if c.indicator == "hv":
-        print(f"{c.algorithm:10s} HV: p_anova {c.p_anova:.2g}, p_tukey {c.p_tukey:.2g}, "
-              f"p_wilcoxon {c.p_wilcoxon:.2g}, Holm-adjusted {c.p_wilcoxon_holm:.2g}")
+        print(f"{c.algorithm:10s} HV: p_anova {c.p_anova:.2g}, "
+              f"p_tukey {c.p_tukey:.2g}, p_wilcoxon {c.p_wilcoxon:.2g}, "
+              f"Holm-adjusted {c.p_wilcoxon_holm:.2g}")
 
 # %%
 # Friedman and Nemenyi over all variants

@@ -33,12 +33,15 @@ Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
 
 free = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
 bounds = [0.1, 0.2, 0.3, 0.45, 0.7, 1.0]
-designs = [rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu, u_max=u, w_energy=1.0) for u in bounds]
+designs = [rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu, u_max=u,
+                     w_energy=1.0) for u in bounds]
 
 fig, ax = plt.subplots(figsize=(6, 3.4), layout="constrained")
 ax.plot(bounds, [d.gamma for d in designs], "o-", label="with the input bound")
-ax.axhline(free.gamma, color="k", ls="--", lw=0.8, label=f"no bound: $\\gamma$ = {free.gamma:.3g}")
-ax.set(xlabel=r"guaranteed $|\alpha| \leq u_{max}$ [rad] (unit-energy $w$)", ylabel=r"$\gamma$")
+ax.axhline(free.gamma, color="k", ls="--", lw=0.8,
+           label=f"no bound: $\\gamma$ = {free.gamma:.3g}")
+ax.set(xlabel=r"guaranteed $|\alpha| \leq u_{max}$ [rad] (unit-energy $w$)",
+       ylabel=r"$\gamma$")
 ax.legend()
 
 # %%
@@ -50,12 +53,15 @@ ax.legend()
 # ``x+ = (F + G K) x + Bw w``, ``z = (Cz + Dzu K) x``, and the input bound
 # against ``u_bound`` = ``max sqrt(E k X k')``.
 ctrl = designs[bounds.index(0.45)]
-cl = control.ss(ctrl.closed_loop(), Bw, Cz + Dzu @ ctrl.K, np.zeros((5, 2)), plant.dt)
+cl = control.ss(ctrl.closed_loop(), Bw, Cz + Dzu @ ctrl.K, np.zeros((5, 2)),
+                plant.dt)
 norm, _ = control.linfnorm(cl)
-print(f"gamma = {ctrl.gamma:.5g} (optimum {ctrl.gamma_opt:.5g}), ||T_zw||_inf = {norm:.5g}")
+print(f"gamma = {ctrl.gamma:.5g} (optimum {ctrl.gamma_opt:.5g}), "
+      f"||T_zw||_inf = {norm:.5g}")
 for block, eig in ctrl.info["certificate"].items():
     print(f"  LMI block {block}: smallest eigenvalue {eig:.3g}")
-print(f"guaranteed max |alpha| = {float(np.max(ctrl.info['u_bound'])):.4f} rad (asked 0.45)")
+u_bound = float(np.max(ctrl.info["u_bound"]))
+print(f"guaranteed max |alpha| = {u_bound:.4f} rad (asked 0.45)")
 
 # %%
 # Worst-case steering over unit-energy disturbances
@@ -94,12 +100,13 @@ bound = float(np.max(ctrl.info["u_bound"]))
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.2), layout="constrained")
 ax1.plot(np.arange(1, N + 1) * plant.dt, steer)
 ax1.axhline(bound, color="r", label="guaranteed bound")
-ax1.set(xlabel="time [s]", ylabel=r"$\alpha$ [rad]", title="worst-case disturbance (peak at the end)")
+ax1.set(xlabel="time [s]", ylabel=r"$\alpha$ [rad]",
+        title="worst-case disturbance (peak at the end)")
 ax1.legend()
 ax2.hist(peak, bins=40, label="2000 random disturbances")
 ax2.axvline(worst, color="k", ls="--", label="worst case")
 ax2.axvline(bound, color="r", label="guaranteed bound")
 ax2.set(xlabel=r"peak $|\alpha|$ [rad]", ylabel="count")
 ax2.legend(fontsize=8)
-print(f"worst case sqrt(k Wc k') = {worst:.4f} rad <= guaranteed {bound:.4f} rad; "
-      f"random: at most {peak.max():.4f} rad")
+print(f"worst case sqrt(k Wc k') = {worst:.4f} rad <= guaranteed "
+      f"{bound:.4f} rad; random: at most {peak.max():.4f} rad")

@@ -28,16 +28,19 @@ SEEDS = (0, 1, 2)
 variants = {"NSGA-II": {}, "NSGA-II/MO-LSP": {"molsp": True},
             "NSGA-II/MO-LSP, 5 leaders": {"molsp": True, "max_leaders": 5}}
 
-results = {name: [run("zdt1", "nsga2", seed=s, evals=EVALS, **kw) for s in SEEDS]
+results = {name: [run("zdt1", "nsga2", seed=s, evals=EVALS, **kw)
+                  for s in SEEDS]
            for name, kw in variants.items()}
 
 grid = np.linspace(92, EVALS, 200)
 fig, ax = plt.subplots(figsize=(7, 3.6), layout="constrained")
 for name, runs in results.items():
-    curves = np.array([np.interp(grid, r.hv_history[:, 0], r.hv_history[:, 1]) for r in runs])
+    curves = np.array([np.interp(grid, *r.hv_history.T) for r in runs])
     line, = ax.plot(grid, curves.mean(axis=0), label=name)
-    ax.fill_between(grid, curves.min(axis=0), curves.max(axis=0), color=line.get_color(), alpha=0.2)
-ax.set(xlabel="evaluations", ylabel="hypervolume", title="ZDT1 (mean and range of 3 seeds)")
+    ax.fill_between(grid, curves.min(axis=0), curves.max(axis=0),
+                    color=line.get_color(), alpha=0.2)
+ax.set(xlabel="evaluations", ylabel="hypervolume",
+       title="ZDT1 (mean and range of 3 seeds)")
 ax.legend(loc="lower right")
 
 for name, runs in results.items():
@@ -59,18 +62,21 @@ from pymoo.optimize import minimize
 from moo.molsp import molsp
 from moo.problems import make_problem
 
-problem = make_problem("zdt1")                 # pymoo's ZDT1 with its reference points
+problem = make_problem("zdt1")     # pymoo's ZDT1 with its reference points
 host = NSGA2(pop_size=92)
 wrapped = molsp(host, ref_point=problem.molsp_ref_point)
 print(type(wrapped).__name__, isinstance(wrapped, NSGA2))
 
-fronts = {"NSGA2": minimize(problem, host, ("n_eval", EVALS), seed=1),
-          "NSGA2 + MO-LSP": minimize(problem, wrapped, ("n_eval", EVALS), seed=1)}
+budget = ("n_eval", EVALS)
+fronts = {"NSGA2": minimize(problem, host, budget, seed=1),
+          "NSGA2 + MO-LSP": minimize(problem, wrapped, budget, seed=1)}
 
 fig, ax = plt.subplots(figsize=(4.5, 4), layout="constrained")
 f1 = np.linspace(0, 1, 200)
 ax.plot(f1, 1 - np.sqrt(f1), "k-", lw=0.8, label="Pareto front")
 for name, res in fronts.items():
-    ax.plot(res.F[:, 0], res.F[:, 1], ".", label=f"{name} ({res.algorithm.evaluator.n_eval} evals)")
-ax.set(xlabel="$f_1$", ylabel="$f_2$", title=f"ZDT1 after {EVALS} evaluations")
+    n_eval = res.algorithm.evaluator.n_eval
+    ax.plot(res.F[:, 0], res.F[:, 1], ".", label=f"{name} ({n_eval} evals)")
+ax.set(xlabel="$f_1$", ylabel="$f_2$",
+       title=f"ZDT1 after {EVALS} evaluations")
 ax.legend()

@@ -26,26 +26,31 @@ import numpy as np
 import robustctl as rc
 from robustctl.models import truck
 from robustctl.path import default_route
-from robustctl.simulate import simulate
+from robustctl.pathfollow import simulate
 
-plant = truck.truck_plant(0.0)                     # x = [ydot, psidot, rho, theta], u = steering
+plant = truck.truck_plant(0.0)    # x = [ydot, psidot, rho, theta], u = alpha
 Q, R = truck.lqr_weights()
 lqr = rc.design("lqr", plant, Q=Q, R=R)
 
-plant2 = truck.truck_plant(0.0, doubled=True)      # G2 = [G G], alpha = u1 + u2
+plant2 = truck.truck_plant(0.0, doubled=True)   # G2 = [G G], alpha = u1 + u2
 Q2, R2 = truck.lqr_weights(doubled=True)
 EF, EG, mu = truck.uncertainty_from_z(truck.RLQR_MOP_Z)
-rlqr = rc.design("rlqr", plant2, EF[0], EG[0], mu[0], Q=Q2, R=R2, H=np.ones((4, 1)))
+rlqr = rc.design("rlqr", plant2, EF[0], EG[0], mu[0], Q=Q2, R=R2,
+                 H=np.ones((4, 1)))
 
-_, _, Gk = truck.discretise(0.0)                   # curvature input of the ZOH model
-Bw = np.column_stack([[0.0, 0.0, 1.0, 0.0], Gk[0] / 200.0])   # rho impulse, curvature of a 200 m bend
+# disturbances: a rho impulse and the curvature of a 200 m bend
+_, _, Gk = truck.discretise(0.0)       # curvature input of the ZOH model
+Bw = np.column_stack([[0.0, 0.0, 1.0, 0.0], Gk[0] / 200.0])
 Cz = np.vstack([np.sqrt(Q), np.zeros((1, 4))])
 Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
-hinf = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu, u_max=truck.STEER_LIMIT, w_energy=1.0)
+hinf = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu,
+                 u_max=truck.STEER_LIMIT, w_energy=1.0)
 
 print(lqr)
 print(rlqr)
-print(f"H-infinity: gamma = {hinf.gamma:.4g}, guaranteed |alpha| <= {float(np.max(hinf.info['u_bound'])):.3f} rad")
+bound = float(np.max(hinf.info["u_bound"]))
+print(f"H-infinity: gamma = {hinf.gamma:.4g}, "
+      f"guaranteed |alpha| <= {bound:.3f} rad")
 
 # %%
 # Simulate every gain at every payload in one batched call
@@ -58,7 +63,7 @@ K = np.stack([lqr.K, rlqr.K.sum(axis=0, keepdims=True), hinf.K])
 overloads = [0.0, 100.0, 200.0, 300.0]
 path = default_route()
 res = simulate(K, path, overloads)
-mse = res.mse()                                    # (B, S, 4): f1..f4 = MSE of rho, psidot, ydot, theta
+mse = res.mse()      # (B, S, 4): f1..f4 = MSE of rho, psidot, ydot, theta
 print(f"{path.T} steps, diverged: {res.diverged.any()}")
 
 # %%
@@ -68,8 +73,9 @@ t = np.arange(path.T) * path.dt
 fig, ax = plt.subplots(figsize=(8, 3.2), layout="constrained")
 for b, name in enumerate(names):
     ax.plot(t, res.errors[b, -1, :, 2], lw=0.8, label=name)
-ax.set(xlabel="time [s]", ylabel=r"$\rho - \rho_{ref}$ [m]", title="300 % overload")
-ax.legend(ncols=3, loc="upper right")
+ax.set(xlabel="time [s]", ylabel=r"$\rho - \rho_{ref}$ [m]",
+       title="300 % overload")
+fig.legend(loc="outside right upper")
 
 # %%
 # MSE of the four objectives against the payload
@@ -83,5 +89,7 @@ for j, ax in enumerate(axes):
     ax.set(xlabel="overload [%]", title=labels[j])
 axes[0].legend()
 
-for b, name in enumerate(names):
+print(f"{'MSE at 300 %':14s}",
+      "  ".join(f"{h:>9s}" for h in ("f1", "f2", "f3", "f4")))
+for b, name in enumerate(["LQR", "RLQR^MOP", "H-infinity"]):
     print(f"{name:14s}", "  ".join(f"{v:.3e}" for v in mse[b, -1]))

@@ -34,23 +34,27 @@ import numpy as np
 import robustctl as rc
 from robustctl.models import truck
 
-plant = truck.truck_plant(0.0)                     # nominal truck, x = [ydot, psidot, rho, theta]
+plant = truck.truck_plant(0.0)       # nominal, x = [ydot, psidot, rho, theta]
 Q, R = truck.lqr_weights()
 lqr = rc.design("lqr", plant, Q=Q, R=R)
 
 EF, EG, mu = truck.uncertainty_from_z(truck.RLQR_MOP_Z)
 Q2, R2 = truck.lqr_weights(doubled=True)
-rlqr = rc.design("rlqr", truck.truck_plant(0.0, doubled=True), EF[0], EG[0], mu[0], Q=Q2, R=R2,
-                 H=np.ones((4, 1)))
+rlqr = rc.design("rlqr", truck.truck_plant(0.0, doubled=True),
+                 EF[0], EG[0], mu[0], Q=Q2, R=R2, H=np.ones((4, 1)))
 
-_, _, Gk = truck.discretise(0.0)                   # curvature input of the ZOH model
+_, _, Gk = truck.discretise(0.0)       # curvature input of the ZOH model
 Bw = np.column_stack([[0.0, 0.0, 1.0, 0.0], Gk[0] / 200.0])
 Cz = np.vstack([np.sqrt(Q), np.zeros((1, 4))])
 Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
-hinf = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu, u_max=truck.STEER_LIMIT, w_energy=1.0)
+hinf = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu,
+                 u_max=truck.STEER_LIMIT, w_energy=1.0)
 
-gains = {"LQR": lqr.K, "RLQR^MOP": rlqr.K.sum(axis=0, keepdims=True), "H-infinity": hinf.K}
+gains = {"LQR": lqr.K,
+         "RLQR^MOP": rlqr.K.sum(axis=0, keepdims=True),   # K1 + K2
+         "H-infinity": hinf.K}
 labels = {"LQR": "LQR", "RLQR^MOP": r"RLQR$^{MOP}$", "H-infinity": r"H$_\infty$"}
+colors = {"LQR": "tab:green", "RLQR^MOP": "tab:blue", "H-infinity": "tab:red"}
 
 # %%
 # Certified margins
@@ -65,13 +69,19 @@ appendix = truck.algebraic_uncertainty("printed")
 model = rc.NormBounded(appendix.H, appendix.EF, appendix.EG[:, :1])
 vertices = [truck.truck_plant(p) for p in (100.0, 200.0, 300.0)]
 
-print(f"{'':14s} {'polytope 0-300 %':>18s} {'appendix model':>16s} {'worst radius':>13s}")
+
+def yes(r):
+    return "yes" if r.certified else "no"
+
+
+print(f"{'':11s} {'polytope 0-300 %':>17s} {'appendix model':>17s} "
+      f"{'worst radius':>13s}")
 for name, K in gains.items():
     poly = rc.robust_stability((plant, K), vertices=vertices)
     norm = rc.robust_stability((plant, K), model)
     worst = rc.worst_case((plant, K), model, seed=0)
-    print(f"{name:14s} {poly.margin:12.3f} ({'yes' if poly.certified else 'no':>3s}) "
-          f"{norm.margin:10.3f} ({'yes' if norm.certified else 'no':>3s}) {worst.radius:13.4f}")
+    print(f"{name:11s} {poly.margin:11.3f} ({yes(poly):>3s}) "
+          f"{norm.margin:11.3f} ({yes(norm):>3s}) {worst.radius:13.4f}")
 
 # %%
 # RLQR^MOP is not certified over 0-300 % (margin below 1), yet the
@@ -88,28 +98,37 @@ for name, K in gains.items():
 # 1. The frozen-payload spectral radius stays below 1 much further.
 ranges = np.arange(100.0, 801.0, 100.0)
 loads = np.linspace(0.0, 800.0, 161)
-F, G, _ = truck.discretise(loads)                  # (len(loads), 4, 4), (len(loads), 4, 1)
+F, G, _ = truck.discretise(loads)      # (161, 4, 4), (161, 4, 1)
 
-fig, (ax_rho, ax_m) = plt.subplots(1, 2, figsize=(11, 3.8), layout="constrained")
+
+def polytope_margin(K, p):
+    """Margin of the payload range [0, p] (vertices at p/3, 2p/3, p)."""
+    corners = [truck.truck_plant(q) for q in np.linspace(0.0, p, 4)[1:]]
+    return rc.robust_stability((plant, K), vertices=corners).margin
+
+
+fig, (ax_rho, ax_m) = plt.subplots(1, 2, figsize=(11, 3.8),
+                                   layout="constrained")
 ax_rho.axvspan(0.0, 300.0, color="0.9", label="the MSE table's 0-300 %")
-for i, ((name, K), color) in enumerate(zip(gains.items(), ["tab:green", "tab:blue", "tab:red"], strict=True)):
+bars = ax_rho.get_xaxis_transform()    # x in data, y in axes units
+for i, (name, K) in enumerate(gains.items()):
     rho = rc.spectral_radius(F + G @ K)
-    margin = np.array([rc.robust_stability((plant, K), vertices=[truck.truck_plant(q) for q in
-                                                                  np.linspace(0.0, p, 4)[1:]]).margin
-                       for p in ranges])
+    margin = np.array([polytope_margin(K, p) for p in ranges])
     certified = ranges[margin >= 1.0]
     reach = certified.max() if certified.size else 0.0
-    ax_rho.plot(loads, rho, color=color, label=f"{labels[name]}")
-    # the certified range as a bar along the bottom (x in data, y in axes units)
-    ax_rho.plot([0.0, reach], [0.05 + 0.06 * i] * 2, color=color, lw=5, solid_capstyle="butt",
-                transform=ax_rho.get_xaxis_transform())
-    ax_rho.text(reach + 10.0, 0.05 + 0.06 * i, f"certified to {reach:.0f} %", color=color, va="center",
-                fontsize=8, transform=ax_rho.get_xaxis_transform())
-    ax_m.plot(ranges, margin, "o-", color=color, label=labels[name])
-    print(f"{name:10s} spectral radius at most {rho[loads <= 300].max():.4f} on 0-300 %, "
-          f"{rho.max():.4f} on 0-800 %; polytope certified up to {reach:.0f} % (grid of 100 %)")
+    c, y = colors[name], 0.05 + 0.06 * i
+    ax_rho.plot(loads, rho, color=c, label=labels[name])
+    ax_rho.plot([0.0, reach], [y, y], color=c, lw=5, solid_capstyle="butt",
+                transform=bars)
+    ax_rho.text(reach + 10.0, y, f"certified to {reach:.0f} %", color=c,
+                va="center", fontsize=8, transform=bars)
+    ax_m.plot(ranges, margin, "o-", color=c, label=labels[name])
+    print(f"{name:10s} spectral radius <= {rho[loads <= 300].max():.4f} "
+          f"on 0-300 %, <= {rho.max():.4f} on 0-800 %; "
+          f"polytope certified up to {reach:.0f} % (grid of 100 %)")
 ax_rho.axhline(1.0, color="k", lw=0.8)
-ax_rho.set(xlabel="payload overload [%]", ylabel="spectral radius of $F + G K$", ylim=(0.89, 1.005),
+ax_rho.set(xlabel="payload overload [%]", ylabel="spectral radius of $F + GK$",
+           ylim=(0.89, 1.005),
            title="frozen payloads; bars: certified range (polytope)")
 ax_rho.legend(fontsize=8, loc="upper left")
 ax_m.axhline(1.0, color="k", lw=0.8)
@@ -125,6 +144,8 @@ ax_m.legend(fontsize=8)
 # polytope (the MSE table's ``Hinf_polytopic`` row), and with
 # ``uncertainty=model`` a gain robust to the norm-bounded model
 # (``Hinf_robust``); see :doc:`../user_guide/hinf`.
-hinf_poly = rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, vertices=vertices, u_max=truck.STEER_LIMIT, w_energy=1.0)
-print(f"polytopic H-infinity: gamma = {hinf_poly.gamma:.4g}, polytope margin "
-      f"{rc.robust_stability(hinf_poly, vertices=vertices).margin:.3f}")
+hinf_poly = rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, vertices=vertices,
+                    u_max=truck.STEER_LIMIT, w_energy=1.0)
+poly = rc.robust_stability(hinf_poly, vertices=vertices)
+print(f"polytopic H-infinity: gamma = {hinf_poly.gamma:.4g}, "
+      f"polytope margin {poly.margin:.3f}")
