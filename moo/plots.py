@@ -154,7 +154,7 @@ def indicator_boxplots(runs: Sequence[RunIndicators], title: str = "") -> Figure
         ax.set_ylabel(LABELS[name])
         ax.tick_params(axis="y", labelsize=7)
         ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
-    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside upper right", ncols=2, fontsize=8)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=8)
     fig.suptitle(f"{title}indicators of the final sets (per MOEA: plain, MO-LSP)")
     return fig
 
