@@ -38,7 +38,7 @@ fig, axes = plt.subplots(1, 3, figsize=(11, 3.4), layout="constrained")
 for ax, (i, j) in zip(axes, [(0, 1), (0, 2), (0, 3)], strict=True):
     sc = ax.scatter(F[:, i], F[:, j], c=np.arange(len(F)), cmap="viridis",
                     s=14)
-    ax.set(xlabel=names[i], ylabel=names[j])
+    ax.set(xlabel=names[i], ylabel=names[j], xscale="log", yscale="log")
 fig.colorbar(sc, ax=axes, label="design index (by $f_1$)")
 fig.suptitle("front of the applied MOP "
              "(MSE, averaged over 0 and 100 % overload)")

@@ -49,15 +49,18 @@ except ValueError as exc:
 # :func:`moo.stats.compare` tests each MOEA against its MO-LSP version.
 # ``^a`` marks a significant difference by Tukey's HSD, ``^w`` by the
 # Wilcoxon rank-sum test after Holm's correction over the MOEAs of a column.
+# The tables are Markdown, as ``python -m moo stats`` prints them
+# (:func:`moo.stats.to_latex` and :func:`moo.stats.to_csv` write the others).
 records = load_records(out)
 runs = stats.run_indicators(records)
 table = stats.compare(runs)
 print(stats.to_markdown(table))
+print(f"{'HV, p-values':12s} {'ANOVA':>8s} {'Tukey':>8s} {'Wilcoxon':>9s} "
+      f"{'Holm':>8s}")
 for c in table:
     if c.indicator == "hv":
-        print(f"{c.algorithm:10s} HV: p_anova {c.p_anova:.2g}, "
-              f"p_tukey {c.p_tukey:.2g}, p_wilcoxon {c.p_wilcoxon:.2g}, "
-              f"Holm-adjusted {c.p_wilcoxon_holm:.2g}")
+        print(f"{c.algorithm:12s} {c.p_anova:8.2g} {c.p_tukey:8.2g} "
+              f"{c.p_wilcoxon:9.2g} {c.p_wilcoxon_holm:8.2g}")
 
 # %%
 # Friedman and Nemenyi over all variants
@@ -70,10 +73,19 @@ print(stats.ranks_to_markdown(ranks))
 # %%
 # Figures
 # -------
-# Hypervolume over the evaluations (median and inter-quartile band), the
-# indicators' box plots and the critical-difference diagram of HV
-# (``python -m moo plot DIR --out FIGDIR`` writes all of them as PNG and PDF).
-fig_hv = plots.hv_history(records, title="ZDT1: ")            # title: a prefix
+# ``python -m moo plot DIR --out FIGDIR`` writes every figure of
+# :mod:`moo.plots` as PNG and PDF; each is also a function returning a
+# :class:`matplotlib.figure.Figure`. The hypervolume over the evaluations,
+# median and inter-quartile band of the 8 runs:
+fig_hv = plots.hv_history(records, title="ZDT1: ")       # title: a prefix
+
+# %%
+# The indicators' box plots, plain beside MO-LSP:
 fig_box = plots.indicator_boxplots(runs, title="ZDT1: ")
+
+# %%
+# The critical-difference diagram of HV (Demsar 2006): the variants on their
+# mean-rank axis, the CD bar, and thick bars joining variants that Nemenyi's
+# test does not separate.
 fig_cd = plots.cd_diagram(next(r for r in ranks if r.indicator == "hv"))
 tmp.cleanup()

@@ -47,7 +47,7 @@ for name, runs in results.items():
     hv = [r.hv for r in runs]
     share = np.mean([r.molsp_evals / r.n_evals for r in runs])
     print(f"{name:26s} final HV {np.mean(hv):.4f} +- {np.std(hv):.4f}, "
-          f"{100 * share:.0f} % of the evaluations spent on mutants")
+          f"mutants {100 * share:.0f} % of the evaluations")
 
 # %%
 # Wrapping any pymoo algorithm
