@@ -11,12 +11,49 @@ import numbers
 
 import numpy as np
 
-# Generic array checks (no control code) are shared with robustctl: this is the
-# one import of robustctl in moo outside moo/problems/.
-from robustctl._validation import as_float_array, as_matrix, check_positive_scalar
+# moo's generic core (algorithms, MO-LSP, indicators, runner, ...) does not import robustctl:
+# these few array checks are moo's own (robustctl/_validation.py has its own for the control code).
 
 __all__ = ["as_float_array", "as_matrix", "as_objectives", "check_choice", "check_directions", "check_int",
-           "check_positive_scalar", "check_real"]
+           "check_real"]
+
+
+def as_float_array(value, name: str) -> np.ndarray:
+    """``value`` as a real float64 array (any shape); ``TypeError`` naming ``name`` otherwise."""
+    if isinstance(value, (str, bytes)) or value is None:
+        raise TypeError(f"{name} must be an array of numbers, got {type(value).__name__}")
+    try:
+        arr = np.asarray(value)
+        if np.iscomplexobj(arr):
+            raise TypeError("complex entries")
+        return np.array(arr, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{name} must be an array of real numbers ({exc})") from None
+
+
+def as_matrix(value, name: str, *, rows: int | None = None, cols: int | None = None, rows_what: str = "",
+              cols_what: str = "", allow_empty: bool = False) -> np.ndarray:
+    """``value`` as a finite float64 2-D array with the given numbers of rows and columns.
+
+    A scalar becomes 1x1 and a 1-D array one row (one column when ``cols == 1``);
+    ``rows_what`` / ``cols_what`` say in the message what the expected size is.
+    """
+    arr = as_float_array(value, name)
+    if arr.ndim == 0:
+        arr = arr.reshape(1, 1)
+    elif arr.ndim == 1:
+        arr = arr.reshape(-1, 1) if cols == 1 and rows != 1 else arr.reshape(1, -1)
+    elif arr.ndim != 2:
+        raise ValueError(f"{name} must be a 2-D matrix, got an array of shape {arr.shape}")
+    for axis, want, what in ((0, rows, rows_what), (1, cols, cols_what)):
+        if want is not None and arr.shape[axis] != want:
+            unit = "rows" if axis == 0 else "columns"
+            raise ValueError(f"{name} must have {want} {unit}{f' ({what})' if what else ''}, got shape {arr.shape}")
+    if arr.size == 0 and not allow_empty:
+        raise ValueError(f"{name} must not be empty, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must have finite entries (found NaN or inf)")
+    return arr
 
 
 def check_int(value, name: str, minimum: int) -> int:
@@ -30,7 +67,9 @@ def check_int(value, name: str, minimum: int) -> int:
 
 def check_choice(value, name: str, choices: tuple[str, ...]) -> str:
     """One of the lower-case strings ``choices`` (matched case-insensitively); returned lower-cased."""
-    if not isinstance(value, str) or value.lower() not in choices:
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be one of {', '.join(map(repr, choices))}, got {type(value).__name__}")
+    if value.lower() not in choices:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value.lower()
 

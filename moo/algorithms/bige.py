@@ -122,10 +122,15 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import as_objectives, check_int
-from ._base import BinaryTournament, paper_operators
-from .operators import POP_SIZE
+from ._base import BinaryTournament, factory_arguments, paper_operators
+from .operators import POP_SIZE, OperatorSettings
 
-__all__ = ["BiGE", "BiGESurvival", "bige_estimation", "make_bige", "niche_radius"]
+__all__ = ["BiGE", "BiGESurvival", "bige_estimation", "make_bige", "niche_radius", "ORIGINAL_OPERATORS"]
+
+#: BiGE's own settings (Li, Yang & Liu 2015, Sec. 5: SBX pc = 1, eta_c = 20; polynomial mutation
+#: pm = 1/n, eta_m = 20).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=20.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Li, Yang & Liu (2015), Sec. 5")
 
 
 def niche_radius(pop_size: int, n_obj: int) -> float:
@@ -273,7 +278,7 @@ class BiGE(GeneticAlgorithm):
         pymoo duplicate elimination of offspring.
     """
 
-    def __init__(self, pop_size: int = POP_SIZE, sampling=None, crossover=None, mutation=None,
+    def __init__(self, *, pop_size: int = POP_SIZE, sampling=None, crossover=None, mutation=None,
                  eliminate_duplicates: bool = True, output=None):
         super().__init__(
             pop_size=pop_size,
@@ -281,12 +286,13 @@ class BiGE(GeneticAlgorithm):
             selection=BinaryTournament(_bige_tournament),
             survival=BiGESurvival(),
             eliminate_duplicates=eliminate_duplicates,
+            advance_after_initial_infill=True,
         )
         self.termination = DefaultMultiObjectiveTermination()
 
 
-def make_bige(*, n_obj: int, pop_size: int = POP_SIZE) -> BiGE:
-    """BiGE with the paper's settings (population 92, SBX, PM).
+def make_bige(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper") -> BiGE:
+    """BiGE with the paper's settings (population 92, SBX, PM); the shape of every factory (:mod:`moo.algorithms`).
 
     BiGE has no parameter of its own: the niche radius follows from ``N`` and
     ``m`` (Eq. 3) and the sharing discriminator is fixed at (0.5, 1.5), the
@@ -298,13 +304,12 @@ def make_bige(*, n_obj: int, pop_size: int = POP_SIZE) -> BiGE:
         Number of objectives (>= 2); checked only.
     pop_size : int, default 92
         Population size ``N``.
+    operators : {"paper", "original"} or OperatorSettings
+        Variation settings; ``"original"``: :data:`ORIGINAL_OPERATORS`.
 
     Returns
     -------
     BiGE
     """
-    if isinstance(n_obj, bool) or not isinstance(n_obj, (int, np.integer)) or n_obj < 2:
-        raise ValueError(f"n_obj must be an integer >= 2, got {n_obj!r}")
-    if isinstance(pop_size, bool) or not isinstance(pop_size, (int, np.integer)) or pop_size < 2:
-        raise ValueError(f"pop_size must be an integer >= 2, got {pop_size!r}")
-    return BiGE(pop_size=int(pop_size))
+    _, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
+    return BiGE(pop_size=pop_size, **variation)

@@ -90,8 +90,8 @@ from scipy.spatial.distance import cdist
 
 from .._validation import as_matrix, check_choice, check_int
 from ._normalize import HyperplaneNormalization
-from ._base import NormalizationForwarding, paper_operators
-from .operators import POP_SIZE
+from ._base import NormalizationForwarding, factory_arguments, paper_operators
+from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
     "MaOEADDFC",
@@ -102,7 +102,13 @@ __all__ = [
     "select_by_dd_fc",
     "tournament_winners",
     "make_maoea_ddfc",
+    "ORIGINAL_OPERATORS",
 ]
+
+#: MaOEA-DDFC's own settings (Cheng, Yen & Zhang 2015, Sec. V: SBX pc = 1, eta_c = 20;
+#: polynomial mutation pm = 1/n, eta_m = 20).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=20.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Cheng, Yen & Zhang (2015), Sec. V")
 
 _FC_FLOOR = 1e-6
 _CHOICES = ("roulette", "best")
@@ -335,9 +341,14 @@ class MaOEADDFC(GeneticAlgorithm):
         self.survival.reset()
 
 
-def make_maoea_ddfc(*, n_obj: int, pop_size: int = POP_SIZE, n_neighbors: int = 5,
-                    n_candidates: int = 3,
+def make_maoea_ddfc(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+                    n_neighbors: int = 5, n_candidates: int = 3,
                     candidate_choice: Literal["roulette", "best"] = "roulette") -> MaOEADDFC:
-    """MaOEA-DDFC with the paper's settings (``K = 5``, ``L = 3``, SBX and PM as in the paper)."""
+    """MaOEA-DDFC with the paper's settings (``K = 5``, ``L = 3``, SBX and PM as in the paper).
+
+    The shape of every factory (:mod:`moo.algorithms`); ``operators="original"``:
+    :data:`ORIGINAL_OPERATORS`.
+    """
+    n_obj, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
     return MaOEADDFC(n_obj, pop_size=pop_size, n_neighbors=n_neighbors, n_candidates=n_candidates,
-                     candidate_choice=candidate_choice)
+                     candidate_choice=candidate_choice, **variation)

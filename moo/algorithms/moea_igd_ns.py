@@ -77,8 +77,8 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import check_int
-from ._base import paper_operators
-from .operators import POP_SIZE
+from ._base import factory_arguments, paper_operators
+from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
     "IGDNSSurvival",
@@ -89,7 +89,13 @@ __all__ = [
     "reduce_by_igd_ns",
     "truncate_by_angle",
     "update_archive",
+    "ORIGINAL_OPERATORS",
 ]
+
+#: MOEA/IGD-NS's own settings (Tian et al. 2016, Sec. IV: SBX pc = 1, eta_c = 20; polynomial
+#: mutation pm = 1/n, eta_m = 20, PlatEMO's defaults, in which the authors' group ran it).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=20.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Tian et al. (2016), Sec. IV")
 
 
 def _as_points(value, name: str, n_obj: int | None = None) -> np.ndarray:
@@ -359,8 +365,9 @@ class MOEAIGDNS(GeneticAlgorithm):
         self.survival.reset()
 
 
-def make_moea_igd_ns(*, n_obj: int, pop_size: int = POP_SIZE, archive_size: int | None = None) -> MOEAIGDNS:
-    """MOEA/IGD-NS with the paper's settings.
+def make_moea_igd_ns(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+                     archive_size: int | None = None) -> MOEAIGDNS:
+    """MOEA/IGD-NS with the paper's settings; the shape of every factory (:mod:`moo.algorithms`).
 
     Parameters
     ----------
@@ -369,8 +376,10 @@ def make_moea_igd_ns(*, n_obj: int, pop_size: int = POP_SIZE, archive_size: int 
         checked for consistency with the registry's signature).
     pop_size : int
         Population size (92 in the paper).
+    operators : {"paper", "original"} or OperatorSettings
+        Variation settings; ``"original"``: :data:`ORIGINAL_OPERATORS`.
     archive_size : int, optional
         Bound of the external archive (default ``5 * pop_size``).
     """
-    check_int(n_obj, "n_obj", 2)
-    return MOEAIGDNS(pop_size=pop_size, archive_size=archive_size)
+    _, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
+    return MOEAIGDNS(pop_size=pop_size, archive_size=archive_size, **variation)

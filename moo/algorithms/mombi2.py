@@ -87,8 +87,8 @@ from pymoo.core.survival import Survival
 from pymoo.operators.selection.tournament import TournamentSelection
 
 from .._validation import check_directions, check_int, check_real
-from ._base import check_ref_dirs_fit, paper_operators
-from .operators import POP_SIZE, reference_directions
+from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, paper_operators
+from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
     "MOMBI2",
@@ -98,7 +98,13 @@ __all__ = [
     "r2_ranking",
     "r2_tournament",
     "update_reference_points",
+    "ORIGINAL_OPERATORS",
 ]
+
+#: MOMBI-II's own settings (SBX pc = 0.9, eta_c = 20; polynomial mutation pm = 1/n, eta_m = 20:
+#: the MOMBI papers' settings, as in jMetal's MOMBI-II runner; the GECCO text was not at hand).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=0.9, crossover_eta=20.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Hernandez Gomez & Coello Coello (2015), as configured in jMetal")
 
 #: Value substituted for zero weight components in the ASF.
 ZERO_WEIGHT = 1e-6
@@ -365,24 +371,28 @@ class MOMBI2(GeneticAlgorithm):
         self.survival.reset()
 
 
-def make_mombi2(*, n_obj: int, pop_size: int = POP_SIZE, alpha: float = 0.5, epsilon: float = 1e-3,
-                record_size: int = 5) -> MOMBI2:
-    """MOMBI-II with the paper's settings.
+def make_mombi2(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+                alpha: float = 0.5, epsilon: float = 1e-3, record_size: int = 5,
+                ref_dirs: np.ndarray | None = None) -> MOMBI2:
+    """MOMBI-II with the paper's settings; the shape of every factory (:mod:`moo.algorithms`).
 
     Parameters
     ----------
     n_obj : int
-        Number of objectives (weights from :func:`reference_directions`).
+        Number of objectives.
     pop_size : int
         Population size (92 in the paper).
+    operators : {"paper", "original"} or OperatorSettings
+        Variation settings; ``"original"``: :data:`ORIGINAL_OPERATORS`.
     alpha : float
         Variance threshold of the nadir record (0.5).
     epsilon : float
         Tolerance below which an objective range counts as collapsed (1e-3).
     record_size : int
         Number of past nadir candidates kept (5).
+    ref_dirs : ndarray, optional
+        Weight vectors (default :func:`~moo.algorithms.operators.reference_directions`).
     """
-    n_obj = check_int(n_obj, "n_obj", 2)
-    pop_size = check_int(pop_size, "pop_size", 2)
-    return MOMBI2(reference_directions(n_obj, pop_size), pop_size=pop_size, alpha=alpha,
-                  epsilon=epsilon, record_size=record_size)
+    n_obj, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
+    return MOMBI2(factory_ref_dirs(ref_dirs, n_obj, pop_size), pop_size=pop_size, alpha=alpha,
+                  epsilon=epsilon, record_size=record_size, **variation)

@@ -1,4 +1,4 @@
-"""The paper's variation operators and reference directions (Section 4.1.2).
+"""Variation operators (the paper's and each algorithm's original ones) and reference directions.
 
 The paper ran on PlatEMO with population 92, SBX ``pc = 1.0``, polynomial
 mutation ``pm = 0.5`` and ``eta_m = 20``, other parameters at their defaults.
@@ -17,10 +17,19 @@ Readings (see PAPER_NOTES.md):
   ``UniformPoint(92, 4)`` returns); the population stays 92. For M objectives
   in general: the largest one-layer set of size <= pop_size, which gives
   ``pop_size - 1`` directions for 2 objectives.
+
+Every factory of :mod:`moo.algorithms` takes ``operators="paper"`` (the
+default: :data:`PAPER_OPERATORS` above, shared by all ten algorithms as in the
+reproduced study) or ``operators="original"``: the SBX / polynomial mutation
+settings of the algorithm's own paper, an :class:`OperatorSettings` constant
+``ORIGINAL_OPERATORS`` in its module. An :class:`OperatorSettings` instance
+may also be passed. Only the parameters change; SBX stays pymoo's bounded
+form with the two children's values swapped with probability 0.5.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import comb
 
 import numpy as np
@@ -28,9 +37,34 @@ from pymoo.operators.crossover.sbx import SBX
 from pymoo.operators.mutation.pm import PM
 from pymoo.util.ref_dirs import get_reference_directions
 
-__all__ = ["PaperPM", "paper_crossover", "paper_mutation", "reference_directions", "POP_SIZE"]
+__all__ = ["OPERATOR_CHOICES", "OperatorSettings", "PAPER_OPERATORS", "POP_SIZE", "PaperPM", "paper_crossover",
+           "paper_mutation", "reference_directions", "variation_operators"]
 
 POP_SIZE = 92
+
+
+@dataclass(frozen=True)
+class OperatorSettings:
+    """SBX and polynomial-mutation parameters, with where they come from.
+
+    ``mutation_rate`` is the expected number of mutated variables of an
+    offspring (PlatEMO's ``proM``): each variable mutates with probability
+    ``mutation_rate / n_var``, so ``1.0`` is the usual ``pm = 1/n``.
+    """
+
+    crossover_prob: float
+    crossover_eta: float
+    mutation_rate: float
+    mutation_eta: float
+    source: str
+
+
+#: The reproduced paper's settings (Morais et al. 2022, Sec. 4.1.2, read as above).
+PAPER_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=20.0, mutation_rate=0.5, mutation_eta=20.0,
+                                   source="Morais et al. (2022), Sec. 4.1.2 (PlatEMO's pm = 0.5 expected mutations)")
+
+#: Accepted names of the ``operators`` argument of the factories.
+OPERATOR_CHOICES = ("paper", "original")
 
 
 class PaperPM(PM):
@@ -54,6 +88,12 @@ def paper_crossover(eta: float = 20.0, prob: float = 1.0) -> SBX:
 def paper_mutation(expected_mutations: float = 0.5, eta: float = 20.0) -> PaperPM:
     """Polynomial mutation as the paper configured it (pm = 0.5, eta_m = 20)."""
     return PaperPM(expected_mutations=expected_mutations, eta=eta)
+
+
+def variation_operators(settings: OperatorSettings) -> dict:
+    """``{"crossover": SBX, "mutation": PaperPM}`` built from ``settings``."""
+    return {"crossover": paper_crossover(eta=settings.crossover_eta, prob=settings.crossover_prob),
+            "mutation": paper_mutation(expected_mutations=settings.mutation_rate, eta=settings.mutation_eta)}
 
 
 def reference_directions(n_obj: int, pop_size: int = POP_SIZE) -> np.ndarray:

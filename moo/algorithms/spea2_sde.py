@@ -74,8 +74,8 @@ from pymoo.core.survival import Survival
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 
 from .._validation import as_float_array, as_objectives
-from ._base import BinaryTournament, paper_operators
-from .operators import POP_SIZE
+from ._base import BinaryTournament, factory_arguments, paper_operators
+from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
     "SPEA2SDE",
@@ -84,7 +84,13 @@ __all__ = [
     "sde_fitness",
     "sde_truncation",
     "shifted_distances",
+    "ORIGINAL_OPERATORS",
 ]
+
+#: SPEA2+SDE's own settings (Li, Yang & Liu 2014, Sec. IV: SBX pc = 1, eta_c = 20; polynomial
+#: mutation pm = 1/n, eta_m = 20).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=20.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Li, Yang & Liu (2014), Sec. IV")
 
 _FITNESS = "sde_fitness"
 
@@ -349,7 +355,7 @@ class SPEA2SDE(GeneticAlgorithm):
         pymoo duplicate elimination of offspring.
     """
 
-    def __init__(self, pop_size: int = POP_SIZE, sampling=None, crossover=None, mutation=None,
+    def __init__(self, *, pop_size: int = POP_SIZE, sampling=None, crossover=None, mutation=None,
                  normalize: bool = True, eliminate_duplicates: bool = True, output=None):
         super().__init__(
             pop_size=pop_size,
@@ -362,8 +368,11 @@ class SPEA2SDE(GeneticAlgorithm):
         self.termination = DefaultMultiObjectiveTermination()
 
 
-def make_spea2_sde(*, n_obj: int, pop_size: int = POP_SIZE, normalize: bool = True) -> SPEA2SDE:
+def make_spea2_sde(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+                   normalize: bool = True) -> SPEA2SDE:
     """SPEA2+SDE with the paper's settings (population = archive = 92, SBX, PM).
+
+    The shape of every factory (:mod:`moo.algorithms`).
 
     Parameters
     ----------
@@ -372,6 +381,8 @@ def make_spea2_sde(*, n_obj: int, pop_size: int = POP_SIZE, normalize: bool = Tr
         it is checked only.
     pop_size : int, default 92
         Archive size ``N`` and number of offspring per generation.
+    operators : {"paper", "original"} or OperatorSettings
+        Variation settings; ``"original"``: :data:`ORIGINAL_OPERATORS`.
     normalize : bool, default True
         Scale objectives by the ranked set's ideal point and non-dominated
         nadir before the shifted distances (``False``: raw objectives, as
@@ -381,11 +392,8 @@ def make_spea2_sde(*, n_obj: int, pop_size: int = POP_SIZE, normalize: bool = Tr
     -------
     SPEA2SDE
     """
-    if isinstance(n_obj, bool) or not isinstance(n_obj, (int, np.integer)) or n_obj < 2:
-        raise ValueError(f"n_obj must be an integer >= 2, got {n_obj!r}")
-    if isinstance(pop_size, bool) or not isinstance(pop_size, (int, np.integer)) or pop_size < 2:
-        raise ValueError(f"pop_size must be an integer >= 2, got {pop_size!r}")
+    _, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
     if not isinstance(normalize, (bool, np.bool_)):
         raise TypeError(f"normalize must be a bool, got {type(normalize).__name__}")
-    return SPEA2SDE(pop_size=int(pop_size), normalize=bool(normalize))
+    return SPEA2SDE(pop_size=pop_size, normalize=bool(normalize), **variation)
 

@@ -91,9 +91,9 @@ from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
 from .._validation import check_directions, check_int
-from ._base import check_ref_dirs_fit, paper_operators
+from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, paper_operators
 from ._normalize import front_bounds
-from .operators import POP_SIZE, reference_directions
+from .operators import POP_SIZE, OperatorSettings
 from .theta_dea import finite_first, select_by_fronts, theta_nondominated_ranks
 
 __all__ = [
@@ -105,7 +105,13 @@ __all__ = [
     "associate_by_angle",
     "spea_r_fitness",
     "make_spea_r",
+    "ORIGINAL_OPERATORS",
 ]
+
+#: SPEA/R's own settings (Jiang & Yang 2017, Sec. IV: SBX pc = 1, eta_c = 30; polynomial
+#: mutation pm = 1/n, eta_m = 20, the settings of the NSGA-III study it compares with).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=30.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Jiang & Yang (2017), Sec. IV")
 
 
 def dominance_matrix(F: np.ndarray) -> np.ndarray:
@@ -293,14 +299,16 @@ class SPEAR(GeneticAlgorithm):
         check_ref_dirs_fit(self.ref_dirs, problem)
 
 
-def make_spea_r(*, n_obj: int, pop_size: int = POP_SIZE, k_mating: int = 20) -> SPEAR:
-    """SPEA/R with the project's directions and operators.
+def make_spea_r(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+                k_mating: int = 20, ref_dirs: np.ndarray | None = None) -> SPEAR:
+    """SPEA/R with the project's directions; the shape of every factory (:mod:`moo.algorithms`).
 
-    Directions: :func:`~moo.algorithms.operators.reference_directions`
-    (91 for 3 objectives, 84 for 4); population ``pop_size`` (92);
-    ``k_mating`` random candidates in the restricted mating selection.
+    Directions: ``ref_dirs``, by default
+    :func:`~moo.algorithms.operators.reference_directions` (91 for 3
+    objectives, 84 for 4); population ``pop_size`` (92); ``k_mating``
+    random candidates in the restricted mating selection;
+    ``operators="original"``: :data:`ORIGINAL_OPERATORS`.
     """
-    n_obj = check_int(n_obj, "n_obj", 2)
-    pop_size = check_int(pop_size, "pop_size", 2)
+    n_obj, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
     k_mating = check_int(k_mating, "k_mating", 1)
-    return SPEAR(reference_directions(n_obj, pop_size), pop_size=pop_size, k_mating=k_mating)
+    return SPEAR(factory_ref_dirs(ref_dirs, n_obj, pop_size), pop_size=pop_size, k_mating=k_mating, **variation)

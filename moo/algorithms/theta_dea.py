@@ -75,9 +75,9 @@ from pymoo.util.misc import random_permutations
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from .._validation import check_directions, check_int, check_real
-from ._base import NormalizationForwarding, check_ref_dirs_fit, paper_operators
+from ._base import NormalizationForwarding, check_ref_dirs_fit, factory_arguments, factory_ref_dirs, paper_operators
 from ._normalize import HyperplaneNormalization
-from .operators import POP_SIZE, reference_directions
+from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
     "ThetaDEA",
@@ -88,7 +88,13 @@ __all__ = [
     "select_by_fronts",
     "finite_first",
     "make_theta_dea",
+    "ORIGINAL_OPERATORS",
 ]
+
+#: theta-DEA's own settings (Yuan et al. 2016, Sec. V; the authors' ``ThetaDEA_main.java``:
+#: SBX pc = 1, eta_c = 30; polynomial mutation pm = 1/n, eta_m = 20).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=30.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Yuan et al. (2016), Sec. V; authors' code yyxhdy/ManyEAs")
 
 AXIS_THETA = 1.0e6
 
@@ -285,13 +291,15 @@ class ThetaDEA(GeneticAlgorithm):
         self.survival.reset()
 
 
-def make_theta_dea(*, n_obj: int, pop_size: int = POP_SIZE, theta: float = 5.0) -> ThetaDEA:
-    """theta-DEA with the paper's settings (theta = 5) and the project's operators.
+def make_theta_dea(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+                   theta: float = 5.0, ref_dirs: np.ndarray | None = None) -> ThetaDEA:
+    """theta-DEA with the paper's settings (theta = 5); the shape of every factory (:mod:`moo.algorithms`).
 
-    Directions: :func:`~moo.algorithms.operators.reference_directions`
-    (91 for 3 objectives, 84 for 4); population ``pop_size`` (92).
+    Directions: ``ref_dirs``, by default
+    :func:`~moo.algorithms.operators.reference_directions` (91 for 3
+    objectives, 84 for 4); population ``pop_size`` (92);
+    ``operators="original"``: :data:`ORIGINAL_OPERATORS`.
     """
-    n_obj = check_int(n_obj, "n_obj", 2)
-    pop_size = check_int(pop_size, "pop_size", 2)
+    n_obj, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
     theta = check_real(theta, "theta", positive=False)
-    return ThetaDEA(reference_directions(n_obj, pop_size), theta=theta, pop_size=pop_size)
+    return ThetaDEA(factory_ref_dirs(ref_dirs, n_obj, pop_size), theta=theta, pop_size=pop_size, **variation)
