@@ -37,6 +37,15 @@ def test_fc_hand_values():
     np.testing.assert_allclose(favorable_convergence([[2, 0.5, 1]]), [1 / 3.5])
 
 
+def test_fc_of_tiny_and_huge_values_without_warnings():
+    # issue 17: 1/1e-310 overflowed (a RuntimeWarning, an error under the test settings). FC is homogeneous of
+    # degree 1, so FC(c f) = c FC(f); 1e-310 is subnormal, so compare with a relative tolerance of 1e-6.
+    f = np.array([[1.0, 2.0, 4.0]])                      # FC = 1 / (1 + 1/2 + 1/4) = 4/7
+    for c in (1e-310, 1e-300, 1e300):
+        np.testing.assert_allclose(favorable_convergence(c * f), [c * 4 / 7], rtol=1e-6)
+    np.testing.assert_allclose(favorable_convergence([[1e-310, 1.0]]), [1e-310], rtol=1e-6)
+
+
 def _fc_by_lp(f):
     # min s  s.t.  w_i f_i <= s,  sum w = 1,  w >= 0   (variables [w, s])
     M = len(f)

@@ -119,13 +119,16 @@ def favorable_convergence(F: np.ndarray) -> np.ndarray:
 
     ``FC(x) = min_{w in simplex} max_i w_i F_i(x) = 1 / sum_i (1 / F_i(x))``,
     and 0 if some ``F_i(x) = 0``. Negative entries (a point better than the
-    stored ideal) are clipped to 0.
+    stored ideal) are clipped to 0. Computed as ``m / sum_i (m / F_i)`` with
+    ``m = min_i F_i``: every ratio lies in ``(0, 1]``, so tiny or huge values
+    neither overflow (``1 / 1e-310`` does) nor lose the result.
     """
     F = np.maximum(as_matrix(F, "F"), 0.0)
-    with np.errstate(divide="ignore"):
-        inv = 1.0 / F
-    total = inv.sum(axis=1)
-    return np.where(np.isinf(total), 0.0, 1.0 / total)
+    m = F.min(axis=1)
+    fc = np.zeros(len(F))
+    pos = m > 0
+    fc[pos] = m[pos] / np.sum(m[pos, None] / F[pos], axis=1)
+    return fc
 
 
 def directional_projection(F: np.ndarray) -> np.ndarray:

@@ -90,9 +90,9 @@ from pymoo.core.survival import Survival
 from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
-from .._validation import check_directions, check_int
+from .._validation import check_choice, check_directions, check_int
 from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, paper_operators
-from ._normalize import front_bounds
+from ._normalize import HyperplaneNormalization, front_bounds
 from .operators import POP_SIZE, OperatorSettings
 from .theta_dea import finite_first, select_by_fronts, theta_nondominated_ranks
 
@@ -106,7 +106,12 @@ __all__ = [
     "spea_r_fitness",
     "make_spea_r",
     "ORIGINAL_OPERATORS",
+    "NORMALIZATIONS",
 ]
+
+#: ``normalization`` options of the survival: the shared hyperplane normalisation, or the paper's
+#: minimum and maximum of the non-dominated solutions (see "Readings").
+NORMALIZATIONS = ("hyperplane", "front")
 
 #: SPEA/R's own settings (Jiang & Yang 2017, Sec. IV: SBX pc = 1, eta_c = 30; polynomial
 #: mutation pm = 1/n, eta_m = 20, the settings of the NSGA-III study it compares with).
@@ -191,17 +196,32 @@ def spea_r_fitness(F: np.ndarray, niche: np.ndarray, angle: np.ndarray, theta_ba
 class SPEARSurvival(Survival):
     """SPEA/R environmental selection (steps 1-5 of the module docstring).
 
-    Stateless: a function of the population it is given, so it may be called
-    any number of times per generation on populations of any size.
-    Individuals with non-finite objectives are ranked last. The
+    With ``normalization="front"`` stateless: a function of the population it
+    is given; with ``"hyperplane"`` (default) its only state is the
+    normalisation (ideal point, extreme points), which it updates itself. So
+    it may be called any number of times per generation on populations of any
+    size. Individuals with non-finite objectives are ranked last. The
     survivors carry ``niche``, ``angle``, ``fitness`` and ``round`` (the
     selection round, 0-based).
     """
 
-    def __init__(self, ref_dirs: np.ndarray):
+    def __init__(self, ref_dirs: np.ndarray, normalization: str = "hyperplane"):
         super().__init__(filter_infeasible=True)
         self.ref_dirs = check_directions(ref_dirs)
         self.theta_bar = largest_neighbour_angle(self.ref_dirs)
+        self.normalization = check_choice(normalization, "normalization", NORMALIZATIONS)
+        self.norm = HyperplaneNormalization(self.ref_dirs.shape[1])
+
+    def reset(self) -> None:
+        """Forget the normalisation state (a new run starts)."""
+        self.norm.reset()
+
+    def _normalized(self, F: np.ndarray, nondominated: np.ndarray) -> np.ndarray:
+        if self.normalization == "front":
+            z_min, rng = front_bounds(F, nondominated)
+            return (F - z_min) / rng
+        self.norm.update(F, nondominated=np.flatnonzero(nondominated))
+        return self.norm.normalize(F)
 
     def _do(self, problem, pop, n_survive=None, random_state=None, **kwargs):
         F = pop.get("F").astype(float)
@@ -210,8 +230,7 @@ class SPEARSurvival(Survival):
         if not np.all(np.isfinite(F)):
             return finite_first(self._do, problem, pop, n_survive, random_state)
         dom = dominance_matrix(F)
-        z_min, rng = front_bounds(F, ~dom.any(axis=0))
-        niche, angle = associate_by_angle((F - z_min) / rng, self.ref_dirs)
+        niche, angle = associate_by_angle(self._normalized(F, ~dom.any(axis=0)), self.ref_dirs)
         fitness = spea_r_fitness(F, niche, angle, self.theta_bar, dom=dom)
         rounds = theta_nondominated_ranks(niche, fitness)
         keep = select_by_fronts(rounds, n_survive, fitness)
@@ -279,16 +298,17 @@ class SPEAR(GeneticAlgorithm):
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, pop_size: int | None = None, k_mating: int = 20,
-                 sampling: Sampling | None = None, crossover: Crossover | None = None,
-                 mutation: Mutation | None = None, eliminate_duplicates: bool = True,
-                 n_offsprings: int | None = None, output: Output | None = None):
+                 normalization: str = "hyperplane", sampling: Sampling | None = None,
+                 crossover: Crossover | None = None, mutation: Mutation | None = None,
+                 eliminate_duplicates: bool = True, n_offsprings: int | None = None,
+                 output: Output | None = None):
         ref_dirs = check_directions(ref_dirs)
         pop_size = check_int(len(ref_dirs) if pop_size is None else pop_size, "pop_size", 2)
         self.ref_dirs = ref_dirs
         super().__init__(
             pop_size=pop_size,
             selection=NeighbourMatingSelection(check_int(k_mating, "k_mating", 1)),
-            survival=SPEARSurvival(ref_dirs),
+            survival=SPEARSurvival(ref_dirs, normalization=normalization),
             eliminate_duplicates=eliminate_duplicates,
             n_offsprings=n_offsprings,
             advance_after_initial_infill=True,
@@ -297,10 +317,12 @@ class SPEAR(GeneticAlgorithm):
 
     def _setup(self, problem, **kwargs):
         check_ref_dirs_fit(self.ref_dirs, problem)
+        self.survival.reset()
 
 
 def make_spea_r(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
-                k_mating: int = 20, ref_dirs: np.ndarray | None = None) -> SPEAR:
+                k_mating: int = 20, normalization: str = "hyperplane",
+                ref_dirs: np.ndarray | None = None) -> SPEAR:
     """SPEA/R with the project's directions; the shape of every factory (:mod:`moo.algorithms`).
 
     Directions: ``ref_dirs``, by default
@@ -311,4 +333,5 @@ def make_spea_r(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | Operat
     """
     n_obj, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
     k_mating = check_int(k_mating, "k_mating", 1)
-    return SPEAR(factory_ref_dirs(ref_dirs, n_obj, pop_size), pop_size=pop_size, k_mating=k_mating, **variation)
+    return SPEAR(factory_ref_dirs(ref_dirs, n_obj, pop_size), pop_size=pop_size, k_mating=k_mating,
+                 normalization=normalization, **variation)
