@@ -244,6 +244,19 @@ def test_survival_fills_by_fitness_then_truncates():
     np.testing.assert_array_equal(raw.get("F"), F[[0, 1]])
 
 
+def test_normalisation_falls_back_to_the_whole_range_when_the_front_hardly_spans_an_objective():
+    # rows 0, 1 non-dominated with f2 = 2e-300, 1e-300; row 2 = (2, 1) dominated by both (raw fitness 1 + 1).
+    # By the front's f2 range (1e-300) alone row 2 would scale to 1e300 and its squared distances overflow
+    # (a RuntimeWarning, an error under the test settings). A front range below 1e-10 of the whole set's takes
+    # the whole set's (1), so f2 ~ (1e-300, 0, 1) and f1 = (0, 1, 2) / 1. Shifted distances (k = 1): row 0 sees
+    # row 1 at 1 and row 2 at sqrt 5 -> density 1/3; row 1 sees row 0 at 1e-300 -> 1/2; row 2 sees row 0 at 0.
+    F = np.array([[0.0, 2e-300], [1.0, 1e-300], [2.0, 1.0]])
+    fit, raw, density = sde_fitness(F)
+    np.testing.assert_array_equal(raw, [0, 0, 2])
+    np.testing.assert_allclose(density, [1 / 3, 1 / 2, 1 / 2], rtol=1e-12)
+    np.testing.assert_allclose(fit, [1 / 3, 1 / 2, 2.5], rtol=1e-12)
+
+
 def test_normalised_survival_is_invariant_to_objective_scaling():
     # Scaling objective k by a_k > 0 and shifting it leaves the normalised set unchanged, so the
     # same individuals survive; the raw form is not invariant (it follows the largest objective).

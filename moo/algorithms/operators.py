@@ -33,11 +33,13 @@ from dataclasses import dataclass
 from math import comb
 
 import numpy as np
+from pymoo.core.crossover import Crossover
+from pymoo.core.variable import Real
 from pymoo.operators.crossover.sbx import SBX
 from pymoo.operators.mutation.pm import PM
 from pymoo.util.ref_dirs import get_reference_directions
 
-__all__ = ["OPERATOR_CHOICES", "OperatorSettings", "PAPER_OPERATORS", "POP_SIZE", "PaperPM", "paper_crossover",
+__all__ = ["ClippedSBX", "OPERATOR_CHOICES", "OperatorSettings", "PAPER_OPERATORS", "POP_SIZE", "PaperPM", "paper_crossover",
            "paper_mutation", "reference_directions", "variation_operators"]
 
 POP_SIZE = 92
@@ -57,6 +59,7 @@ class OperatorSettings:
     mutation_rate: float
     mutation_eta: float
     source: str
+    crossover_form: str = "bounded"
 
 
 #: The reproduced paper's settings (Morais et al. 2022, Sec. 4.1.2, read as above).
@@ -65,6 +68,38 @@ PAPER_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=20.0, mutat
 
 #: Accepted names of the ``operators`` argument of the factories.
 OPERATOR_CHOICES = ("paper", "original")
+
+
+class ClippedSBX(Crossover):
+    """SBX with the unbounded spread of Deb & Agrawal (1995), children clipped to the bounds.
+
+    For each variable, with ``u ~ U(0, 1)``,
+    ``beta = (2u)^(1/(eta+1))`` if ``u <= 1/2`` else ``(2 - 2u)^(-1/(eta+1))``,
+    the children are ``(p1 + p2)/2 +- beta (p1 - p2)/2`` (the sign drawn at
+    random, i.e. the children swapped with probability 1/2), each variable is
+    crossed with probability 1/2 (otherwise copied), and values outside the
+    box are clipped to its bounds. This is PlatEMO's ``OperatorGA``, on which
+    the reproduced paper ran; pymoo's :class:`~pymoo.operators.crossover.sbx.SBX`
+    is the bound-aware form of Deb's NSGA-II code instead, whose spread
+    shrinks near a bound and never reaches it. A mating is crossed with
+    probability ``prob`` (pymoo's ``Crossover``), else the parents are copied.
+    """
+
+    def __init__(self, prob: float = 1.0, eta: float = 20.0):
+        super().__init__(2, 2, prob=prob)
+        self.eta = Real(eta, bounds=(3.0, 30.0), strict=(1.0, None))
+
+    def _do(self, problem, X, *args, random_state=None, **kwargs):
+        p1, p2 = X[0].astype(float), X[1].astype(float)
+        eta = float(self.eta.value)
+        u = random_state.random(p1.shape)
+        beta = np.where(u <= 0.5, (2 * u) ** (1 / (eta + 1)), (2 - 2 * np.minimum(u, 1 - 1e-16)) ** (-1 / (eta + 1)))
+        beta *= np.where(random_state.random(p1.shape) < 0.5, -1.0, 1.0)
+        copied = random_state.random(p1.shape) < 0.5
+        mid, half = (p1 + p2) / 2, (p1 - p2) / 2
+        c1 = np.where(copied, p1, mid + beta * half)           # copied exactly, not through the formula
+        c2 = np.where(copied, p2, mid - beta * half)
+        return np.clip(np.stack([c1, c2]), problem.xl, problem.xu)
 
 
 class PaperPM(PM):
@@ -80,8 +115,12 @@ class PaperPM(PM):
         return np.full(kwargs.get("size", 1), min(1.0, self.expected_mutations / problem.n_var))
 
 
-def paper_crossover(eta: float = 20.0, prob: float = 1.0) -> SBX:
-    """SBX as the paper configured it (pc = 1.0, eta_c = 20)."""
+def paper_crossover(eta: float = 20.0, prob: float = 1.0, form: str = "bounded") -> Crossover:
+    """SBX with ``pc = prob``, ``eta_c = eta``: pymoo's bound-aware form or :class:`ClippedSBX` (``form``)."""
+    if form == "clipped":
+        return ClippedSBX(prob=prob, eta=eta)
+    if form != "bounded":
+        raise ValueError(f"form must be 'bounded' or 'clipped', got {form!r}")
     return SBX(prob=prob, eta=eta, prob_var=0.5, prob_bin=0.5)
 
 
@@ -92,7 +131,8 @@ def paper_mutation(expected_mutations: float = 0.5, eta: float = 20.0) -> PaperP
 
 def variation_operators(settings: OperatorSettings) -> dict:
     """``{"crossover": SBX, "mutation": PaperPM}`` built from ``settings``."""
-    return {"crossover": paper_crossover(eta=settings.crossover_eta, prob=settings.crossover_prob),
+    return {"crossover": paper_crossover(eta=settings.crossover_eta, prob=settings.crossover_prob,
+                                         form=settings.crossover_form),
             "mutation": paper_mutation(expected_mutations=settings.mutation_rate, eta=settings.mutation_eta)}
 
 

@@ -100,11 +100,17 @@ def _normalise(F: np.ndarray, nondominated: np.ndarray) -> np.ndarray:
 
     ``(f - z_min) / (z_nad - z_min)`` with ``z_min`` the component-wise minimum
     (always attained by a non-dominated individual) and ``z_nad`` the
-    component-wise maximum over the non-dominated ones; a zero range maps to
-    0. Dominated individuals may get values above 1.
+    component-wise maximum over the non-dominated ones. A range below
+    ``1e-10`` of the whole set's is replaced by the whole set's (on DTLZ4 the
+    non-dominated individuals can all have an objective of ``1e-300``, and the
+    dominated ones would then scale to ``1e300`` and overflow in the
+    distances); a zero range maps to 0. Dominated individuals may get values
+    above 1.
     """
     fmin = F.min(axis=0)
+    full = F.max(axis=0) - fmin
     span = F[nondominated].max(axis=0) - fmin
+    span = np.where(span > 1e-10 * full, span, full)
     span = np.where(span > 0, span, 1.0)
     return (F - fmin) / span
 
