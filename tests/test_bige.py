@@ -257,9 +257,10 @@ def test_dtlz2_igd_comparable_to_nsga3():
 
 
 def test_dtlz1_converges_to_the_linear_front():
-    # DTLZ1 (3 objectives, n_var 7): the front is sum f = 0.5. 20000 evaluations (~2.5 s).
+    # DTLZ1 (3 objectives, n_var 7): the front is sum f = 0.5. 30000 evaluations (~3.5 s): at 20000 a run can
+    # still sit on the local front sum f = 1 (seed 1 did once the initial population went through the survival)
     problem = get_problem("dtlz1", n_obj=3)
-    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 20000), seed=1)
+    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 30000), seed=1)
     s = res.F.sum(axis=1)
     assert abs(np.median(s) - 0.5) < 0.01, np.median(s)
     assert np.mean(np.abs(s - 0.5) < 0.05) > 0.9

