@@ -57,6 +57,14 @@ def _common_scale(*arrays: np.ndarray) -> float:
     return 1.0 if top == 0.0 else float(2.0 ** np.frexp(top)[1])
 
 
+def _distance_to_reference(indicator, F: ArrayLike, ref_set: ArrayLike) -> float:
+    """``indicator(F, ref=ref_set)`` (a moocore distance indicator, degree 1) on the scaled sets."""
+    A = _points(F, "F")
+    R = _points(ref_set, "ref_set", n_obj=A.shape[1])
+    c = _common_scale(A, R)
+    return c * float(indicator(A / c, ref=R / c))
+
+
 def _nearest_neighbour(D: np.ndarray) -> np.ndarray:
     """Row-wise minimum of a square distance matrix, the diagonal excluded."""
     D = D.copy()
@@ -89,10 +97,7 @@ def igd(F: ArrayLike, ref_set: ArrayLike) -> float:
     of a coevolutionary multi-objective evolutionary algorithm", MICAI 2004, LNCS 2972.
     Computed by :func:`moocore.igd`.
     """
-    A = _points(F, "F")
-    R = _points(ref_set, "ref_set", n_obj=A.shape[1])
-    c = _common_scale(A, R)
-    return c * float(moocore.igd(A / c, ref=R / c))
+    return _distance_to_reference(moocore.igd, F, ref_set)
 
 
 def igd_plus(F: ArrayLike, ref_set: ArrayLike) -> float:
@@ -120,10 +125,7 @@ def igd_plus(F: ArrayLike, ref_set: ArrayLike) -> float:
     calculation in generational distance and inverted generational distance",
     EMO 2015, LNCS 9019, 110-125. Computed by :func:`moocore.igd_plus`.
     """
-    A = _points(F, "F")
-    R = _points(ref_set, "ref_set", n_obj=A.shape[1])
-    c = _common_scale(A, R)
-    return c * float(moocore.igd_plus(A / c, ref=R / c))
+    return _distance_to_reference(moocore.igd_plus, F, ref_set)
 
 
 def spacing(F: ArrayLike) -> float:
