@@ -52,7 +52,8 @@ from moo.algorithms import make_algorithm  # noqa: E402
 from moo.molsp import molsp  # noqa: E402
 from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
 from moo.problems.generic import GenericRLQRProblem  # noqa: E402
-from robustctl.simulate import simulate  # noqa: E402
+from robustctl.models import truck  # noqa: E402
+from robustctl.pathfollow import simulate  # noqa: E402
 
 
 class ElementwiseApplied(ElementwiseProblem):
@@ -66,6 +67,7 @@ class ElementwiseApplied(ElementwiseProblem):
 
     def __init__(self, batched: AppliedRLQRProblem):
         self.b = batched
+        self.F_s, self.G_s, _ = truck.discretise(batched.overloads)
         super().__init__(n_var=batched.n_var, n_obj=batched.n_obj, xl=batched.xl, xu=batched.xu)
 
     def _evaluate(self, x, out, *args, **kwargs):
@@ -78,11 +80,12 @@ class ElementwiseApplied(ElementwiseProblem):
             out["F"] = np.full(b.n_obj, 2.0 * pen)
             return
         rho = max(np.max(np.abs(np.linalg.eigvals(Fs + Gs @ K.sum(axis=0, keepdims=True))))
-                  for Fs, Gs in zip(b._F_s, b._G_s))
+                  for Fs, Gs in zip(self.F_s, self.G_s))
         if rho >= 1.0:
             out["F"] = np.full(b.n_obj, pen * min(rho, 2.0))
             return
-        e = simulate(K, b.path, tuple(b.overloads), keep_trajectories=False).mse()[0]
+        e = simulate(K, b.path, tuple(b.overloads), keep_trajectories=False,
+                     input_map=truck.DOUBLED_INPUT_MAP).mse()[0]
         f = e.mean(axis=0) if b.aggregate == "mean" else e.max(axis=0)
         out["F"] = np.minimum(f, pen)
 

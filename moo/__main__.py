@@ -1,37 +1,66 @@
-"""Command line: ``python -m moo run | experiment | stats``.
+"""Command line: ``python -m moo run | experiment | stats | plot``.
 
 ::
 
     python -m moo run --problem {generic,applied,zdt1..6,dtlz1..7} [--n-obj M]
                       --algorithm NAME [--molsp [--max-leaders K]] --seed S
                       --evals N [--pop-size P] --out FILE.json
-    python -m moo experiment --problem P [--n-obj M] --algorithms all|a,b --runs N
-                      --evals E [--molsp-max-leaders K] [--pop-size P] [--seed BASE]
-                      --out DIR [--workers W]
-    python -m moo stats DIR [--out FILE.csv|.md|.tex] [--runs-out FILE.csv] [--alpha A]
+    python -m moo experiment --problem P [--n-obj M] [--algorithms all|a,b] --runs N
+                      --evals E [--max-leaders K] [--pop-size P] [--seed BASE] --out DIR
+                      [--executor {process,dask}] [--workers W] [--scheduler ADDRESS]
+                      [--keep-going]
+    python -m moo stats DIR [--out FILE.csv|.md|.tex] [--ranks-out FILE.csv|.md|.tex]
+                      [--runs-out FILE.csv] [--alpha A]
+    python -m moo plot DIR --out FIGDIR [--format png,pdf]
 
-``run`` runs :func:`moo.runner.run` and writes its record (:meth:`RunResult.to_dict`)
-as JSON. ``experiment`` runs a resumable grid (:func:`moo.experiment.run_experiment`,
-one JSON record per run under DIR; progress with an ETA on a terminal).
-``stats`` computes the five indicators per run and the ANOVA/Tukey comparison of
-each MOEA with its MO-LSP version (:mod:`moo.stats`), prints the table as
-Markdown and writes it to FILE in the format of its extension. A progress bar goes to stderr when stderr is a terminal; nothing is
-printed otherwise. Bad arguments give a one-line error on stderr and exit
-code 2; a failure during the run raises (exit code 1).
+``run`` runs :func:`moo.runner.run` and writes its record (the fields are
+listed in :mod:`moo.runner`) as JSON. ``experiment`` runs a resumable grid
+(:func:`moo.experiment.run_experiment`; one record per run under DIR) in this
+process, a local process pool, or on a Dask cluster (:mod:`moo.executors`).
+``stats`` computes the indicators per run and the comparisons of
+:mod:`moo.stats`, prints the tables as Markdown and writes them in the format
+of the file's extension. ``plot`` draws the figures of :mod:`moo.plots`.
+
+The CLI is a thin layer: every check is the library's (:func:`moo.runner.prepare`,
+:func:`moo.experiment.prepare`, :func:`moo.executors.open_executor`,
+:mod:`moo.store`), done before any work; its messages name the flag.
+
+Exit codes (the same for every command):
+
+* 0 - done;
+* 1 - the work failed: a run raised (``experiment``: without ``--keep-going``
+  the grid stops there; with it, the grid finishes and the failed runs are
+  listed), or the executor failed (a pool process killed, the scheduler
+  unreachable). One line on stderr says what and where the traceback is; the
+  records already written stay, and rerunning the command resumes;
+* 2 - bad arguments (a one-line message on stderr; nothing was run or written),
+  including an unusable ``--out``, a results directory holding runs with
+  other settings, and a corrupt record read by ``stats`` or ``plot``;
+* 130 - interrupted (Ctrl-C); the records already written stay.
+
+Progress bars go to stderr when stderr is a terminal.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
+import re
 import sys
-from collections.abc import Sequence
+import traceback
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager, nullcontext
 
 from moo.algorithms import ALGORITHMS
+from moo.algorithms.operators import POP_SIZE
 from moo.problems import PROBLEMS
 
 __all__ = ["main"]
+
+_PROG = "python -m moo"
+
+_EXIT_CODES = """exit codes: 0 done; 1 the work failed (a run raised, or the executor failed; records
+already written stay, rerun to resume); 2 bad arguments (nothing run); 130 interrupted"""
 
 
 class _UsageError(Exception):
@@ -43,10 +72,24 @@ class _Parser(argparse.ArgumentParser):
         raise _UsageError(message)
 
 
+def _subparser(sub, name: str, help_text: str, example: str) -> argparse.ArgumentParser:
+    return sub.add_parser(name, help=help_text, description=help_text,
+                          epilog=f"example:\n  {example}\n\n{_EXIT_CODES}",
+                          formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="python -m moo", description="Multiobjective tuning with MOEAs and MO-LSP.")
+    parser = _Parser(prog=_PROG, description="Multiobjective tuning with MOEAs and MO-LSP.",
+                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                     epilog="examples:\n"
+                            f"  {_PROG} run --problem zdt1 --algorithm nsga2 --seed 0 --evals 2000 --out run.json\n"
+                            f"  {_PROG} experiment --problem generic --runs 50 --evals 10000 --out results/generic\n"
+                            f"  {_PROG} stats results/generic --out table.md\n"
+                            f"  {_PROG} plot results/generic --out figures\n\n" + _EXIT_CODES)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    r = sub.add_parser("run", help="one run of a MOEA on a problem, recorded as JSON")
+
+    r = _subparser(sub, "run", "one run of a MOEA on a problem, recorded as JSON",
+                   f"{_PROG} run --problem applied --algorithm nsga3 --molsp --seed 1 --evals 10000 --out run.json")
     r.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}")
     r.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
     r.add_argument("--algorithm", required=True, help=f"one of {', '.join(ALGORITHMS)}")
@@ -54,27 +97,72 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--max-leaders", type=int, default=None, help="MO-LSP cap on candidates per generation")
     r.add_argument("--seed", type=int, required=True, help="seed (integer >= 0)")
     r.add_argument("--evals", type=int, required=True, help="evaluation budget")
-    r.add_argument("--pop-size", type=int, default=92, help="population size (default 92)")
-    r.add_argument("--out", required=True, help="output JSON file")
+    r.add_argument("--pop-size", type=int, default=POP_SIZE, help=f"population size (default {POP_SIZE})")
+    r.add_argument("--out", required=True, help="output JSON file (checked before the run)")
 
-    e = sub.add_parser("experiment", help="a resumable grid of runs: algorithms x {plain, MO-LSP} x seeds")
+    e = _subparser(sub, "experiment", "a resumable grid of runs: algorithms x {plain, MO-LSP} x seeds",
+                   f"{_PROG} experiment --problem generic --algorithms nsga2,nsga3 --runs 50 --evals 10000 "
+                   "--out results/generic --executor dask --workers 2")
     e.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}")
     e.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
     e.add_argument("--algorithms", default="all", help="'all' or a comma-separated list (default all)")
     e.add_argument("--runs", type=int, required=True, help="independent runs per algorithm and variant")
     e.add_argument("--evals", type=int, required=True, help="evaluation budget of each run")
-    e.add_argument("--molsp-max-leaders", type=int, default=None, help="MO-LSP cap on candidates per generation")
-    e.add_argument("--pop-size", type=int, default=92, help="population size (default 92)")
+    e.add_argument("--max-leaders", type=int, default=None, help="MO-LSP cap on candidates per generation")
+    e.add_argument("--molsp-max-leaders", type=int, default=None, help=argparse.SUPPRESS)  # deprecated alias
+    e.add_argument("--pop-size", type=int, default=POP_SIZE, help=f"population size (default {POP_SIZE})")
     e.add_argument("--seed", type=int, default=0, help="base seed of the SeedSequence (default 0)")
     e.add_argument("--out", required=True, help="results directory (created; existing runs are kept)")
-    e.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    e.add_argument("--executor", choices=("process", "dask"), default="process",
+                   help="'process' (default): this process or a local pool; 'dask': a Dask cluster")
+    e.add_argument("--workers", type=int, default=None,
+                   help="processes of the local pool or local Dask cluster (default 1)")
+    e.add_argument("--scheduler", default=None,
+                   help="address of a running Dask scheduler (with --executor dask), e.g. tcp://HOST:8786")
+    e.add_argument("--keep-going", action="store_true",
+                   help="record a failed run (with its traceback) and go on; default: stop at the first failure")
 
-    s = sub.add_parser("stats", help="indicators, ANOVA and Tukey HSD of a results directory")
+    s = _subparser(sub, "stats", "indicators and statistics (ANOVA/Tukey, Wilcoxon-Holm, Friedman/Nemenyi)",
+                   f"{_PROG} stats results/generic --out table.tex --ranks-out ranks.md --runs-out runs.csv")
     s.add_argument("dir", help="results directory written by 'experiment'")
-    s.add_argument("--out", default=None, help="write the table to FILE (.csv, .md or .tex)")
+    s.add_argument("--out", default=None, help="write the MOEA vs MO-LSP table to FILE (.csv, .md or .tex)")
+    s.add_argument("--ranks-out", default=None, help="write the Friedman ranks table to FILE (.csv, .md or .tex)")
     s.add_argument("--runs-out", default=None, help="write the per-run indicators to FILE (.csv)")
     s.add_argument("--alpha", type=float, default=0.05, help="significance level (default 0.05)")
+
+    p = _subparser(sub, "plot", "figures of a results directory (hypervolume, box plots, fronts, CD diagrams)",
+                   f"{_PROG} plot results/generic --out figures --format png,pdf")
+    p.add_argument("dir", help="results directory written by 'experiment'")
+    p.add_argument("--out", required=True, help="figure directory (created)")
+    p.add_argument("--format", default="png,pdf", help="comma-separated file formats (default png,pdf)")
+    p.add_argument("--alpha", type=float, default=0.05, help="significance level of the CD diagrams")
     return parser
+
+
+# ---------------------------------------------------------------------------- library errors -> usage errors
+
+_FLAGS = {"seed": "--seed", "base_seed": "--seed", "evals": "--evals", "pop_size": "--pop-size",
+          "max_leaders": "--max-leaders", "n_obj": "--n-obj", "runs": "--runs", "workers": "--workers",
+          "scheduler": "--scheduler", "executor": "--executor", "alpha": "--alpha", "algorithms": "--algorithms",
+          "out": "--out"}
+
+
+def _flagged(message: str) -> str:
+    """The library's message with its leading argument name spelled as the CLI flag."""
+    message = str(message).splitlines()[0] if str(message) else type(message).__name__
+    m = re.match(r"([a-z_]+)\b", message)
+    if m and m.group(1) in _FLAGS:
+        message = _FLAGS[m.group(1)] + message[m.end():]
+    return message.replace("molsp=True", "--molsp")
+
+
+@contextmanager
+def _usage() -> Iterator[None]:
+    """Turn the library's argument errors (raised before any work) into usage errors."""
+    try:
+        yield
+    except (ValueError, TypeError, NotImplementedError) as exc:
+        raise _UsageError(_flagged(str(exc))) from None
 
 
 class _Progress:
@@ -94,151 +182,153 @@ class _Progress:
         sys.stderr.flush()
 
 
-def _validate(args) -> None:
-    if args.problem.lower() not in PROBLEMS:
-        raise _UsageError(f"unknown problem {args.problem!r}; valid: {', '.join(PROBLEMS)}")
-    if args.algorithm.lower() not in ALGORITHMS:
-        raise _UsageError(f"unknown algorithm {args.algorithm!r}; valid: {', '.join(ALGORITHMS)}")
-    if args.seed < 0:
-        raise _UsageError(f"--seed must be >= 0, got {args.seed}")
-    if args.pop_size < 4:
-        raise _UsageError(f"--pop-size must be >= 4, got {args.pop_size}")
-    if args.evals < args.pop_size:
-        raise _UsageError(f"--evals must be at least the population size ({args.pop_size}), got {args.evals}")
-    if args.max_leaders is not None and not args.molsp:
-        raise _UsageError("--max-leaders needs --molsp")
-    if args.max_leaders is not None and args.max_leaders < 1:
-        raise _UsageError(f"--max-leaders must be >= 1, got {args.max_leaders}")
-    out_dir = os.path.dirname(os.path.abspath(args.out))
-    if not os.path.isdir(out_dir):
-        raise _UsageError(f"--out: directory {out_dir!r} does not exist")
-    # build problem and algorithm once, so that their own checks report as usage errors
-    from moo.algorithms import make_algorithm
-    from moo.problems import make_problem
-    try:
-        problem = make_problem(args.problem, args.n_obj)
-        algorithm = make_algorithm(args.algorithm, n_obj=problem.n_obj, pop_size=args.pop_size)
-    except (ValueError, TypeError, NotImplementedError) as exc:
-        raise _UsageError(str(exc).splitlines()[0]) from None
-    if args.evals < algorithm.pop_size:
-        raise _UsageError(f"--evals must be at least the population size ({algorithm.pop_size}), "
-                          f"got {args.evals}")
+def _error(message: str, code: int) -> int:
+    print(f"{_PROG}: error: {message}", file=sys.stderr)
+    return code
 
 
-def _usage_error(message: str) -> int:
-    print(f"python -m moo: error: {message}", file=sys.stderr)
-    return 2
+def _failure(exc: BaseException, what: str) -> int:
+    """Exit 1 for an exception during the work: its traceback, then one line naming it."""
+    traceback.print_exception(exc, file=sys.stderr)
+    return _error(f"{what}: {type(exc).__name__}: {_flagged(str(exc)) if str(exc) else ''}".rstrip(": "), 1)
 
 
-def _validate_experiment(args) -> None:
-    from moo.experiment import plan
+# ---------------------------------------------------------------------------- commands
 
-    if args.problem.lower() not in PROBLEMS:
-        raise _UsageError(f"unknown problem {args.problem!r}; valid: {', '.join(PROBLEMS)}")
-    for name, value, minimum in (("--runs", args.runs, 1), ("--evals", args.evals, 1),
-                                 ("--workers", args.workers, 1), ("--seed", args.seed, 0),
-                                 ("--pop-size", args.pop_size, 4)):
-        if value < minimum:
-            raise _UsageError(f"{name} must be >= {minimum}, got {value}")
-    if args.molsp_max_leaders is not None and args.molsp_max_leaders < 1:
-        raise _UsageError(f"--molsp-max-leaders must be >= 1, got {args.molsp_max_leaders}")
-    if os.path.exists(args.out) and not os.path.isdir(args.out):
-        raise _UsageError(f"--out: {args.out!r} exists and is not a directory")
-    from moo.algorithms import make_algorithm
-    from moo.problems import make_problem
-    try:
-        specs = plan(args.problem, args.algorithms, runs=args.runs, evals=args.evals, n_obj=args.n_obj,
-                     base_seed=args.seed, pop_size=args.pop_size, max_leaders=args.molsp_max_leaders)
-        problem = make_problem(args.problem, args.n_obj)
-        for name in dict.fromkeys(s.algorithm for s in specs):
-            algorithm = make_algorithm(name, n_obj=problem.n_obj, pop_size=args.pop_size)
-            if args.evals < algorithm.pop_size:
-                raise _UsageError(f"--evals must be at least the population size of {name} "
-                                  f"({algorithm.pop_size}), got {args.evals}")
-    except (ValueError, TypeError, NotImplementedError) as exc:
-        raise _UsageError(str(exc).splitlines()[0]) from None
+def _cmd_run(args) -> int:
+    from moo.runner import prepare
+    from moo.store import check_output_file, write_json_atomic
 
-
-_STATS_FORMATS = (".csv", ".md", ".tex")
-
-
-def _validate_stats(args) -> None:
-    if not os.path.isdir(args.dir):
-        raise _UsageError(f"results directory {args.dir!r} does not exist")
-    if not 0 < args.alpha < 1:
-        raise _UsageError(f"--alpha must be in (0, 1), got {args.alpha}")
-    for flag, path, formats in (("--out", args.out, _STATS_FORMATS), ("--runs-out", args.runs_out, (".csv",))):
-        if path is None:
-            continue
-        if os.path.splitext(path)[1].lower() not in formats:
-            raise _UsageError(f"{flag} must end in {', '.join(formats)}, got {path!r}")
-        if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
-            raise _UsageError(f"{flag}: directory of {path!r} does not exist")
-
-
-def _main_experiment(args) -> int:
-    from moo.experiment import run_experiment
-
-    report = run_experiment(args.problem, args.algorithms, runs=args.runs, evals=args.evals, out=args.out,
-                            n_obj=args.n_obj, base_seed=args.seed, pop_size=args.pop_size,
-                            max_leaders=args.molsp_max_leaders, workers=args.workers)
-    if sys.stderr.isatty():
-        print(report, file=sys.stderr)
-    return 0
-
-
-def _main_stats(args) -> int:
-    from moo.stats import analyse, to_csv, to_latex, to_markdown
-
-    try:
-        runs, table = analyse(args.dir, alpha=args.alpha)
-    except ValueError as exc:
-        return _usage_error(str(exc).splitlines()[0])
-    text = to_markdown(table)
-    print(text)
-    if args.out is not None:
-        ext = os.path.splitext(args.out)[1].lower()
-        if ext == ".csv":
-            to_csv(table, args.out)
-        else:
-            with open(args.out, "w", encoding="utf-8") as fh:
-                fh.write(text if ext == ".md" else to_latex(table))
-    if args.runs_out is not None:
-        to_csv(runs, args.runs_out)
-    return 0
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit code (0 success, 1 run failure, 2 bad arguments)."""
-    try:
-        args = _parser().parse_args(argv)
-        if args.command == "experiment":
-            _validate_experiment(args)
-        elif args.command == "stats":
-            _validate_stats(args)
-        else:
-            _validate(args)
-    except _UsageError as exc:
-        return _usage_error(str(exc))
-    if args.command == "experiment":
-        return _main_experiment(args)
-    if args.command == "stats":
-        return _main_stats(args)
-
-    from moo.runner import run  # heavy imports after argument checks
-
+    with _usage():
+        out = check_output_file(args.out, "--out")
+        job = prepare(args.problem, args.algorithm, seed=args.seed, evals=args.evals, n_obj=args.n_obj,
+                      molsp=args.molsp, pop_size=args.pop_size, max_leaders=args.max_leaders)
     bar = _Progress(f"{args.algorithm}{'+molsp' if args.molsp else ''} {args.problem} s{args.seed}") \
         if sys.stderr.isatty() else None
     try:
-        result = run(args.problem, args.algorithm, seed=args.seed, evals=args.evals, n_obj=args.n_obj,
-                     molsp=args.molsp, pop_size=args.pop_size, max_leaders=args.max_leaders, progress=bar)
+        result = job.run(progress=bar)
+    except Exception as exc:
+        return _failure(exc, "the run failed")
     finally:
         if bar is not None:
             bar.close()
-    with open(args.out, "w", encoding="utf-8") as fh:
-        json.dump(result.to_dict(), fh, indent=1)
-        fh.write("\n")
+    write_json_atomic(out, result.to_dict())
     return 0
+
+
+def _cmd_experiment(args) -> int:
+    from moo.executors import open_executor
+    from moo.experiment import RunFailedError, prepare
+
+    if args.molsp_max_leaders is not None:
+        if args.max_leaders is not None:
+            raise _UsageError("give --max-leaders only (--molsp-max-leaders is its deprecated alias)")
+        print(f"{_PROG}: warning: --molsp-max-leaders is deprecated, use --max-leaders", file=sys.stderr)
+        args.max_leaders = args.molsp_max_leaders
+    with _usage():
+        executor = open_executor(args.executor, workers=args.workers, scheduler=args.scheduler)
+        grid = prepare(args.problem, args.algorithms, runs=args.runs, evals=args.evals, out=args.out,
+                       n_obj=args.n_obj, base_seed=args.seed, pop_size=args.pop_size,
+                       max_leaders=args.max_leaders)
+    if grid.skipped:
+        retry = f", {grid.retried} failed before and retried" if grid.retried else ""
+        print(f"{grid.skipped} of {len(grid.specs)} runs already done in {grid.out} (skipped); "
+              f"{len(grid.todo)} to run{retry}", file=sys.stderr)
+    try:
+        with executor if grid.todo else nullcontext() as ex:    # nothing to run: no cluster to start
+            report = grid.run(ex, keep_going=args.keep_going)
+    except RunFailedError as exc:
+        return _error(f"{exc}; the records written stay, rerun to resume", 1)
+    except ConnectionError as exc:
+        return _error(str(exc), 1)
+    except Exception as exc:
+        return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
+    print(report, file=sys.stderr)
+    if report.failed:
+        more = f" and {len(report.failed) - 1} more" if len(report.failed) > 1 else ""
+        return _error(f"{len(report.failed)} of {report.total} runs failed; tracebacks in "
+                      f"{report.failed[0]}{more}", 1)
+    return 0
+
+
+_TABLE_FORMATS = (".csv", ".md", ".tex")
+
+
+def _check_table_path(flag: str, path: str | None, formats: tuple[str, ...]) -> None:
+    from moo.store import check_output_file
+
+    if path is None:
+        return
+    if os.path.splitext(path)[1].lower() not in formats:
+        raise ValueError(f"{flag} must end in {', '.join(formats)}, got {path!r}")
+    check_output_file(path, flag)
+
+
+def _write_table(path: str, csv_text: str, markdown: str, latex: str) -> None:
+    text = {".csv": csv_text, ".md": markdown, ".tex": latex}[os.path.splitext(path)[1].lower()]
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(text)
+
+
+def _results_dir(path: str) -> None:
+    if not os.path.isdir(path):
+        raise ValueError(f"results directory {path!r} does not exist")
+
+
+def _cmd_stats(args) -> int:
+    from moo import stats
+
+    with _usage():
+        _results_dir(args.dir)
+        if not 0 < args.alpha < 1:
+            raise ValueError(f"alpha must be in (0, 1), got {args.alpha}")
+        _check_table_path("--out", args.out, _TABLE_FORMATS)
+        _check_table_path("--ranks-out", args.ranks_out, _TABLE_FORMATS)
+        _check_table_path("--runs-out", args.runs_out, (".csv",))
+        runs, table = stats.analyse(args.dir, alpha=args.alpha)
+    ranks = stats.friedman(runs, alpha=args.alpha)
+    md, ranks_md = stats.to_markdown(table), stats.ranks_to_markdown(ranks)
+    print(md)
+    print(ranks_md)
+    if args.out is not None:
+        _write_table(args.out, stats.to_csv(table), md, stats.to_latex(table))
+    if args.ranks_out is not None:
+        _write_table(args.ranks_out, stats.ranks_to_csv(ranks), ranks_md, stats.ranks_to_latex(ranks))
+    if args.runs_out is not None:
+        stats.to_csv(runs, args.runs_out)
+    return 0
+
+
+def _cmd_plot(args) -> int:
+    from moo import plots
+    from moo.store import load_records, prepare_results_dir
+
+    with _usage():
+        _results_dir(args.dir)
+        formats = plots.check_formats(args.format)
+        if not 0 < args.alpha < 1:
+            raise ValueError(f"alpha must be in (0, 1), got {args.alpha}")
+        records = load_records(args.dir)
+        if not records:
+            raise ValueError(f"no run records (*/*/seed_*.json) under {args.dir!r}")
+        out = prepare_results_dir(args.out, "--out")
+    for path in plots.plot_results(records, out, formats=formats, alpha=args.alpha):
+        print(path)
+    return 0
+
+
+_COMMANDS = {"run": _cmd_run, "experiment": _cmd_experiment, "stats": _cmd_stats, "plot": _cmd_plot}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; returns the exit code (see the module docstring)."""
+    try:
+        args = _parser().parse_args(argv)
+        return _COMMANDS[args.command](args)
+    except _UsageError as exc:
+        return _error(str(exc), 2)
+    except KeyboardInterrupt:
+        return _error("interrupted; the records written stay, rerun the same command to resume", 130)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ import numpy as np
 # these few array checks are moo's own (robustctl/_validation.py has its own for the control code).
 
 __all__ = ["as_float_array", "as_matrix", "as_objectives", "check_choice", "check_directions", "check_int",
-           "check_real"]
+           "check_positive_scalar", "check_real"]
 
 
 def as_float_array(value, name: str) -> np.ndarray:
@@ -85,6 +85,22 @@ def check_real(value, name: str, *, positive: bool) -> float:
         raise ValueError(f"{name} must be > 0, got {x}")
     if not positive and x < 0:
         raise ValueError(f"{name} must be >= 0, got {x}")
+    return x
+
+
+def check_positive_scalar(value, name: str, *, allow_inf: bool = False) -> float:
+    """A real scalar > 0, a NumPy 0-d array included (``inf`` only if ``allow_inf``; ``bool`` is refused)."""
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
+        arr = np.asarray(value)
+        if arr.shape != () or not np.issubdtype(arr.dtype, np.number) or np.iscomplexobj(arr):
+            raise TypeError(f"{name} must be a real scalar, got {type(value).__name__}")
+    x = float(value)
+    if np.isnan(x):
+        raise ValueError(f"{name} must be a number, got NaN")
+    if np.isinf(x) and not (allow_inf and x > 0):
+        raise ValueError(f"{name} must be finite, got {x}")
+    if x <= 0:
+        raise ValueError(f"{name} must be > 0, got {x}")
     return x
 
 

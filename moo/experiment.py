@@ -1,21 +1,25 @@
-"""Experiment grid: problem x algorithms x {plain, MO-LSP} x independent runs, resumable.
+"""Experiment grid: problem x algorithms x {plain, MO-LSP} x independent runs, resumable, on any executor.
 
 :func:`run_experiment` runs every cell of the grid with :func:`moo.runner.run`
-and writes one JSON record (:meth:`moo.runner.RunResult.to_dict`) per run::
+and stores one JSON record per run (:mod:`moo.store`)::
 
     <out>/<problem>/<algorithm>/seed_<s>.json          plain MOEA
     <out>/<problem>/<algorithm>+molsp/seed_<s>.json    the same MOEA wrapped by MO-LSP
 
 (``<problem>`` carries the number of objectives for DTLZ, e.g. ``dtlz2-m5``.)
+It is :func:`prepare` (check every argument, build the problem once, scan the
+results directory) followed by :meth:`PreparedExperiment.run`.
 
-Writes are atomic: the record goes to a temporary file in the target
-directory, is flushed to disk and renamed over the final name
-(:func:`os.replace`), so a file under its final name is always complete. A
-rerun with the same arguments skips every run whose file exists and holds the
-expected record (problem, objectives, algorithm, variant, seed, budget,
-population, MO-LSP cap); an interrupted experiment therefore continues where
-it stopped and never recomputes a finished run. A file that holds a run with
-*other* settings (say another budget) is an error, never silently mixed in.
+Resuming
+--------
+A rerun skips every run whose file holds the expected record: the same
+problem, objectives, algorithm, variant, seed, budget, population size (the
+one the algorithm uses) and MO-LSP cap. An interrupted experiment therefore
+continues where it stopped and never recomputes a finished run. A file that
+holds a run with *other* settings (say another budget) is an error naming the
+file and the setting, raised before any run starts: results of two settings
+are never mixed. A file that cannot be read (not written by us: the writes are
+atomic) is recomputed and replaced. Runs recorded as failed are retried.
 
 Seeds
 -----
@@ -27,38 +31,54 @@ ones). The same seed serves every algorithm and both variants of run ``i``:
 common random numbers, so the plain MOEA and its MO-LSP version start from the
 same initial population.
 
-Parallelism
------------
-``workers > 1`` runs the grid in a :class:`concurrent.futures.ProcessPoolExecutor`
-(spawned processes); each run is independent and deterministic, so the result
-files do not depend on ``workers``. If a run fails or the experiment is
-interrupted, queued runs are cancelled and the error propagates; the records
-already written stay and a rerun resumes from them.
+Executors
+---------
+The runs are independent and deterministic, so the records do not depend on
+where they run. ``executor=None`` runs them in this process (or, with
+``workers > 1``, in a pool of spawned processes); any
+:class:`concurrent.futures.Executor` can be given instead: a
+:class:`~concurrent.futures.ProcessPoolExecutor`, a Dask cluster's
+``Client.get_executor()``, mpi4py's ``MPIPoolExecutor``
+(:func:`moo.executors.open_executor` opens the first two). Workers compute and
+*return* records; only this process (the driver) writes them, atomically, so
+the workers need no shared file system. A Dask worker lost mid-grid has its
+runs recomputed on the others by the scheduler; the driver keeps every
+record that arrived.
+
+Failures
+--------
+A run that raises is recorded beside its cell as ``seed_<s>.failed.json``
+(settings, error, traceback). Without ``keep_going`` the first failure stops
+the grid (:class:`RunFailedError`; queued runs are cancelled, the records
+already written stay, and a rerun resumes); with ``keep_going`` the grid goes
+on and the report lists the failures. A failure of the executor itself
+(``BrokenProcessPool`` when a pool process is killed, Dask's ``KilledWorker``
+when a run has killed several workers) stops the grid in the same way.
 """
 
 from __future__ import annotations
 
-import json
 import os
 import sys
-import tempfile
 import time
+import traceback
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
-from multiprocessing import get_context
+from concurrent.futures import Executor, as_completed
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from moo._validation import check_int
 from moo.algorithms import ALGORITHMS
+from moo.algorithms.operators import POP_SIZE
+from moo.store import FAILED_SUFFIX, load_records, prepare_results_dir, read_record, write_json_atomic
 
-__all__ = ["RunSpec", "ExperimentReport", "plan", "run_seeds", "run_experiment", "load_records",
-           "write_json_atomic"]
+__all__ = ["RunSpec", "ExperimentReport", "PreparedExperiment", "RunFailedError", "plan", "run_seeds",
+           "prepare", "run_experiment", "load_records", "write_json_atomic"]
 
 # Fields of a record that must match its RunSpec for the file to count as done.
-_MATCH = ("problem", "n_obj", "algorithm", "molsp", "seed", "budget", "max_leaders")
+_MATCH = ("problem", "n_obj", "algorithm", "molsp", "seed", "budget", "pop_size", "max_leaders")
 
 
 @dataclass(frozen=True)
@@ -72,7 +92,7 @@ class RunSpec:
     run_index: int
     seed: int
     evals: int
-    pop_size: int = 92
+    pop_size: int = POP_SIZE
     max_leaders: int | None = None
 
     @property
@@ -80,24 +100,43 @@ class RunSpec:
         """Directory name of the algorithm variant: ``name`` or ``name+molsp``."""
         return f"{self.algorithm}+molsp" if self.molsp else self.algorithm
 
+    @property
+    def label(self) -> str:
+        """``problem/variant run i (seed s)``, for messages."""
+        return f"{problem_dir(self.problem, self.n_obj)}/{self.variant} run {self.run_index} (seed {self.seed})"
+
     def path(self, out: str | os.PathLike) -> Path:
         """``<out>/<problem>/<variant>/seed_<seed>.json``."""
         return Path(out) / problem_dir(self.problem, self.n_obj) / self.variant / f"seed_{self.seed}.json"
 
+    def failed_path(self, out: str | os.PathLike) -> Path:
+        """``<out>/<problem>/<variant>/seed_<seed>.failed.json``: the record of a failed run."""
+        return self.path(out).with_name(f"seed_{self.seed}{FAILED_SUFFIX}")
+
 
 @dataclass(frozen=True)
 class ExperimentReport:
-    """What :func:`run_experiment` did: grid size, runs skipped (already done) and run now."""
+    """What a grid run did: its size, runs skipped (already done), run now, and the failures."""
 
     out: Path
     total: int
     skipped: int
     completed: int
     wall_time: float
+    failed: tuple[Path, ...] = ()
 
     def __repr__(self) -> str:
+        fails = f", {len(self.failed)} failed" if self.failed else ""
         return (f"ExperimentReport({self.out}: {self.total} runs, {self.skipped} already done, "
-                f"{self.completed} run now in {self.wall_time:.1f} s)")
+                f"{self.completed} run now{fails} in {self.wall_time:.1f} s)")
+
+
+class RunFailedError(RuntimeError):
+    """A run of the grid raised; ``path`` is its failure record (with the traceback)."""
+
+    def __init__(self, spec: RunSpec, path: Path, error: str):
+        super().__init__(f"run {spec.label} failed: {error} (traceback in {path})")
+        self.spec, self.path, self.error = spec, path, error
 
 
 def problem_dir(problem: str, n_obj: int | None) -> str:
@@ -107,7 +146,7 @@ def problem_dir(problem: str, n_obj: int | None) -> str:
 
 
 def run_seeds(runs: int, base_seed: int = 0) -> list[int]:
-    """The integer seeds of runs ``0 .. runs-1`` (see the module docstring)."""
+    """The integer seeds of runs ``0`` to ``runs - 1`` (see the module docstring)."""
     runs = check_int(runs, "runs", 1)
     base_seed = check_int(base_seed, "base_seed", 0)
     return [int(child.generate_state(1)[0]) for child in np.random.SeedSequence(base_seed).spawn(runs)]
@@ -130,7 +169,7 @@ def _algorithms(algorithms: str | Sequence[str]) -> list[str]:
 
 
 def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int, n_obj: int | None = None,
-         base_seed: int = 0, pop_size: int = 92, max_leaders: int | None = None,
+         base_seed: int = 0, pop_size: int = POP_SIZE, max_leaders: int | None = None,
          variants: Sequence[bool] = (False, True)) -> list[RunSpec]:
     """The grid as a list of :class:`RunSpec`, ordered run index first.
 
@@ -175,81 +214,66 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
             for i, s in enumerate(seeds) for name in names for v in variants]
 
 
-def write_json_atomic(path: str | os.PathLike, data: dict) -> None:
-    """Write ``data`` as JSON to ``path`` atomically (temp file in the same directory + rename).
+# ---------------------------------------------------------------------------- the store scan
 
-    The directory is created if needed. On any failure the temporary file is
-    removed and ``path`` is left as it was.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            json.dump(data, fh, indent=1)
-            fh.write("\n")
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-
-
-def _expected(spec: RunSpec) -> dict:
-    return {"problem": spec.problem, "n_obj": spec.n_obj, "algorithm": spec.algorithm, "molsp": spec.molsp,
-            "seed": spec.seed, "budget": spec.evals, "max_leaders": spec.max_leaders}
-
-
-def _is_done(spec: RunSpec, out: Path) -> bool:
+def _is_done(spec: RunSpec, out: Path, expected: dict) -> bool:
     """True if the spec's file holds its record; False if absent or unreadable; error if another run."""
     path = spec.path(out)
     if not path.is_file():
         return False
     try:
-        rec = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        rec = read_record(path, required=(*_MATCH, "F"))
+    except ValueError:
         return False                      # unreadable (not written by us): recompute and replace
-    if not isinstance(rec, dict) or not {*_MATCH, "F"} <= rec.keys():
-        return False
-    expected = _expected(spec)
-    if expected["n_obj"] is None:
-        expected.pop("n_obj")
-    wrong = {k: rec[k] for k, v in expected.items() if rec[k] != v}
+    wrong = {k: (rec[k], v) for k, v in expected.items() if rec[k] != v}
     if wrong:
-        raise ValueError(f"{path} holds a run with other settings ({wrong}, expected "
-                         f"{ {k: expected[k] for k in wrong} }); use another out directory")
+        what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, (got, want) in wrong.items())
+        raise ValueError(f"{path} holds a run with other settings: {what}; use another out directory "
+                         "or the settings of that run")
     return True
 
 
-def _execute(spec: RunSpec, out: str) -> tuple[str, float]:
-    """Run one spec and write its record (worker entry point; importable for spawned processes)."""
-    from moo.runner import run
+def _expected(spec: RunSpec, n_obj: int, pop_sizes: dict[str, int]) -> dict:
+    return {"problem": spec.problem, "n_obj": n_obj, "algorithm": spec.algorithm, "molsp": spec.molsp,
+            "seed": spec.seed, "budget": spec.evals, "pop_size": pop_sizes[spec.algorithm],
+            "max_leaders": spec.max_leaders}
 
-    result = run(spec.problem, spec.algorithm, seed=spec.seed, evals=spec.evals, n_obj=spec.n_obj,
-                 molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders)
+
+# ---------------------------------------------------------------------------- one run (worker side)
+
+def _execute(spec: RunSpec) -> dict:
+    """Run one spec and return its record, or a failure record (worker entry point; writes nothing)."""
+    from moo import runner
+
+    try:
+        result = runner.run(spec.problem, spec.algorithm, seed=spec.seed, evals=spec.evals, n_obj=spec.n_obj,
+                            molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders)
+    except Exception as exc:           # recorded by the driver; KeyboardInterrupt etc. propagate
+        return {"status": "failed", "problem": spec.problem, "n_obj": spec.n_obj, "algorithm": spec.algorithm,
+                "molsp": spec.molsp, "seed": spec.seed, "run_index": spec.run_index, "budget": spec.evals,
+                "pop_size": spec.pop_size, "max_leaders": spec.max_leaders,
+                "error": f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}".rstrip(": "),
+                "traceback": traceback.format_exc()}
     rec = result.to_dict()
     rec["run_index"] = spec.run_index
-    write_json_atomic(spec.path(out), rec)
-    return str(spec.path(out)), result.wall_time
+    return rec
 
+
+# ---------------------------------------------------------------------------- the driver
 
 class _Progress:
-    """``runs done/total, elapsed, ETA`` on one stderr line."""
+    """``[done/total runs] elapsed, ETA`` on one stderr line (ETA over the whole grid)."""
 
     def __init__(self, total: int, skipped: int):
         self.total, self.skipped, self.start = total, skipped, time.perf_counter()
 
-    def update(self, done_now: int, label: str) -> None:
+    def update(self, done_now: int, failed: int, label: str) -> None:
         elapsed = time.perf_counter() - self.start
         remaining = self.total - self.skipped - done_now
-        eta = elapsed / done_now * remaining if done_now else float("nan")
-        eta_txt = "?" if not np.isfinite(eta) else f"{eta:.0f} s"
-        sys.stderr.write(f"\r[{self.skipped + done_now}/{self.total} runs] elapsed {elapsed:.0f} s, "
-                         f"ETA {eta_txt}  {label:<30.30}")
+        eta = f"{elapsed / done_now * remaining:.0f} s" if done_now else "?"
+        fails = f", {failed} failed" if failed else ""
+        sys.stderr.write(f"\r[{self.skipped + done_now}/{self.total} runs{fails}] elapsed {elapsed:.0f} s, "
+                         f"ETA {eta}  {label:<40.40}")
         sys.stderr.flush()
 
     def close(self) -> None:
@@ -257,10 +281,146 @@ class _Progress:
         sys.stderr.flush()
 
 
+@dataclass
+class _Recorder:
+    """Writes what the runs return (records, failure records) and keeps count."""
+
+    out: Path
+    keep_going: bool
+    bar: _Progress | None
+    completed: int = 0
+    failed: list[Path] = field(default_factory=list)
+
+    def add(self, spec: RunSpec, rec: dict) -> None:
+        failed = rec.get("status") == "failed"
+        if failed:
+            write_json_atomic(spec.failed_path(self.out), rec)
+            self.failed.append(spec.failed_path(self.out))
+        else:
+            self.keep(spec, rec)
+        if self.bar is not None:
+            self.bar.update(self.completed + len(self.failed), len(self.failed), spec.label)
+        if failed and not self.keep_going:
+            raise RunFailedError(spec, self.failed[-1], rec["error"])
+
+    def keep(self, spec: RunSpec, rec: dict) -> None:
+        """Write a finished run's record (a failure record is left to :meth:`add`)."""
+        if rec.get("status") == "failed":
+            return
+        write_json_atomic(spec.path(self.out), rec)
+        spec.failed_path(self.out).unlink(missing_ok=True)
+        self.completed += 1
+
+
+def _run_on(executor: Executor, specs: Sequence[RunSpec], recorder: _Recorder) -> None:
+    """Submit every spec, record results as they arrive; on any error cancel the rest, keep what finished."""
+    futures = {executor.submit(_execute, spec): spec for spec in specs}
+    try:
+        for fut in as_completed(list(futures)):
+            recorder.add(futures.pop(fut), fut.result())
+    finally:
+        for fut in futures:
+            fut.cancel()
+        for fut, spec in futures.items():          # finished while we were stopping: keep them
+            if fut.done() and not fut.cancelled() and fut.exception() is None:
+                recorder.keep(spec, fut.result())
+
+
+@dataclass(frozen=True, repr=False)
+class PreparedExperiment:
+    """A checked grid and the state of its results directory (see :func:`prepare`)."""
+
+    specs: tuple[RunSpec, ...]
+    out: Path
+    todo: tuple[RunSpec, ...]
+    retried: int
+
+    @property
+    def skipped(self) -> int:
+        """Runs already recorded."""
+        return len(self.specs) - len(self.todo)
+
+    def __repr__(self) -> str:
+        return (f"PreparedExperiment({self.out}: {len(self.specs)} runs, {self.skipped} already done, "
+                f"{len(self.todo)} to run)")
+
+    def run(self, executor: Executor | None = None, *, keep_going: bool = False,
+            progress: bool | None = None) -> ExperimentReport:
+        """Run the runs not yet recorded and write their records.
+
+        Parameters
+        ----------
+        executor : concurrent.futures.Executor, optional
+            Where the runs go (see the module docstring); ``None``: one after
+            the other in this process. The executor is not shut down.
+        keep_going : bool
+            Record a failed run and go on (default: stop at the first failure).
+        progress : bool, optional
+            ``runs done/total``, the failures and an ETA on stderr; default:
+            only when stderr is a terminal.
+
+        Raises
+        ------
+        RunFailedError
+            A run raised (without ``keep_going``).
+        """
+        if executor is not None and not isinstance(executor, Executor):
+            raise TypeError(f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}")
+        show = sys.stderr.isatty() if progress is None else bool(progress)
+        bar = _Progress(len(self.specs), self.skipped) if show else None
+        recorder = _Recorder(self.out, bool(keep_going), bar)
+        start = time.perf_counter()
+        try:
+            if bar is not None:
+                bar.update(0, 0, "")
+            if executor is None:
+                for spec in self.todo:
+                    recorder.add(spec, _execute(spec))
+            else:
+                _run_on(executor, self.todo, recorder)
+        finally:
+            if bar is not None:
+                bar.close()
+        return ExperimentReport(out=self.out, total=len(self.specs), skipped=self.skipped,
+                                completed=recorder.completed, wall_time=time.perf_counter() - start,
+                                failed=tuple(recorder.failed))
+
+
+def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int, out: str | os.PathLike,
+            n_obj: int | None = None, base_seed: int = 0, pop_size: int = POP_SIZE,
+            max_leaders: int | None = None, variants: Sequence[bool] = (False, True)) -> PreparedExperiment:
+    """Check the grid of :func:`plan`, create ``out`` and find the runs already recorded there.
+
+    Every check happens here, before any run: the arguments of :func:`plan`,
+    the budget against each algorithm's population (the problem is built
+    once), ``out`` (a directory that can be written), and the records already
+    in ``out`` (another setting in any of them is an error).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A bad argument, an unusable ``out``, or ``out`` holding a run of the
+        grid with other settings (the message names the file).
+    """
+    from moo.problems import make_problem
+    from moo.runner import check_budget
+
+    specs = plan(problem, algorithms, runs=runs, evals=evals, n_obj=n_obj, base_seed=base_seed,
+                 pop_size=pop_size, max_leaders=max_leaders, variants=variants)
+    prob = make_problem(problem, n_obj)
+    pop_sizes = {name: int(check_budget(prob, name, evals=specs[0].evals, pop_size=specs[0].pop_size).pop_size)
+                 for name in dict.fromkeys(s.algorithm for s in specs)}
+    out = prepare_results_dir(out)
+    todo = tuple(s for s in specs if not _is_done(s, out, _expected(s, prob.n_obj, pop_sizes)))
+    retried = sum(s.failed_path(out).is_file() for s in todo)
+    return PreparedExperiment(specs=tuple(specs), out=out, todo=todo, retried=retried)
+
+
 def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int,
-                   out: str | os.PathLike, n_obj: int | None = None, base_seed: int = 0, pop_size: int = 92,
+                   out: str | os.PathLike, n_obj: int | None = None, base_seed: int = 0, pop_size: int = POP_SIZE,
                    max_leaders: int | None = None, variants: Sequence[bool] = (False, True),
-                   workers: int = 1, progress: bool | None = None) -> ExperimentReport:
+                   workers: int = 1, executor: Executor | None = None, keep_going: bool = False,
+                   progress: bool | None = None) -> ExperimentReport:
     """Run the grid of :func:`plan` into ``out``, skipping runs already recorded.
 
     Parameters are those of :func:`plan`, plus:
@@ -268,7 +428,14 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
     out : path-like
         Results directory (created if needed).
     workers : int
-        Processes running the grid (1: in this process).
+        Without ``executor``: processes running the grid (1: in this process).
+    executor : concurrent.futures.Executor, optional
+        Run the grid there instead (a Dask ``Client.get_executor()``, a
+        ``ProcessPoolExecutor``, mpi4py's ``MPIPoolExecutor``, ...); it is
+        not shut down.
+    keep_going : bool
+        Record a failed run (``seed_<s>.failed.json``, with its traceback)
+        and go on; default: stop at the first failure.
     progress : bool, optional
         Show ``runs done/total`` and an ETA on stderr; default: only when
         stderr is a terminal.
@@ -279,62 +446,20 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
 
     Raises
     ------
-    ValueError
+    ValueError, TypeError
         Bad arguments, or ``out`` holds a run of the same cell with other
-        settings.
+        settings; raised before any run starts.
+    RunFailedError
+        A run raised (without ``keep_going``); the records written stay.
     """
-    specs = plan(problem, algorithms, runs=runs, evals=evals, n_obj=n_obj, base_seed=base_seed,
-                 pop_size=pop_size, max_leaders=max_leaders, variants=variants)
+    from moo.executors import open_executor
+
     workers = check_int(workers, "workers", 1)
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"out must be a directory, {str(out)!r} is a file")
-    out.mkdir(parents=True, exist_ok=True)
-    todo = [s for s in specs if not _is_done(s, out)]
-    show = sys.stderr.isatty() if progress is None else bool(progress)
-    bar = _Progress(len(specs), len(specs) - len(todo)) if show else None
-    start = time.perf_counter()
-    done = 0
-    try:
-        if bar is not None:
-            bar.update(0, "")
-        if workers == 1 or len(todo) <= 1:
-            for spec in todo:
-                _execute(spec, str(out))
-                done += 1
-                if bar is not None:
-                    bar.update(done, f"{spec.variant} s{spec.run_index}")
-        else:
-            pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
-            try:
-                futures = {pool.submit(_execute, spec, str(out)): spec for spec in todo}
-                for fut in as_completed(futures):
-                    fut.result()
-                    done += 1
-                    if bar is not None:
-                        spec = futures[fut]
-                        bar.update(done, f"{spec.variant} s{spec.run_index}")
-            except BaseException:
-                # interrupted or a run failed: drop the queued runs (finished files stay) and re-raise
-                pool.shutdown(wait=False, cancel_futures=True)
-                raise
-            pool.shutdown()
-    finally:
-        if bar is not None:
-            bar.close()
-    return ExperimentReport(out=out, total=len(specs), skipped=len(specs) - len(todo), completed=done,
-                            wall_time=time.perf_counter() - start)
-
-
-def load_records(out: str | os.PathLike) -> list[dict]:
-    """Every run record under ``out`` (``*/*/seed_*.json``), sorted by path; temp files ignored."""
-    out = Path(out)
-    if not out.is_dir():
-        raise ValueError(f"results directory {str(out)!r} does not exist")
-    records = []
-    for path in sorted(out.glob("*/*/seed_*.json")):
-        rec = json.loads(path.read_text(encoding="utf-8"))
-        rec["_path"] = str(path)
-        rec["_problem_dir"] = path.parent.parent.name
-        records.append(rec)
-    return records
+    if executor is not None and workers != 1:
+        raise ValueError("give workers (a local process pool) or executor, not both")
+    grid = prepare(problem, algorithms, runs=runs, evals=evals, out=out, n_obj=n_obj, base_seed=base_seed,
+                   pop_size=pop_size, max_leaders=max_leaders, variants=variants)
+    if executor is not None:
+        return grid.run(executor, keep_going=keep_going, progress=progress)
+    with open_executor("process", workers=workers if len(grid.todo) > 1 else 1) as pool:
+        return grid.run(pool, keep_going=keep_going, progress=progress)

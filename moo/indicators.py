@@ -7,16 +7,16 @@ assess. ``ref_set`` is a reference set ``P*`` sampling the true front (for the
 control-design MOPs, whose front is unknown, the non-dominated union of all
 runs, see PAPER_NOTES.md).
 
-=================  =====================  ========  ======================================
-indicator          function               better    source
-=================  =====================  ========  ======================================
-IGD                :func:`igd`            lower     Coello & Reyes Sierra (2004)
-IGD+               :func:`igd_plus`       lower     Ishibuchi et al. (2015); moocore
-Spacing (SP)       :func:`spacing`        lower     Schott (1995)
-Hypervolume (HV)   :func:`hypervolume`    higher    While et al. (2006); moocore
-Pure diversity     :func:`pure_diversity` higher    Wang, Jin & Yao (2017)
-Spread             :func:`spread`         lower     Zhou et al. (2006); Wang, Wu & Yuan (2010)
-=================  =====================  ========  ======================================
+=================  =======================  ========  ==========================================
+indicator          function                 better    source
+=================  =======================  ========  ==========================================
+IGD                :func:`igd`              lower     Coello & Reyes Sierra (2004)
+IGD+               :func:`igd_plus`         lower     Ishibuchi et al. (2015); moocore
+Spacing (SP)       :func:`spacing`          lower     Schott (1995)
+Hypervolume (HV)   :func:`hypervolume`      higher    While et al. (2006); moocore
+Pure diversity     :func:`pure_diversity`   higher    Wang, Jin & Yao (2017)
+Spread             :func:`spread`           lower     Zhou et al. (2006); Wang, Wu & Yuan (2010)
+=================  =======================  ========  ==========================================
 
 Scale. Every indicator is computed on the objective vectors divided by a
 common power of two (the largest magnitude in ``F``, ``ref_set`` and

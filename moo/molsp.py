@@ -339,7 +339,7 @@ def molsp(algorithm: Algorithm, *, ref_point: ArrayLike, max_leaders: int | None
     ----------
     algorithm : pymoo Algorithm
         Not yet set up (``minimize``/``setup`` not called), with a ``survival``
-        operator and a ``pop_size``: every :class:`GeneticAlgorithm`-based MOEA.
+        operator and a ``pop_size``: every :class:`~pymoo.algorithms.base.genetic.GeneticAlgorithm`-based MOEA.
         It is deep-copied; the argument is left untouched.
     ref_point : array_like, shape (n_obj,)
         The fixed reference point ``r`` of the leader choice (checked against the

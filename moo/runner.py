@@ -1,6 +1,9 @@
 """One optimisation run: problem and MOEA by name, optional MO-LSP, an evaluation budget.
 
-:func:`run` builds the problem (:func:`moo.problems.make_problem`) and the
+:func:`prepare` checks every argument and builds the problem and the algorithm
+once (a bad argument raises ``ValueError``/``TypeError`` naming it, before any
+work); :meth:`PreparedRun.run` then runs it. :func:`run` does both. In detail,
+:func:`prepare` builds the problem (:func:`moo.problems.make_problem`) and the
 algorithm (:func:`moo.algorithms.make_algorithm`), wraps it with MO-LSP
 (:func:`moo.molsp.molsp`, reference point ``problem.molsp_ref_point``) if
 asked, runs it with pymoo's ``("n_eval", evals)`` termination and records the
@@ -15,10 +18,39 @@ offspring batch (MO-LSP's mutants never add to the overshoot, see
 Randomness: the seed goes to pymoo's ``setup``, which makes the run's only
 Generator (``algorithm.random_state``); the global numpy state is not touched.
 Same arguments, same result.
+
+The record
+----------
+:meth:`RunResult.to_dict` is the JSON record that ``python -m moo run`` and
+``python -m moo experiment`` write (plain JSON types; arrays as nested lists):
+
+=================  ==========================================================
+``problem``        problem name (lower case), ``n_obj`` its objectives
+``algorithm``      registry name; ``molsp`` true for the MO-LSP version
+``max_leaders``    MO-LSP's cap on candidates per generation (null: none)
+``seed``           the run's seed
+``pop_size``       population size used (reference-direction algorithms
+                   may enlarge the one asked for)
+``budget``         evaluation budget; ``n_evals`` evaluations used (at
+                   most one offspring batch more); ``molsp_evals`` of them
+                   spent on MO-LSP mutants
+``n_gen``          generations, the initial one included
+``hv``             hypervolume of the final set at ``hv_ref_point``
+``F``, ``X``       objectives and decision vectors of the final
+                   non-dominated set (``|F| x n_obj``, ``|F| x n_var``)
+``hv_ref_point``   hypervolume reference point; ``molsp_ref_point`` MO-LSP's
+                   (null for a plain run)
+``hv_history``     ``{"evaluations": [...], "hypervolume": [...]}`` after
+                   every generation
+``wall_time_s``    seconds spent in the run
+``versions``       Python and package versions
+``run_index``      (experiment records only) the run's index in the grid
+=================  ==========================================================
 """
 
 from __future__ import annotations
 
+import copy
 import platform
 import time
 from collections.abc import Callable
@@ -32,11 +64,12 @@ from pymoo.core.population import Population
 
 from moo._validation import check_int
 from moo.algorithms import make_algorithm
+from moo.algorithms.operators import POP_SIZE
 from moo.indicators import hypervolume
 from moo.molsp import molsp as add_molsp
 from moo.problems import make_problem
 
-__all__ = ["RunResult", "run"]
+__all__ = ["RunResult", "PreparedRun", "prepare", "run", "check_budget"]
 
 
 def _versions() -> dict[str, str]:
@@ -51,7 +84,7 @@ def _versions() -> dict[str, str]:
 
 @dataclass(frozen=True, repr=False)
 class RunResult:
-    """The record of one run (see :func:`run`); :meth:`to_dict` gives its JSON form.
+    """The record of one run (see :func:`run`); :meth:`~RunResult.to_dict` gives its JSON form.
 
     ``F``/``X`` are the objectives and decision vectors of the final
     non-dominated set (of the final population together with the algorithm's
@@ -141,10 +174,62 @@ class _HVHistory(Callback):
             self.progress(n_eval, self.budget)
 
 
-def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,
-        molsp: bool = False, pop_size: int = 92, max_leaders: int | None = None,
-        progress: Callable[[int, int], None] | None = None) -> RunResult:
-    """Run one MOEA (optionally with MO-LSP) on one problem to an evaluation budget.
+def check_budget(problem, algorithm: str, *, evals: int, pop_size: int = POP_SIZE):
+    """The algorithm ``algorithm`` built for ``problem`` (a pymoo problem); ``ValueError`` if
+    ``evals`` is below the population size it uses."""
+    alg = make_algorithm(algorithm, n_obj=problem.n_obj, pop_size=pop_size)
+    if evals < alg.pop_size:
+        raise ValueError(f"evals must be at least the population size of {algorithm} ({alg.pop_size}), "
+                         f"got {evals}")
+    return alg
+
+
+@dataclass(frozen=True, repr=False)
+class PreparedRun:
+    """A run whose arguments are checked and whose problem and algorithm are built (see :func:`prepare`)."""
+
+    problem_name: str
+    algorithm_name: str
+    seed: int
+    evals: int
+    molsp: bool
+    max_leaders: int | None
+    problem: object
+    algorithm: object
+
+    def __repr__(self) -> str:
+        tag = "+molsp" if self.molsp else ""
+        return (f"PreparedRun({self.algorithm_name}{tag} on {self.problem_name} (M={self.problem.n_obj}), "
+                f"seed={self.seed}, evals={self.evals})")
+
+    def run(self, progress: Callable[[int, int], None] | None = None) -> RunResult:
+        """Run it (on a copy of the algorithm, so a prepared run can be run again: same result).
+
+        ``progress`` is called as ``progress(n_evals, evals)`` after every generation.
+        """
+        prob, alg = self.problem, copy.deepcopy(self.algorithm)
+        hv_ref = np.asarray(prob.hv_ref_point, dtype=float)
+        history = _HVHistory(hv_ref, progress, self.evals)
+        start = time.perf_counter()
+        alg.setup(prob, termination=("n_eval", self.evals), seed=self.seed, callback=history, verbose=False)
+        while alg.has_next():
+            alg.next()
+        wall = time.perf_counter() - start
+
+        F, X = _front(alg)
+        molsp_ref = np.asarray(prob.molsp_ref_point, dtype=float) if self.molsp else None
+        return RunResult(
+            problem=self.problem_name, n_obj=prob.n_obj, algorithm=self.algorithm_name, molsp=self.molsp,
+            max_leaders=self.max_leaders, seed=self.seed, pop_size=int(alg.pop_size), budget=self.evals,
+            n_evals=int(alg.evaluator.n_eval), n_gen=len(history.rows),
+            molsp_evals=int(alg.data.get("molsp_n_eval", 0)), F=F, X=X, hv_ref_point=hv_ref,
+            molsp_ref_point=molsp_ref, hv_history=np.array(history.rows, dtype=float).reshape(-1, 2),
+            wall_time=wall, versions=_versions())
+
+
+def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,
+            molsp: bool = False, pop_size: int = POP_SIZE, max_leaders: int | None = None) -> PreparedRun:
+    """Check the arguments of one run and build its problem and algorithm (once).
 
     Parameters
     ----------
@@ -161,45 +246,51 @@ def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | Non
     molsp : bool
         Wrap the algorithm with MO-LSP (reference point ``problem.molsp_ref_point``).
     pop_size : int
-        Population size (the paper's 92 by default; reference-direction
-        algorithms may enlarge it, the size used is recorded).
+        Population size (the paper's 92, :data:`moo.algorithms.operators.POP_SIZE`,
+        by default; reference-direction algorithms may enlarge it, the size
+        used is recorded).
     max_leaders : int, optional
         MO-LSP's cap on candidates per generation (default: none, the paper's).
-    progress : callable, optional
-        Called as ``progress(n_evals, evals)`` after every generation.
 
     Returns
     -------
-    RunResult
+    PreparedRun
+
+    Raises
+    ------
+    ValueError, TypeError
+        A bad argument (the message names it).
+    NotImplementedError
+        A registered problem or algorithm whose module is not available.
     """
     seed = check_int(seed, "seed", 0)
     evals = check_int(evals, "evals", 1)
     pop_size = check_int(pop_size, "pop_size", 4)
+    if not isinstance(molsp, (bool, np.bool_)):
+        raise TypeError(f"molsp must be a bool, got {type(molsp).__name__}")
     if max_leaders is not None:
         max_leaders = check_int(max_leaders, "max_leaders", 1)
         if not molsp:
             raise ValueError("max_leaders needs molsp=True")
     prob = make_problem(problem, n_obj)
-    alg = make_algorithm(algorithm, n_obj=prob.n_obj, pop_size=pop_size)
-    if evals < alg.pop_size:
-        raise ValueError(f"evals must be at least the population size ({alg.pop_size}), got {evals}")
-    hv_ref = np.asarray(prob.hv_ref_point, dtype=float)
-    molsp_ref = np.asarray(prob.molsp_ref_point, dtype=float) if molsp else None
+    alg = check_budget(prob, algorithm, evals=evals, pop_size=pop_size)
     if molsp:
-        alg = add_molsp(alg, ref_point=molsp_ref, max_leaders=max_leaders)
+        alg = add_molsp(alg, ref_point=np.asarray(prob.molsp_ref_point, dtype=float), max_leaders=max_leaders)
+    return PreparedRun(problem_name=problem.lower(), algorithm_name=algorithm.lower(), seed=seed, evals=evals,
+                       molsp=bool(molsp), max_leaders=max_leaders, problem=prob, algorithm=alg)
 
-    history = _HVHistory(hv_ref, progress, evals)
-    start = time.perf_counter()
-    alg.setup(prob, termination=("n_eval", evals), seed=seed, callback=history, verbose=False)
-    while alg.has_next():
-        alg.next()
-    wall = time.perf_counter() - start
 
-    F, X = _front(alg)
-    return RunResult(
-        problem=problem.lower(), n_obj=prob.n_obj, algorithm=algorithm.lower(), molsp=bool(molsp),
-        max_leaders=max_leaders, seed=seed, pop_size=int(alg.pop_size), budget=evals,
-        n_evals=int(alg.evaluator.n_eval), n_gen=len(history.rows),
-        molsp_evals=int(alg.data.get("molsp_n_eval", 0)), F=F, X=X, hv_ref_point=hv_ref,
-        molsp_ref_point=molsp_ref, hv_history=np.array(history.rows, dtype=float).reshape(-1, 2),
-        wall_time=wall, versions=_versions())
+def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,
+        molsp: bool = False, pop_size: int = POP_SIZE, max_leaders: int | None = None,
+        progress: Callable[[int, int], None] | None = None) -> RunResult:
+    """Run one MOEA (optionally with MO-LSP) on one problem to an evaluation budget.
+
+    The arguments are those of :func:`prepare` (which checks them), plus
+    ``progress``, called as ``progress(n_evals, evals)`` after every generation.
+
+    Returns
+    -------
+    RunResult
+    """
+    return prepare(problem, algorithm, seed=seed, evals=evals, n_obj=n_obj, molsp=molsp, pop_size=pop_size,
+                   max_leaders=max_leaders).run(progress)

@@ -1,11 +1,13 @@
-"""Indicators per run and the paper's statistics (ANOVA + Tukey HSD, MOEA vs MOEA/MO-LSP).
+"""Indicators per run and the statistics: the paper's ANOVA + Tukey HSD, Wilcoxon-Holm, Friedman-Nemenyi.
 
 Pipeline (``python -m moo stats DIR``)::
 
-    records = load_records(DIR)              # moo.experiment: one dict per run
+    records = load_records(DIR)              # moo.store: one dict per run
     runs    = run_indicators(records)        # five indicators per run (RunIndicators)
     table   = compare(runs)                  # one Comparison per (problem, algorithm, indicator)
     to_markdown(table) / to_csv(...) / to_latex(...)
+    ranks   = friedman(runs)                 # one FriedmanResult per (problem, indicator)
+    ranks_to_markdown(ranks) / ranks_to_csv(...) / ranks_to_latex(...)
 
 Indicators (:mod:`moo.indicators`) on each run's final non-dominated set ``F``:
 
@@ -33,10 +35,38 @@ tables bold the *larger* SP as the better one); ``significant`` is
 ``p_tukey < alpha``. If both groups are constant the tests are undefined: p is
 1 when the two constants are equal and 0 otherwise.
 
+Nonparametric statistics, as the EMO community reports them:
+
+* **Wilcoxon rank-sum** (Mann-Whitney U, two-sided,
+  :func:`scipy.stats.mannwhitneyu`; exact for small samples without ties,
+  the normal approximation with tie correction otherwise) between each MOEA
+  and its MO-LSP version, with **Holm's** step-down correction (:func:`holm`)
+  over the family of the MOEAs compared on one problem and indicator (one
+  column of the table): ``p_wilcoxon_holm``, ``significant_wilcoxon``.
+* **Friedman** test (:func:`scipy.stats.friedmanchisquare`, chi-square with
+  the tie correction) over all variants (every MOEA, plain and MO-LSP) on one
+  problem and indicator, with the runs as blocks: run ``i`` of every variant
+  shares its seed (common random numbers, :mod:`moo.experiment`), so the
+  values of one seed form a block. Only seeds with a finite value for every
+  variant count. Ranks are 1 for the best value of a block (ties share the
+  mean rank). **Nemenyi** post-hoc: two variants differ when their mean ranks
+  differ by more than the critical difference
+  ``CD = q_alpha sqrt(k (k + 1) / (6 N))``, ``q_alpha`` the ``1 - alpha``
+  quantile of the Studentized range for ``k`` groups and infinite degrees of
+  freedom divided by ``sqrt(2)`` (:data:`scipy.stats.studentized_range`);
+  :meth:`FriedmanResult.nemenyi_p` gives the pairwise p-values of the same
+  test. Following Demsar, the post-hoc marks are shown only when the
+  Friedman test rejects.
+
 References
 ----------
 J. W. Tukey (1949), "Comparing individual means in the analysis of variance",
-Biometrics 5(2), 99-114; Morais et al. (2022), Section 4.
+Biometrics 5(2), 99-114; S. Holm (1979), "A simple sequentially rejective
+multiple test procedure", Scand. J. Statist. 6(2), 65-70; M. Friedman (1937),
+J. Amer. Statist. Assoc. 32(200), 675-701; P. Nemenyi (1963), "Distribution-free
+multiple comparisons", PhD thesis, Princeton; J. Demsar (2006), "Statistical
+comparisons of classifiers over multiple data sets", JMLR 7, 1-30;
+Morais et al. (2022), Section 4.
 """
 
 from __future__ import annotations
@@ -45,10 +75,11 @@ import csv
 import io
 import math
 import os
+import re
 import warnings
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
 import moocore
@@ -57,15 +88,23 @@ from numpy.typing import ArrayLike
 from scipy import stats as sps
 
 from moo import indicators as ind
+from moo.algorithms import ALGORITHMS
+from moo.experiment import problem_dir
 
-__all__ = ["INDICATORS", "HIGHER_IS_BETTER", "RunIndicators", "Comparison", "true_front", "reference_sets",
-           "run_indicators", "pairwise_test", "compare", "to_csv", "to_markdown", "to_latex", "analyse"]
+__all__ = ["INDICATORS", "HIGHER_IS_BETTER", "LABELS", "RunIndicators", "Comparison", "FriedmanResult", "true_front",
+           "reference_sets", "run_indicators", "pairwise_test", "rank_sum_test", "holm", "friedman_test",
+           "nemenyi_cd", "registry_order", "compare", "friedman", "to_csv", "to_markdown", "to_latex", "ranks_to_csv",
+           "ranks_to_markdown", "ranks_to_latex", "analyse"]
 
-#: Indicator names in the paper's column order.
+#: Indicator names in the paper's column order. (A new indicator, e.g. IGD+ once
+#: moo.indicators has it, is one entry here, in HIGHER_IS_BETTER and _LABELS, a
+#: field of RunIndicators and one line in run_indicators.)
 INDICATORS: tuple[str, ...] = ("igd", "sp", "hv", "pd", "spread")
 #: Direction of each indicator (True: larger is better).
 HIGHER_IS_BETTER: dict[str, bool] = {"igd": False, "sp": False, "hv": True, "pd": True, "spread": False}
-_LABELS = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
+#: Column labels of the indicators.
+LABELS: dict[str, str] = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
+_LABELS = LABELS
 
 _TRUE_FRONT_POINTS = 5000
 
@@ -103,7 +142,56 @@ class Comparison:
     p_anova: float
     p_tukey: float
     better: str            # "molsp", "plain" or "tie"
-    significant: bool
+    significant: bool      # Tukey HSD at alpha
+    p_wilcoxon: float = float("nan")          # rank-sum, two-sided
+    p_wilcoxon_holm: float = float("nan")     # Holm-adjusted over the MOEAs of (problem, indicator)
+    significant_wilcoxon: bool = False        # p_wilcoxon_holm < alpha
+    alpha: float = 0.05
+
+
+@dataclass(frozen=True)
+class FriedmanResult:
+    """Friedman test over the variants of one problem and indicator, with Nemenyi's critical difference.
+
+    ``variants`` are ``name`` (plain) and ``name+molsp``; ``mean_ranks`` their
+    mean ranks over the ``n_blocks`` runs (1 = best); ``statistic`` the
+    tie-corrected chi-square and ``p_value`` its p; ``cd`` the Nemenyi
+    critical difference at ``alpha``. NaN when fewer than two variants or two
+    blocks are available.
+    """
+
+    problem: str
+    indicator: str
+    variants: tuple[str, ...]
+    mean_ranks: tuple[float, ...]
+    n_blocks: int
+    statistic: float
+    p_value: float
+    cd: float
+    alpha: float
+
+    @property
+    def rejects(self) -> bool:
+        """The Friedman test rejects equal performance at ``alpha``."""
+        return bool(np.isfinite(self.p_value) and self.p_value < self.alpha)
+
+    def nemenyi_p(self) -> np.ndarray:
+        """``(k, k)`` p-values of Nemenyi's test, ``p_ij < alpha`` exactly when ``|R_i - R_j| > cd``."""
+        k, n = len(self.variants), self.n_blocks
+        R = np.asarray(self.mean_ranks, dtype=float)
+        if k < 2 or n < 2:
+            return np.full((k, k), np.nan)
+        q = np.abs(R[:, None] - R[None, :]) / math.sqrt(k * (k + 1) / (12.0 * n))
+        p = np.ones((k, k))
+        iu = np.triu_indices(k, 1)
+        p[iu] = sps.studentized_range.sf(q[iu], k, np.inf)
+        p.T[iu] = p[iu]
+        return p
+
+    def differs(self, a: str, b: str) -> bool:
+        """Variants ``a`` and ``b`` differ by Nemenyi's test (mean ranks further apart than ``cd``)."""
+        i, j = self.variants.index(a), self.variants.index(b)
+        return bool(abs(self.mean_ranks[i] - self.mean_ranks[j]) > self.cd)
 
 
 # ---------------------------------------------------------------------------- reference sets
@@ -252,6 +340,77 @@ def pairwise_test(plain: ArrayLike, molsp: ArrayLike) -> tuple[float, float]:
     return p_anova, p_tukey
 
 
+def rank_sum_test(plain: ArrayLike, molsp: ArrayLike) -> float:
+    """Two-sided p-value of the Wilcoxon rank-sum (Mann-Whitney U) test between two samples.
+
+    NaNs are dropped; NaN when a sample has fewer than two values; 1.0 when
+    every value of both samples is the same (no ranks to compare).
+    """
+    a, b = _sample(plain, "plain"), _sample(molsp, "molsp")
+    if len(a) < 2 or len(b) < 2:
+        return float("nan")
+    if np.ptp(np.concatenate([a, b])) == 0:
+        return 1.0
+    return float(sps.mannwhitneyu(a, b, alternative="two-sided").pvalue)
+
+
+def holm(p_values: ArrayLike) -> np.ndarray:
+    """Holm's step-down adjusted p-values (NaN entries stay NaN and do not count in the family).
+
+    With the ``m`` finite p-values sorted, ``p_(1) <= ... <= p_(m)``, the
+    adjusted ones are ``max_{j <= i} min(1, (m - j + 1) p_(j))``; rejecting
+    those below ``alpha`` is Holm's procedure at family-wise level ``alpha``.
+    """
+    p = np.asarray(p_values, dtype=float)
+    if p.ndim != 1:
+        raise ValueError(f"p_values must be 1-D, got shape {p.shape}")
+    out = np.full_like(p, np.nan)
+    ok = np.flatnonzero(np.isfinite(p))
+    if np.any((p[ok] < 0) | (p[ok] > 1)):
+        raise ValueError("p_values must lie in [0, 1]")
+    order = ok[np.argsort(p[ok], kind="stable")]
+    m = len(order)
+    out[order] = np.minimum(1.0, np.maximum.accumulate((m - np.arange(m)) * p[order]))
+    return out
+
+
+def nemenyi_cd(k: int, n_blocks: int, alpha: float = 0.05) -> float:
+    """Nemenyi's critical difference ``q_alpha sqrt(k (k + 1) / (6 N))`` for ``k`` groups and ``N`` blocks."""
+    if k < 2 or n_blocks < 1:
+        return float("nan")
+    q_alpha = sps.studentized_range.ppf(1.0 - alpha, k, np.inf) / math.sqrt(2.0)
+    return float(q_alpha * math.sqrt(k * (k + 1) / (6.0 * n_blocks)))
+
+
+def friedman_test(values: ArrayLike, *, higher_is_better: bool = False, alpha: float = 0.05
+                  ) -> tuple[np.ndarray, float, float, float]:
+    """Friedman test of a ``(N blocks, k treatments)`` table; returns ``(mean_ranks, chi2, p, cd)``.
+
+    Ranks within each block: 1 for the best value (the smallest, or the
+    largest when ``higher_is_better``), ties sharing the mean rank. ``chi2``
+    and ``p`` come from :func:`scipy.stats.friedmanchisquare` (tie-corrected);
+    ``cd`` is :func:`nemenyi_cd`. Needs ``N >= 2``, ``k >= 2`` and finite values;
+    if every block is constant the test is undefined: ``chi2 = 0``, ``p = 1``.
+    """
+    X = np.asarray(values, dtype=float)
+    if X.ndim != 2 or X.shape[0] < 2 or X.shape[1] < 2:
+        raise ValueError(f"values must be a (blocks, treatments) table with at least 2 of each, got shape {X.shape}")
+    if not np.all(np.isfinite(X)):
+        raise ValueError("values must be finite (drop blocks with NaN first)")
+    ranks = sps.rankdata(-X if higher_is_better else X, axis=1)
+    n, k = X.shape
+    cd = nemenyi_cd(k, n, alpha)
+    if np.all(np.ptp(X, axis=1) == 0):
+        return ranks.mean(axis=0), 0.0, 1.0, cd
+    if k == 2:      # scipy needs three treatments; with two, the tie-corrected statistic directly
+        chi2 = float(12.0 / (n * k * (k + 1)) * np.sum(ranks.sum(axis=0) ** 2) - 3.0 * n * (k + 1))
+        ties = sum(np.sum(c ** 3 - c) for row in X for c in [np.unique(row, return_counts=True)[1]])
+        chi2 /= 1.0 - ties / (n * k * (k * k - 1))
+        return ranks.mean(axis=0), chi2, float(sps.chi2.sf(chi2, k - 1)), cd
+    res = sps.friedmanchisquare(*X.T)
+    return ranks.mean(axis=0), float(res.statistic), float(res.pvalue), cd
+
+
 def _better(mean_plain: float, mean_molsp: float, higher: bool) -> str:
     if not (np.isfinite(mean_plain) and np.isfinite(mean_molsp)) or mean_plain == mean_molsp:
         return "tie"
@@ -277,12 +436,9 @@ def compare(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Comparis
     groups: dict[tuple[str, str], dict[bool, list[RunIndicators]]] = {}
     for r in runs:
         groups.setdefault((_pkey(r), r.algorithm), {False: [], True: []})[r.molsp].append(r)
-    from moo.algorithms import ALGORITHMS
-
-    order = {name: i for i, name in enumerate(ALGORITHMS)}
     rows = []
-    for (problem, algorithm), by_variant in sorted(
-            groups.items(), key=lambda kv: (kv[0][0], order.get(kv[0][1], len(order)), kv[0][1])):
+    for (problem, algorithm), by_variant in sorted(groups.items(),
+                                                   key=lambda kv: (kv[0][0], *registry_order(kv[0][1]))):
         for name in INDICATORS:
             a = _sample([getattr(r, name) for r in by_variant[False]], "plain")
             b = _sample([getattr(r, name) for r in by_variant[True]], "molsp")
@@ -293,12 +449,62 @@ def compare(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Comparis
                                    n_molsp=len(b), mean_plain=mp, std_plain=sp_, mean_molsp=mm, std_molsp=sm,
                                    p_anova=p_anova, p_tukey=p_tukey,
                                    better=_better(mp, mm, HIGHER_IS_BETTER[name]),
-                                   significant=bool(np.isfinite(p_tukey) and p_tukey < alpha)))
+                                   significant=bool(np.isfinite(p_tukey) and p_tukey < alpha),
+                                   p_wilcoxon=rank_sum_test(a, b), alpha=alpha))
+    families: dict[tuple[str, str], list[int]] = defaultdict(list)
+    for i, c in enumerate(rows):
+        families[(c.problem, c.indicator)].append(i)
+    for members in families.values():
+        adjusted = holm([rows[i].p_wilcoxon for i in members])
+        for i, p in zip(members, adjusted):
+            rows[i] = replace(rows[i], p_wilcoxon_holm=float(p), significant_wilcoxon=bool(p < alpha))
     return rows
 
 
+def _variant(algorithm: str, molsp: bool) -> str:
+    return f"{algorithm}+molsp" if molsp else algorithm
+
+
+def friedman(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[FriedmanResult]:
+    """Friedman test and Nemenyi's CD over all variants, per problem and indicator (see the module docstring).
+
+    Variants are ordered as the tables' rows (registry order; for each MOEA
+    the MO-LSP version first). Blocks are the seeds run by every variant
+    with a finite value of the indicator.
+    """
+    if not 0 < alpha < 1:
+        raise ValueError(f"alpha must be in (0, 1), got {alpha!r}")
+    by_problem: dict[str, dict[str, dict[int, RunIndicators]]] = defaultdict(lambda: defaultdict(dict))
+    for r in runs:
+        by_problem[_pkey(r)][_variant(r.algorithm, r.molsp)][r.seed] = r
+    out = []
+    for problem in sorted(by_problem):
+        cells = by_problem[problem]
+        algs = sorted({v.removesuffix("+molsp") for v in cells}, key=registry_order)
+        variants = tuple(v for a in algs for v in (_variant(a, True), a) if v in cells)
+        for name in INDICATORS:
+            seeds = sorted(set.intersection(*(set(cells[v]) for v in variants)))
+            table = np.array([[getattr(cells[v][s], name) for v in variants] for s in seeds]).reshape(-1, len(variants))
+            table = table[np.all(np.isfinite(table), axis=1)]
+            if len(variants) < 2 or len(table) < 2:
+                nan = float("nan")
+                out.append(FriedmanResult(problem, name, variants, (nan,) * len(variants), len(table), nan, nan,
+                                          nan, alpha))
+                continue
+            ranks, chi2, p, cd = friedman_test(table, higher_is_better=HIGHER_IS_BETTER[name], alpha=alpha)
+            out.append(FriedmanResult(problem, name, variants, tuple(float(x) for x in ranks), len(table), chi2,
+                                      p, cd, alpha))
+    return out
+
+
 def _pkey(r: RunIndicators) -> str:
-    return f"{r.problem}-m{r.n_obj}" if r.problem.startswith("dtlz") else r.problem
+    return problem_dir(r.problem, r.n_obj)
+
+
+def registry_order(algorithm: str) -> tuple[int, str]:
+    """Sort key of an algorithm name: its place in :data:`moo.algorithms.ALGORITHMS`, others after, by name."""
+    names = list(ALGORITHMS)
+    return (names.index(algorithm) if algorithm in ALGORITHMS else len(names), algorithm)
 
 
 def analyse(results_dir: str | os.PathLike, alpha: float = 0.05) -> tuple[list[RunIndicators], list[Comparison]]:
@@ -359,11 +565,14 @@ def _layout(rows: Sequence[Comparison]):
 
 
 def _marks(c: Comparison, molsp: bool, best: dict) -> tuple[bool, str]:
-    """(bold, superscript marks) of one cell: better of the pair; a = significantly better, * = best."""
+    """(bold, superscript marks) of one cell: better of the pair; a = significantly better (Tukey),
+    w = significantly better (Wilcoxon-Holm), * = best."""
     is_better = c.better == ("molsp" if molsp else "plain")
     marks = []
     if is_better and c.significant:
         marks.append("a")
+    if is_better and c.significant_wilcoxon:
+        marks.append("w")
     if (c.algorithm, molsp) in best.get((c.problem, c.indicator), ()):
         marks.append("*")
     return is_better, ",".join(marks)
@@ -389,12 +598,24 @@ def _rows(table: dict, best: dict, problem: str, cell: Callable[[float, float, b
             yield alg, molsp, cells
 
 
+def _legend(rows: Sequence[Comparison]) -> str:
+    alpha = rows[0].alpha if rows else 0.05
+    level = f"{100 * (1 - alpha):g} %"
+    return (f"Mean ± standard deviation over the runs (n/a: no finite value). Bold: the better mean of the "
+            f"pair MOEA / MOEA with MO-LSP (lower IGD, SP, Spread; higher HV, PD). "
+            f"^a: the difference is significant at {level} by one-way ANOVA and Tukey's HSD (the paper's test), "
+            f"in favour of this row. ^w: significant at {level} by the two-sided Wilcoxon rank-sum test with "
+            f"Holm's correction over the MOEAs of the column, in favour of this row. "
+            f"^*: the best mean of the column.")
+
+
 def to_markdown(rows: Sequence[Comparison]) -> str:
     """The paper's layout: per MOEA a ``/MO-LSP`` row and a plain row, five indicator columns.
 
     The better mean of each pair is bold; ``^a`` marks a significant
-    difference (Tukey, 95 %) in its favour, ``^*`` the best value over the table
-    (every cell sharing it, on ties).
+    difference (Tukey, 95 %) in its favour, ``^w`` one by the Wilcoxon
+    rank-sum test with Holm's correction, ``^*`` the best value over the table
+    (every cell sharing it, on ties). A legend explaining the marks follows.
     """
     table, best = _layout(rows)
     lines = []
@@ -405,11 +626,18 @@ def to_markdown(rows: Sequence[Comparison]) -> str:
         for alg, molsp, cells in _rows(table, best, problem, _markdown_cell):
             lines.append(f"| {alg}{'/MO-LSP' if molsp else ''} | " + " | ".join(cells) + " |")
         lines.append("")
+    if rows:
+        lines += [_legend(rows), ""]
     return "\n".join(lines)
 
 
+def _latex_text(text: str) -> str:
+    text = text.replace("±", r"$\pm$").replace("%", r"\%").replace("_", r"\_")
+    return re.sub(r"\^([a-z*]+)", r"$^{\1}$", text)
+
+
 def to_latex(rows: Sequence[Comparison]) -> str:
-    """The same layout as :func:`to_markdown` as a LaTeX ``tabular`` (one per problem)."""
+    """The same layout as :func:`to_markdown` as a LaTeX ``tabular`` (one per problem), legend below."""
     table, best = _layout(rows)
     out = []
     for problem in dict.fromkeys(p for p, _ in table):
@@ -419,4 +647,100 @@ def to_latex(rows: Sequence[Comparison]) -> str:
             name = alg.replace("_", r"\_") + ("/MO-LSP" if molsp else "")
             out.append(f"{name} & " + " & ".join(cells) + r" \\")
         out += [r"\hline", r"\end{tabular}", ""]
+    if rows:
+        out += [r"\par\smallskip\noindent{\footnotesize " + _latex_text(_legend(rows)) + "}", ""]
     return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------- Friedman ranks tables
+
+def _ranks_layout(results: Sequence[FriedmanResult]):
+    """Per problem: variants in order and {indicator: FriedmanResult}."""
+    table: dict[str, dict[str, FriedmanResult]] = {}
+    for r in results:
+        table.setdefault(r.problem, {})[r.indicator] = r
+    return table
+
+
+def _rank_cell(r: FriedmanResult, variant: str) -> tuple[str, bool, str]:
+    """(rank text, bold, marks) of one variant: bold = best mean rank; n = worse than the best (Nemenyi)."""
+    if variant not in r.variants or not np.isfinite(r.mean_ranks[r.variants.index(variant)]):
+        return "n/a", False, ""
+    rank = r.mean_ranks[r.variants.index(variant)]
+    top = min(r.mean_ranks)
+    best_variant = r.variants[r.mean_ranks.index(top)]
+    marks = "n" if r.rejects and r.differs(variant, best_variant) else ""
+    return f"{rank:.2f}", rank == top, marks
+
+
+def _ranks_legend(results: Sequence[FriedmanResult]) -> str:
+    alpha = results[0].alpha if results else 0.05
+    return (f"Mean Friedman rank over the N runs of every variant (blocks: the runs sharing a seed; rank 1 is "
+            f"the best value of a run, ties share the mean rank). Bold: the best mean rank of the column. "
+            f"^n: worse than the best-ranked variant by Nemenyi's test at alpha = {alpha:g} (mean ranks "
+            f"further apart than the critical difference CD), shown only when the Friedman test rejects "
+            f"(p < {alpha:g}). Last rows: the Friedman chi-square p-value, CD and N of each column.")
+
+
+def _ranks_rows(results: Sequence[FriedmanResult], bold, sup):
+    """(problem, [(label, cells)], footer rows) for each problem, cells written with bold(text) and sup(marks)."""
+    for problem, by_ind in _ranks_layout(results).items():
+        variants = next(iter(by_ind.values())).variants
+        def cell(r: FriedmanResult | None, v: str) -> str:
+            if r is None:
+                return ""
+            text, is_best, marks = _rank_cell(r, v)
+            return (bold(text) if is_best else text) + (sup(marks) if marks else "")
+
+        rows = [(v.replace("+molsp", "/MO-LSP"), [cell(by_ind.get(n), v) for n in INDICATORS]) for v in variants]
+        footer = [("Friedman p", [f"{by_ind[n].p_value:.3g}" if n in by_ind else "" for n in INDICATORS]),
+                  ("CD", [f"{by_ind[n].cd:.3g}" if n in by_ind else "" for n in INDICATORS]),
+                  ("N", [str(by_ind[n].n_blocks) if n in by_ind else "" for n in INDICATORS])]
+        yield problem, rows, footer
+
+
+def ranks_to_markdown(results: Sequence[FriedmanResult]) -> str:
+    """Mean Friedman ranks, one row per variant and one column per indicator, per problem, legend below."""
+    lines = []
+    for problem, rows, footer in _ranks_rows(results, lambda t: f"**{t}**", lambda m: f"^{m}"):
+        lines += [f"**{problem}: mean ranks (Friedman, Nemenyi)**", "",
+                  "| variant | " + " | ".join(_LABELS[n] for n in INDICATORS) + " |",
+                  "|---|" + "---|" * len(INDICATORS)]
+        lines += [f"| {label} | " + " | ".join(cells) + " |" for label, cells in rows + footer]
+        lines.append("")
+    if results:
+        lines += [_ranks_legend(results), ""]
+    return "\n".join(lines)
+
+
+def ranks_to_latex(results: Sequence[FriedmanResult]) -> str:
+    """The table of :func:`ranks_to_markdown` as a LaTeX ``tabular`` per problem, legend below."""
+    out = []
+    for problem, rows, footer in _ranks_rows(results, lambda t: rf"\textbf{{{t}}}", lambda m: f"$^{{{m}}}$"):
+        out += [f"% {problem}: mean Friedman ranks", r"\begin{tabular}{l" + "c" * len(INDICATORS) + "}",
+                r"\hline", "variant & " + " & ".join(_LABELS[n] for n in INDICATORS) + r" \\", r"\hline"]
+        out += [f"{label.replace('_', chr(92) + '_')} & " + " & ".join(cells) + r" \\" for label, cells in rows]
+        out.append(r"\hline")
+        out += [f"{label} & " + " & ".join(cells) + r" \\" for label, cells in footer]
+        out += [r"\hline", r"\end{tabular}", ""]
+    if results:
+        out += [r"\par\smallskip\noindent{\footnotesize " + _latex_text(_ranks_legend(results)) + "}", ""]
+    return "\n".join(out)
+
+
+def ranks_to_csv(results: Sequence[FriedmanResult], path: str | os.PathLike | None = None) -> str:
+    """One CSV row per (problem, indicator, variant): mean rank, Friedman statistic and p, CD, N,
+    and whether Nemenyi's test separates the variant from the best-ranked one."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(["problem", "indicator", "variant", "mean_rank", "n_blocks", "statistic", "p_friedman",
+                     "cd", "alpha", "worse_than_best"])
+    for r in results:
+        for v, rank in zip(r.variants, r.mean_ranks):
+            _, _, marks = _rank_cell(r, v)
+            writer.writerow([r.problem, r.indicator, v, repr(rank), r.n_blocks, repr(r.statistic),
+                             repr(r.p_value), repr(r.cd), repr(r.alpha), marks == "n"])
+    text = buf.getvalue()
+    if path is not None:
+        Path(path).write_text(text, encoding="utf-8")
+    return text

@@ -23,7 +23,9 @@
 regulation horizon N steps instead of 200; applied: the first N samples of
 the route, N * 0.1 s, instead of 5400); the MOEA always uses the problem's
 defaults. The default settings take well under a minute on 2 cores
-(measured: generic about 3 s, applied about 8 s in all, MOEA included).
+(measured on the loaded 2-core machine: generic about 6 s, applied about
+8 s in all, imports and the MOEA included; the simulations run on the
+compiled kernel, :mod:`robustctl.batchsim`).
 
 Writes ``DIR/selection.json`` (settings, z*, win counts of every design, the
 front's objectives, timings) and ``DIR/selection_histogram.png`` (default

@@ -2,6 +2,8 @@
 
     python paper_repro/moea_tables.py --problem generic|applied [--runs 5] [--evals 2000]
                                       [--algorithms all|a,b,...] [--out DIR] [--workers 2] [--seed 0]
+                                      [--max-leaders K] [--executor process|dask] [--scheduler ADDRESS]
+                                      [--no-plots]
 
 Runs the grid problem x algorithms x {plain, MO-LSP} x runs with
 :func:`moo.experiment.run_experiment` into ``DIR`` (default
@@ -13,7 +15,12 @@ the ANOVA/Tukey comparisons (:mod:`moo.stats`), and prints
    row; mean ± std; the better mean of a pair in bold, ``^a`` a significant
    difference in its favour (Tukey HSD, 95 %), ``^*`` the best over the table);
 2. a cell-by-cell comparison with the paper's published table
-   (:mod:`paper_repro.paper_moea_values`), for ``generic`` and ``applied``.
+   (:mod:`paper_repro.paper_moea_values`), for ``generic`` and ``applied``;
+3. the mean Friedman ranks of all 20 variants per indicator, with the
+   Nemenyi critical difference (:func:`moo.stats.friedman`);
+
+and draws the figures of :mod:`moo.plots` (hypervolume over evaluations,
+box plots, fronts, critical-difference diagrams) into ``DIR/figures``.
 
 What is compared. Our objective scales and HV reference points differ from
 the paper's (its regulation errors and PlatEMO set-up are not fully
@@ -30,8 +37,10 @@ minutes on 2 cores (``generic`` about 1 min, ``applied`` about 3-5 min);
 ``--runs 50 --evals 10000`` is the paper's setting. Files written to ``DIR``:
 ``moea_<problem>.md`` (both tables), ``moea_<problem>.tex``,
 ``moea_<problem>_stats.csv`` (one row per MOEA x indicator),
-``moea_<problem>_runs.csv`` (indicators per run) and
-``moea_<problem>_vs_paper.csv``.
+``moea_<problem>_runs.csv`` (indicators per run), ``moea_<problem>_ranks.csv``
+(Friedman ranks), ``moea_<problem>_vs_paper.csv`` and ``figures/*.png|pdf``.
+The paper's experiment on a cluster: ``--executor dask --scheduler
+tcp://HOST:8786`` (see the README's "Experiments and statistics").
 """
 
 from __future__ import annotations
@@ -48,8 +57,12 @@ if __package__ in (None, ""):                      # run as a script: make the r
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from moo.algorithms import ALGORITHMS  # noqa: E402
+from moo.executors import open_executor  # noqa: E402
 from moo.experiment import run_experiment  # noqa: E402
-from moo.stats import INDICATORS, Comparison, analyse, to_csv, to_latex, to_markdown  # noqa: E402
+from moo.plots import plot_results  # noqa: E402
+from moo.stats import (INDICATORS, Comparison, analyse, friedman, ranks_to_csv, ranks_to_latex,  # noqa: E402
+                       ranks_to_markdown, to_csv, to_latex, to_markdown)
+from moo.store import load_records  # noqa: E402
 from paper_repro.paper_moea_values import PAPER_LABELS, PAPER_MOEA, paper_cell  # noqa: E402
 
 _LABELS = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
@@ -152,28 +165,34 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--evals", type=int, default=2000, help="evaluations per run (default 2000; paper 10000)")
     ap.add_argument("--algorithms", default="all", help="'all' (default) or a comma-separated list")
     ap.add_argument("--out", type=Path, default=None, help="results directory (default out/moea_<problem>)")
-    ap.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    ap.add_argument("--workers", type=int, default=None,
+                    help="processes of the local pool or local Dask cluster (default 2 without --scheduler)")
     ap.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
-    ap.add_argument("--molsp-max-leaders", type=int, default=None, help="MO-LSP cap (default: none, the paper's)")
+    ap.add_argument("--max-leaders", type=int, default=None, help="MO-LSP cap (default: none, the paper's)")
+    ap.add_argument("--molsp-max-leaders", type=int, dest="max_leaders", help=argparse.SUPPRESS)  # old name
+    ap.add_argument("--executor", choices=("process", "dask"), default="process",
+                    help="'process' (default) or 'dask' (a local cluster, or the one at --scheduler)")
+    ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (with --executor dask)")
+    ap.add_argument("--no-plots", action="store_true", help="do not draw the figures")
     return ap
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     ap = _parser()
     args = ap.parse_args(argv)
-    for flag, value, minimum in (("--runs", args.runs, 2), ("--evals", args.evals, 1),
-                                 ("--workers", args.workers, 1), ("--seed", args.seed, 0)):
-        if value < minimum:
-            ap.error(f"{flag} must be >= {minimum}, got {value}")
+    if args.runs < 2:
+        ap.error(f"--runs must be >= 2, got {args.runs}")
     names = [a.strip().lower() for a in args.algorithms.split(",")] if args.algorithms != "all" else list(ALGORITHMS)
     unknown = [a for a in names if a not in ALGORITHMS]
     if unknown:
         ap.error(f"unknown algorithm(s) {', '.join(unknown)}; valid: {', '.join(ALGORITHMS)}")
     out = args.out if args.out is not None else Path("out") / f"moea_{args.problem}"
+    workers = 2 if args.workers is None and args.scheduler is None else args.workers
     try:
-        report = run_experiment(args.problem, names, runs=args.runs, evals=args.evals, out=out,
-                                base_seed=args.seed, max_leaders=args.molsp_max_leaders, workers=args.workers)
-    except ValueError as exc:
+        with open_executor(args.executor, workers=workers, scheduler=args.scheduler) as ex:
+            report = run_experiment(args.problem, names, runs=args.runs, evals=args.evals, out=out,
+                                    base_seed=args.seed, max_leaders=args.max_leaders, executor=ex)
+    except (ValueError, TypeError) as exc:
         ap.error(str(exc).splitlines()[0])
     print(f"{report!r}\n")
     runs, table = analyse(out)
@@ -185,15 +204,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     versus = comparison_markdown(args.problem, cells)
     print(f"Our results ({args.runs} runs x {args.evals} evaluations; IGD/Spread reference set: the "
           "non-dominated union of all runs in the directory):\n")
+    ranks = friedman(runs)
+    ranks_md = ranks_to_markdown(ranks)
     print(ours)
     print(versus)
+    print(ranks_md)
     stem = f"moea_{args.problem}"
-    (out / f"{stem}.md").write_text(ours + "\n" + versus, encoding="utf-8")
-    (out / f"{stem}.tex").write_text(to_latex(table), encoding="utf-8")
+    (out / f"{stem}.md").write_text(ours + "\n" + versus + "\n" + ranks_md, encoding="utf-8")
+    (out / f"{stem}.tex").write_text(to_latex(table) + "\n" + ranks_to_latex(ranks), encoding="utf-8")
     to_csv(table, out / f"{stem}_stats.csv")
     to_csv(runs, out / f"{stem}_runs.csv")
+    ranks_to_csv(ranks, out / f"{stem}_ranks.csv")
     _agreement_csv(cells, out / f"{stem}_vs_paper.csv")
-    print(f"written: {out}/{stem}.md, .tex, _stats.csv, _runs.csv, _vs_paper.csv")
+    print(f"written: {out}/{stem}.md, .tex, _stats.csv, _runs.csv, _ranks.csv, _vs_paper.csv")
+    if not args.no_plots:
+        records = [r for r in load_records(out) if r["problem"] == args.problem and r["algorithm"] in keep]
+        figures = plot_results(records, out / "figures")
+        print(f"figures: {len(figures)} files in {out / 'figures'}")
     return 0
 
 

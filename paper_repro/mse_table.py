@@ -3,6 +3,7 @@
     python paper_repro/mse_table.py [--out DIR] [--z Z1 ... Z7] [--uncertainty printed|computed]
                                     [--measure tracking|regulation] [--duration SECONDS]
                                     [--controllers NAME ...] [--no-figures] [--no-extras]
+                                    [--backend numba|numpy]
 
 Controllers (one Q, R for all: :func:`robustctl.models.truck.lqr_weights`):
 
@@ -33,7 +34,7 @@ Two measures of f1..f4 (``--measure`` picks the one printed and written to
 
 * ``tracking`` (default): MSE of ``x - x_ref``, the error of each state from
   the nominal model's steady cornering along the path (yaw-rate reference
-  ``v kappa``, see :func:`robustctl.simulate.simulate`).
+  ``v kappa``, see :func:`robustctl.pathfollow.simulate`).
 * ``regulation``: MSE of the states themselves (``rho``, ``psidot``, ``ydot``,
   ``theta`` regulated to zero). The paper's f2-f4 magnitudes (e.g. LQR f3
   4.5e-2 .. 6.2e-1) match this reading far better than the tracking one, so
@@ -62,7 +63,8 @@ if __package__ in (None, ""):  # run as a script: make the repository importable
 import robustctl as rc  # noqa: E402
 from robustctl.models import truck  # noqa: E402
 from robustctl.path import default_route  # noqa: E402
-from robustctl.simulate import simulate  # noqa: E402
+from robustctl.batchsim import BACKENDS  # noqa: E402
+from robustctl.pathfollow import simulate  # noqa: E402
 
 from paper_repro.paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS, PAPER_MSE  # noqa: E402
 
@@ -365,7 +367,7 @@ MEASURES = {"tracking": "reference", "regulation": "zero"}
 
 def run(out: Path, *, z=truck.RLQR_MOP_Z, uncertainty: str = "printed", measure: str = "tracking",
         duration: float | None = None, figures: bool = True,
-        controllers: tuple[str, ...] | list[str] | None = None, log=print) -> dict:
+        controllers: tuple[str, ...] | list[str] | None = None, backend: str = "numba", log=print) -> dict:
     """Design, simulate, write the tables (and figures); return ``{objective: {controller: (4,)}}``."""
     if measure not in MEASURES:
         raise ValueError(f"measure must be one of {sorted(MEASURES)}, got {measure!r}")
@@ -384,14 +386,14 @@ def run(out: Path, *, z=truck.RLQR_MOP_Z, uncertainty: str = "printed", measure:
                      f"  steering gain K1+...+Km = {np.array2string(d.K_steer[0], precision=5)}\n")
             for ov in OVERLOADS:
                 F, G, _ = truck.discretise(ov)
-                rad = np.max(np.abs(np.linalg.eigvals(F[0] + G[0] @ d.K_steer)))
+                rad = float(rc.spectral_radius(F[0] + G[0] @ d.K_steer))
                 fh.write(f"  closed-loop spectral radius at {ov:3d} %: {rad:.5f}\n")
     log(f"      {', '.join(names)}  ({time.perf_counter() - t0:.1f} s)")
     log(f"[2/4] simulating {len(designs)} controllers x {len(OVERLOADS)} payloads x {path.T} steps "
         f"({path.duration:.0f} s, {path.T * path.dt * path.speed / 1000:.1f} km) ...")
     t1 = time.perf_counter()
     K = np.stack([d.K_steer for d in designs])
-    res = simulate(K, path, list(map(float, OVERLOADS)), keep_trajectories=figures)
+    res = simulate(K, path, list(map(float, OVERLOADS)), keep_trajectories=figures, backend=backend)
     tables = {}
     for meas, target in MEASURES.items():
         m = res.mse(target)                                          # (B, S, 4)
@@ -454,6 +456,8 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=None,
                     help="simulate only the first DURATION seconds of the route (default: all, ~540 s)")
     ap.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    ap.add_argument("--backend", choices=BACKENDS, default="numba",
+                    help="simulator: the compiled kernel (default) or the numpy reference")
     ap.add_argument("--no-extras", action="store_true",
                     help="only the paper's four controllers (no polytopic H-infinity, no other RLQR^A)")
     ap.add_argument("--controllers", nargs="+", metavar="NAME", default=None,
@@ -469,7 +473,7 @@ def main(argv=None) -> int:
         if controllers is None and args.no_extras:
             controllers = list(CONTROLLERS)
         run(args.out, z=z, uncertainty=args.uncertainty, measure=args.measure, duration=args.duration,
-            figures=not args.no_figures, controllers=controllers)
+            figures=not args.no_figures, controllers=controllers, backend=args.backend)
     except (ValueError, TypeError) as exc:
         ap.error(str(exc))
     return 0

@@ -31,7 +31,7 @@ import numpy as np
 
 from .errors import ConvergenceError, InfeasibleError
 
-__all__ = ["LMI", "SolveReport", "solve_sdp", "SOLVER_TOL"]
+__all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "SOLVER_TOL"]
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
@@ -81,6 +81,32 @@ class SolveReport:
                 f"{prefix}solver": self.solver, f"{prefix}tol": self.tol, f"{prefix}solve_time": self.solve_time,
                 f"{prefix}iterations": self.iterations,
                 f"{prefix}certificate": dict(self.certificate)}
+
+
+def certificate(lmis: Sequence[LMI]) -> dict[str, float]:
+    """Smallest eigenvalue of each (symmetrised) block at the current values, by name.
+
+    For blocks built from constants (a candidate point) or from variables
+    holding a solution. Raises ConvergenceError on non-finite values and
+    ValueError on a block that is not symmetric.
+    """
+    return _evaluate(lmis, "the point has")[0]
+
+
+def _evaluate(lmis: Sequence[LMI], who: str) -> tuple[dict[str, float], dict[str, float]]:
+    """``(smallest eigenvalue, max(1, largest |entry|))`` of every block, by name."""
+    cert, scales = {}, {}
+    for lmi in lmis:
+        val = np.asarray(getattr(lmi.M, "value", lmi.M), dtype=float)
+        if not np.all(np.isfinite(val)):
+            raise ConvergenceError(f"{who} non-finite values in LMI {lmi.name!r}")
+        scale = max(1.0, float(np.max(np.abs(val))))
+        asym = float(np.max(np.abs(val - val.T)))
+        if asym > 1e-8 * scale:
+            raise ValueError(f"internal error: LMI block {lmi.name!r} is not symmetric (asymmetry {asym:.3g})")
+        cert[lmi.name] = float(np.linalg.eigvalsh(0.5 * (val + val.T)).min())
+        scales[lmi.name] = scale
+    return cert, scales
 
 
 def _settings(solver: str, tol: float, refine: bool = True) -> dict:
@@ -143,13 +169,9 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
     import cvxpy as cp
 
     cons = list(constraints)
-    syms = []
     for lmi in lmis:
         M = lmi.M
-        k = M.shape[0]
-        S = 0.5 * (M + M.T)
-        syms.append(S)
-        cons.append(S - lmi.margin * np.eye(k) >> 0)
+        cons.append(0.5 * (M + M.T) - lmi.margin * np.eye(M.shape[0]) >> 0)
     prob = cp.Problem(objective, cons)
     # A solver failure ("insufficient progress" at tight tolerances on nearly
     # degenerate problems) is retried twice with 100x looser tolerances, after
@@ -183,20 +205,9 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
                                f"tolerances; the problem is probably infeasible or nearly so: {infeasible_msg}")
     if status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
         raise InfeasibleError(f"{infeasible_msg} (solver status: {status})")
-    cert = {}
-    bad = []
-    for lmi, S in zip(lmis, syms):
-        val = np.asarray(lmi.M.value, dtype=float)
-        if not np.all(np.isfinite(val)):
-            raise ConvergenceError(f"{solver} returned non-finite values in LMI {lmi.name!r}")
-        scale = max(1.0, float(np.max(np.abs(val))))
-        asym = float(np.max(np.abs(val - val.T)))
-        if asym > 1e-8 * scale:
-            raise ValueError(f"internal error: LMI block {lmi.name!r} is not symmetric (asymmetry {asym:.3g})")
-        eig = float(np.linalg.eigvalsh(0.5 * (val + val.T)).min())
-        cert[lmi.name] = eig
-        if eig < -_CERT_TOL * scale:
-            bad.append(f"{lmi.name}: smallest eigenvalue {eig:.3g}")
+    cert, scales = _evaluate(lmis, f"{solver} returned")
+    bad = [f"{name}: smallest eigenvalue {eig:.3g}" for name, eig in cert.items()
+           if eig < -_CERT_TOL * scales[name]]
     if bad:
         raise InfeasibleError(f"{infeasible_msg}: {solver} reported {status!r} but the certificate "
                               f"fails ({'; '.join(bad)})")

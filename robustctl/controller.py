@@ -8,8 +8,9 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._validation import as_matrix
+from ._validation import as_float_array, as_matrix
 from .plant import Plant, _frozen
+from .stability import is_stable
 
 __all__ = ["Controller"]
 
@@ -39,17 +40,21 @@ class Controller:
     info: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self):
+        if not isinstance(self.plant, Plant):
+            raise TypeError(f"plant must be a robustctl.Plant, got {type(self.plant).__name__}")
         K = as_matrix(self.K, "K", rows=self.plant.m, cols=self.plant.n,
                       rows_what="the number of inputs", cols_what="the number of states")
         object.__setattr__(self, "K", _frozen(K))
         object.__setattr__(self, "info", MappingProxyType(dict(self.info)))
 
     def __call__(self, x) -> np.ndarray:
-        """``K @ x`` for one state (n,) or a stack of states (..., n)."""
-        x = np.asarray(x, dtype=float)
+        """``K @ x`` for one state (n,) or a stack of states (..., n); the states must be finite."""
+        x = as_float_array(x, "x")
         if x.shape[-1:] != (self.plant.n,):
             raise ValueError(f"x must have {self.plant.n} entries in its last axis "
                              f"(the number of states), got shape {x.shape}")
+        if not np.all(np.isfinite(x)):
+            raise ValueError("x must have finite entries (found NaN or inf)")
         return x @ self.K.T
 
     def closed_loop(self, plant: Plant | None = None) -> np.ndarray:
@@ -61,12 +66,25 @@ class Controller:
         return np.linalg.eigvals(self.closed_loop(plant))
 
     def is_stabilizing(self, plant: Plant | None = None) -> bool:
-        """Spectral radius of ``F + G K`` below 1 (discrete) or all real parts < 0 (continuous)."""
+        """``F + G K`` is stable: spectral radius below ``1 - 1e-9`` (discrete) or every real part below
+        ``-1e-9`` (continuous), the margin of :mod:`robustctl.stability`."""
         p = self._plant(plant)
-        poles = self.closed_loop_poles(p)
-        if p.is_discrete:
-            return bool(np.max(np.abs(poles)) < 1.0)
-        return bool(np.max(poles.real) < 0.0)
+        return is_stable(self.closed_loop(p), discrete=p.is_discrete)
+
+    def to_statespace(self, plant: Plant | None = None):
+        """The closed loop as a python-control ``StateSpace``: ``x+ = (F + G K) x + G v``, output ``x``.
+
+        ``v`` is an input added to the feedback (``u = K x + v``). Because
+        python-control feeds back with a minus sign, this equals
+        ``control.feedback(plant.to_statespace(), -K)`` for our ``u = K x``.
+        ``plant`` defaults to the design plant (give a perturbed one to close
+        the loop around it).
+        """
+        import control
+
+        p = self._plant(plant)
+        return control.ss(self.closed_loop(p), p.G, np.eye(p.n), np.zeros((p.n, p.m)),
+                          0 if p.dt is None else p.dt)
 
     def _plant(self, plant: Plant | None) -> Plant:
         if plant is None:

@@ -14,6 +14,7 @@ METHODS = {
     "lqr": "robustctl.lqr:lqr",
     "rlqr": "robustctl.rlqr:rlqr",
     "hinf": "robustctl.hinf:hinf",
+    "h2": "robustctl.h2:h2",
 }
 
 
@@ -27,7 +28,8 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     >>> ctrl = design("rlqr", plant, EF, EG, mu, Q=Q, R=R)   # doctest: +SKIP
     """
     if not isinstance(method, str) or method.lower() not in METHODS:
-        raise ValueError(f"unknown design method {method!r}; valid: {', '.join(sorted(METHODS))}")
+        raise ValueError(f"method must name a design: unknown design method {method!r}; "
+                         f"valid: {', '.join(sorted(METHODS))}")
     if not isinstance(plant, Plant):
         raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
     module, func = METHODS[method.lower()].split(":")

@@ -7,7 +7,7 @@ it the usual way.
 
 from __future__ import annotations
 
-__all__ = ["RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError"]
+__all__ = ["RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError"]
 
 
 class RobustCtlError(Exception):
@@ -24,3 +24,15 @@ class RankConditionError(RobustCtlError, ValueError):
 
 class InfeasibleError(RobustCtlError, ValueError):
     """A convex program (LMI) is infeasible, or the solver could not certify a solution."""
+
+
+class NotStabilizableError(ConvergenceError, InfeasibleError):
+    """The plant is not stabilisable: some unstable mode cannot be moved by the input (PBH test).
+
+    Raised by ``lqr`` and ``rlqr`` before they start
+    (:func:`robustctl.stability.check_stabilizable`), since no gain ``u = K x``
+    stabilises such a plant. It is both a :class:`ConvergenceError` (what
+    ``lqr`` raised when its Riccati solver failed on such plants) and an
+    :class:`InfeasibleError` (what ``hinf`` raises, with the same message), so
+    handlers written for either keep working.
+    """

@@ -19,6 +19,7 @@ from ._validation import as_matrix, check_spd
 from .controller import Controller
 from .errors import ConvergenceError
 from .plant import Plant
+from .stability import check_stabilizable
 
 __all__ = ["lqr", "dare"]
 
@@ -40,12 +41,18 @@ def _residual(F, G, Q, R, P) -> float:
     return float(np.linalg.norm(res) / max(1.0, np.linalg.norm(P)))
 
 
-def dare(F, G, Q, R) -> tuple[np.ndarray, str]:
-    """Stabilising solution of the DARE: slycot (via python-control) first, scipy as fallback.
+def dare(F, G, Q=None, R=None) -> tuple[np.ndarray, str]:
+    """Stabilising solution of the DARE: slycot (via python-control) if installed, scipy otherwise or as fallback.
 
     Returns ``(P, backend)``; raises :class:`ConvergenceError` if neither
-    backend gives a solution with relative residual below 1e-8.
+    backend gives a solution with relative residual below 1e-8. The
+    arguments are checked like :func:`lqr`'s (``Q``, ``R`` may be ``None``: identity).
     """
+    plant = Plant(F, G, 1.0)
+    return _dare(plant.F, plant.G, *_weights(plant, Q, R))
+
+
+def _dare(F, G, Q, R) -> tuple[np.ndarray, str]:
     reasons = []
     for backend in ("slycot", "scipy"):
         try:
@@ -81,14 +88,24 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     -------
     Controller
         ``info`` holds ``P`` (Riccati solution), ``residual`` (relative
-        Riccati residual) and ``backend`` (``"slycot"`` or ``"scipy"``).
+        Riccati residual) and ``backend`` (``"slycot"`` if the optional
+        ``robustctl[slycot]`` extra is installed and succeeds, else ``"scipy"``).
+
+    Raises
+    ------
+    NotStabilizableError
+        ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`);
+        ``rlqr`` raises the same, ``hinf`` an ``InfeasibleError`` (which this error also is).
+    ConvergenceError
+        No backend solves the Riccati equation (e.g. ``(F, Q)`` not detectable).
     """
     if not isinstance(plant, Plant):
         raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
     if not plant.is_discrete:
         raise ValueError("plant must be discrete-time (dt > 0) for lqr; discretise it first")
     Q, R = _weights(plant, Q, R)
-    P, backend = dare(plant.F, plant.G, Q, R)
+    check_stabilizable(plant)
+    P, backend = _dare(plant.F, plant.G, Q, R)
     G = plant.G
     K = -np.linalg.solve(R + G.T @ P @ G, G.T @ P @ plant.F)
     return Controller(K, "lqr", plant, {"P": P, "backend": backend,

@@ -363,7 +363,7 @@ def default_route(*, speed: float = DEFAULT_SPEED, dt: float = 0.1,
     120-150 m, and bends of radius 200-500 m (lateral acceleration at most
     ``v^2/R = 1.4 m/s^2``, comfortable for a truck) entered through clothoid
     transitions of 60-80 m, as road design prescribes at this speed. The
-    elements are in :data:`DEFAULT_ROUTE`; build your own with
+    elements are in ``DEFAULT_ROUTE``; build your own with
     :meth:`ReferencePath.from_segments`, :meth:`~ReferencePath.from_curvature`
     or :meth:`~ReferencePath.from_waypoints`.
     """

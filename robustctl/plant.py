@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from ._validation import as_matrix, check_positive_scalar, check_square
+from ._validation import as_matrix, check_choice, check_positive_scalar, check_square
+from .stability import unstabilizable_modes
 
 __all__ = ["Plant"]
 
@@ -15,6 +17,12 @@ _METHODS = ("zoh", "tustin", "euler")
 
 def _frozen(arr: np.ndarray) -> np.ndarray:
     arr = np.array(arr, dtype=np.float64)
+    arr.flags.writeable = False
+    return arr
+
+
+def _frozen_complex(arr: np.ndarray) -> np.ndarray:
+    arr = np.array(arr, dtype=complex)
     arr.flags.writeable = False
     return arr
 
@@ -41,9 +49,7 @@ class Plant:
 
     def __init__(self, F, G, dt: float | None):
         F = check_square(as_matrix(F, "F"), "F")
-        n = F.shape[0]
-        G = as_matrix(G, "G", rows=n, cols=1 if np.ndim(G) == 1 else None,
-                      rows_what="the number of states, from F")
+        G = as_matrix(G, "G", rows=F.shape[0], vector="column", rows_what="the number of states, from F")
         dt = None if dt is None else check_positive_scalar(dt, "dt")
         object.__setattr__(self, "F", _frozen(F))
         object.__setattr__(self, "G", _frozen(G))
@@ -64,32 +70,53 @@ class Plant:
     def is_discrete(self) -> bool:
         return self.dt is not None
 
+    @cached_property
+    def unstabilizable_modes(self) -> np.ndarray:
+        """Eigenvalues of ``F`` that are not stable and that ``G`` cannot move (PBH test).
+
+        Empty for a stabilisable plant; see :mod:`robustctl.stability` for the tolerances.
+        """
+        return _frozen_complex(unstabilizable_modes(self.F, self.G, discrete=self.is_discrete))
+
+    @property
+    def is_stabilizable(self) -> bool:
+        """Some gain ``u = K x`` makes the loop stable (no ``unstabilizable_modes``)."""
+        return self.unstabilizable_modes.size == 0
+
     # -- constructors ------------------------------------------------------
     @classmethod
     def from_continuous(cls, A, B, dt: float | None, method: str = "zoh") -> "Plant":
         """Discretise ``dx/dt = A x + B u`` with sampling time ``dt``.
 
         ``method`` is ``"zoh"`` (exact for piecewise-constant inputs, via
-        python-control's ``c2d``), ``"tustin"`` (bilinear) or ``"euler"``
+        python-control's ``c2d``), ``"tustin"`` (bilinear; needs ``I - A dt/2``
+        invertible, i.e. no eigenvalue of ``A`` at ``2/dt``) or ``"euler"``
         (forward Euler, ``F = I + A dt``, ``G = B dt``). ``dt=None`` keeps the
-        plant in continuous time.
+        plant in continuous time. ``ValueError`` naming ``A`` if ``A dt`` is
+        too large for the discrete plant to be finite.
         """
         A = check_square(as_matrix(A, "A"), "A")
-        B = as_matrix(B, "B", rows=A.shape[0], cols=1 if np.ndim(B) == 1 else None,
-                      rows_what="the number of states, from A")
+        B = as_matrix(B, "B", rows=A.shape[0], vector="column", rows_what="the number of states, from A")
         if dt is None:
             return cls(A, B, None)
         dt = check_positive_scalar(dt, "dt")
-        if method not in _METHODS:
-            raise ValueError(f"method must be one of {_METHODS}, got {method!r}")
-        if method == "euler":
-            return cls(np.eye(A.shape[0]) + A * dt, B * dt, dt)
-        import control
-
+        method = check_choice(method, "method", _METHODS)
         n, m = B.shape
-        sys = control.ss(A, B, np.zeros((1, n)), np.zeros((1, m)))
-        sysd = control.c2d(sys, dt, method="zoh" if method == "zoh" else "tustin")
-        return cls(sysd.A, sysd.B, dt)
+        with np.errstate(all="ignore"):
+            if method == "euler":
+                F, G = np.eye(n) + A * dt, B * dt
+            else:
+                if method == "tustin" and not np.linalg.cond(np.eye(n) - A * (dt / 2)) < 1 / np.finfo(float).eps:
+                    raise ValueError(f"method='tustin' needs I - A dt/2 invertible, but A has an eigenvalue at "
+                                     f"2/dt = {2 / dt:g} (dt={dt:g}); use method='zoh' or another dt")
+                import control
+
+                sysd = control.c2d(control.ss(A, B, np.zeros((1, n)), np.zeros((1, m))), dt, method=method)
+                F, G = sysd.A, sysd.B
+        if not (np.all(np.isfinite(F)) and np.all(np.isfinite(G))):
+            raise ValueError(f"A is too large for dt={dt:g}: the discretised plant ({method}) has non-finite "
+                             "entries; check the units of A and B or use a smaller dt")
+        return cls(F, G, dt)
 
     @classmethod
     def from_statespace(cls, sys) -> "Plant":

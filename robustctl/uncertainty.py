@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_batch, as_matrix
+from ._validation import as_batch, as_float_array, as_matrix
 from .plant import Plant, _frozen
 
 __all__ = ["NormBounded"]
@@ -35,8 +35,7 @@ class NormBounded:
     def __init__(self, H, EF, EG):
         EF = as_matrix(EF, "EF")
         l, n = EF.shape
-        H = as_matrix(H, "H", rows=n, cols=1 if np.ndim(H) == 1 else None,
-                      rows_what="the number of states, from EF's columns")
+        H = as_matrix(H, "H", rows=n, vector="column", rows_what="the number of states, from EF's columns")
         EG = as_matrix(EG, "EG", rows=l, rows_what="the rows of EF")
         object.__setattr__(self, "H", _frozen(H))
         object.__setattr__(self, "EF", _frozen(EF))
@@ -61,13 +60,15 @@ class NormBounded:
         return self.EF.shape[0]
 
     def check_plant(self, plant: Plant) -> None:
-        """Raise ``ValueError`` if the sizes do not match ``plant``."""
+        """Raise ``TypeError`` if ``plant`` is not a :class:`Plant`, ``ValueError`` if the sizes do not match it."""
+        if not isinstance(plant, Plant):
+            raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
         if (plant.n, plant.m) != (self.n, self.m):
             raise ValueError(f"uncertainty is for n={self.n} states and m={self.m} inputs, "
                              f"plant has n={plant.n}, m={plant.m}")
 
     def _deltas(self, Delta) -> np.ndarray:
-        D = np.asarray(Delta, dtype=float)
+        D = as_float_array(Delta, "Delta")
         if D.ndim == 0 or (D.ndim == 1 and self.p == 1 and self.l == 1):
             D = D.reshape(-1, 1, 1) if D.ndim else D.reshape(1, 1, 1)
         elif D.ndim == 2:

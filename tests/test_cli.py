@@ -107,7 +107,7 @@ def test_progress_bar_on_a_terminal(tmp_path, monkeypatch, capsys):
     (["--problem", "zdt1", "--algorithm", "nsga2", "--pop-size", "2"], "--pop-size must be >= 4"),
     (["--problem", "zdt1", "--algorithm", "nsga2", "--seed", "-1"], "--seed must be >= 0"),
     (["--problem", "zdt1", "--n-obj", "3", "--algorithm", "nsga2"], "has 2 objectives"),
-    (["--problem", "dtlz2", "--n-obj", "1", "--algorithm", "nsga2"], "n_obj must be between 2"),
+    (["--problem", "dtlz2", "--n-obj", "1", "--algorithm", "nsga2"], "--n-obj must be between 2"),
     (["--problem", "zdt1", "--algorithm", "nsga2", "--max-leaders", "3"], "--max-leaders needs --molsp"),
     (["--problem", "zdt1", "--algorithm", "nsga2", "--evals", "many"], "invalid int value"),
     (["--problem", "zdt1"], "required"),
@@ -199,3 +199,52 @@ def test_make_problem_names_and_objectives():
         make_problem("foo")
     with pytest.raises(TypeError, match="n_obj must be an integer"):
         make_problem("dtlz2", 2.5)
+
+
+# ----------------------------------------------------------------------------- --out checked before the run
+
+@pytest.fixture
+def no_run(monkeypatch):
+    """Fail the test if a run starts (the checks must come first)."""
+    import moo.runner
+
+    def boom(self, progress=None):
+        raise AssertionError("the run started before --out was checked")
+
+    monkeypatch.setattr(moo.runner.PreparedRun, "run", boom)
+
+
+@pytest.mark.parametrize("out, message", [("{tmp}", "is a directory, not a file"),
+                                          ("", "--out must be a file path"),
+                                          ("/proc/moo-test.json", "--out: cannot write in '/proc'"),
+                                          ("{tmp}/missing/x.json", "does not exist")])
+def test_run_out_is_checked_before_the_run(tmp_path, capsys, no_run, out, message):
+    code = main(["run", "--problem", "zdt1", "--algorithm", "nsga2", "--seed", "0", "--evals", "200",
+                 "--out", out.format(tmp=tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_run_failure_exits_1_with_the_traceback_and_one_line(tmp_path, capsys, monkeypatch):
+    import moo.runner
+
+    def fail(self, progress=None):
+        raise RuntimeError("solver exploded")
+
+    monkeypatch.setattr(moo.runner.PreparedRun, "run", fail)
+    code = main(["run", "--problem", "zdt1", "--algorithm", "nsga2", "--seed", "0", "--evals", "200",
+                 "--out", str(tmp_path / "r.json")])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" in err and not (tmp_path / "r.json").exists()
+    assert err.strip().splitlines()[-1] == "python -m moo: error: the run failed: RuntimeError: solver exploded"
+
+
+def test_prepared_run_is_repeatable_and_matches_run():
+    from moo.runner import prepare, run
+
+    job = prepare("zdt1", "nsga2", seed=4, evals=200, pop_size=20, molsp=True, max_leaders=3)
+    a, b = job.run(), job.run()
+    c = run("zdt1", "nsga2", seed=4, evals=200, pop_size=20, molsp=True, max_leaders=3)
+    assert np.array_equal(a.F, b.F) and np.array_equal(a.F, c.F) and np.array_equal(a.hv_history, c.hv_history)
+    with pytest.raises(TypeError, match="molsp must be a bool"):
+        prepare("zdt1", "nsga2", seed=4, evals=200, molsp="yes")

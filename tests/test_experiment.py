@@ -82,10 +82,11 @@ def test_write_json_atomic_failure_keeps_old_file(tmp_path):
 # ----------------------------------------------------------------------------- resumption
 
 class _FakeResult:
-    def __init__(self, problem, algorithm, seed, evals, n_obj, molsp, max_leaders):
+    def __init__(self, problem, algorithm, seed, evals, n_obj, molsp, max_leaders, pop_size):
         self.wall_time = 0.0
         self._d = {"problem": problem, "n_obj": 2 if n_obj is None else n_obj, "algorithm": algorithm,
                    "molsp": molsp, "max_leaders": max_leaders, "seed": seed, "budget": evals,
+                   "pop_size": pop_size,
                    "F": [[float(seed % 7), 1.0]], "hv_ref_point": [10.0, 10.0]}
 
     def to_dict(self):
@@ -102,7 +103,7 @@ def fake_run(monkeypatch):
         if state["fail_after"] is not None and len(calls) >= state["fail_after"]:
             raise KeyboardInterrupt
         calls.append((algorithm, molsp, seed))
-        return _FakeResult(problem, algorithm, seed, evals, n_obj, molsp, max_leaders)
+        return _FakeResult(problem, algorithm, seed, evals, n_obj, molsp, max_leaders, pop_size)
 
     monkeypatch.setattr(moo.runner, "run", run)
     return calls, state
@@ -203,8 +204,8 @@ def test_cli_experiment_and_stats_end_to_end(tmp_path):
     (["experiment", "--problem", "zdt1", "--runs", "0", "--evals", "300"], "--runs must be >= 1"),
     (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "50"], "population size"),
     (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--workers", "0"], "--workers"),
-    (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--molsp-max-leaders", "0"],
-     "--molsp-max-leaders"),
+    (["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--max-leaders", "0"],
+     "--max-leaders must be >= 1"),
     (["experiment", "--problem", "zdt1", "--runs", "x", "--evals", "300"], "invalid int value"),
     (["experiment", "--problem", "zdt1", "--evals", "300"], "required: --runs"),
 ])
@@ -239,3 +240,171 @@ def test_python_dash_m_exit_code_and_one_line(tmp_path):
                           cwd=Path(__file__).resolve().parents[1])
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.strip().splitlines() == ["python -m moo: error: --runs must be >= 1, got -1"]
+
+
+# ----------------------------------------------------------------------------- run store: settings, failures
+
+def test_rerun_with_another_pop_size_is_an_error_not_a_skip(tmp_path, fake_run):
+    run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path, progress=False)
+    with pytest.raises(ValueError, match=r"seed_\d+\.json holds a run with other settings: pop_size 92 "
+                                         r"\(this grid: 50\)"):
+        run_experiment("zdt1", "nsga2", runs=1, evals=300, pop_size=50, out=tmp_path, progress=False)
+
+
+def test_cli_rerun_with_other_evals_is_a_one_line_usage_error(tmp_path, fake_run, capsys):
+    args = ["experiment", "--problem", "zdt1", "--algorithms", "nsga2", "--runs", "1", "--out", str(tmp_path)]
+    assert main([*args, "--evals", "300"]) == 0
+    capsys.readouterr()
+    assert main([*args, "--evals", "400"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "holds a run with other settings: budget 300 (this grid: 400)" in err
+    assert "seed_" in err and "Traceback" not in err
+
+
+@pytest.fixture
+def failing_run(fake_run, monkeypatch):
+    """The counting stub, raising ValueError for the MO-LSP runs of seed index 1."""
+    calls, _ = fake_run
+    stub, bad_seed = moo.runner.run, run_seeds(2)[1]
+
+    def run(problem, algorithm, *, seed, molsp=False, **kw):
+        if molsp and seed == bad_seed:
+            raise ValueError("boom in the run")
+        return stub(problem, algorithm, seed=seed, molsp=molsp, **kw)
+
+    monkeypatch.setattr(moo.runner, "run", run)
+    return calls, bad_seed
+
+
+def test_keep_going_records_the_failure_and_finishes_the_grid(tmp_path, failing_run):
+    calls, bad_seed = failing_run
+    report = run_experiment("zdt1", "nsga2", runs=3, evals=300, out=tmp_path, keep_going=True, progress=False)
+    assert (report.completed, len(report.failed)) == (5, 1) and len(load_records(tmp_path)) == 5
+    failed = json.loads(report.failed[0].read_text())
+    assert report.failed[0].name == f"seed_{bad_seed}.failed.json" and report.failed[0].parent.name == "nsga2+molsp"
+    assert failed["status"] == "failed" and failed["error"] == "ValueError: boom in the run"
+    assert "Traceback" in failed["traceback"] and "boom in the run" in failed["traceback"]
+    assert (failed["seed"], failed["molsp"], failed["budget"]) == (bad_seed, True, 300)
+    # a rerun retries the failed run only; its success removes the failure record
+    from moo.experiment import prepare
+    grid = prepare("zdt1", "nsga2", runs=3, evals=300, out=tmp_path)
+    assert (grid.skipped, len(grid.todo), grid.retried) == (5, 1, 1)
+
+
+def test_without_keep_going_the_first_failure_stops_the_grid(tmp_path, failing_run):
+    from moo.experiment import RunFailedError
+
+    calls, bad_seed = failing_run
+    with pytest.raises(RunFailedError, match=r"zdt1/nsga2\+molsp run 1 .* failed: ValueError: boom in the run "
+                                             r"\(traceback in .*failed\.json\)") as info:
+        run_experiment("zdt1", "nsga2", runs=3, evals=300, out=tmp_path, progress=False)
+    assert info.value.path.is_file() and info.value.spec.seed == bad_seed
+    assert len(calls) == 3 and len(load_records(tmp_path)) == 3       # runs 0, 0+molsp, 1 kept; 2 not started
+
+
+def test_retried_failure_is_replaced_by_the_record(tmp_path, failing_run, fake_run, monkeypatch):
+    run_experiment("zdt1", "nsga2", runs=2, evals=300, out=tmp_path, keep_going=True, progress=False)
+    assert len(list(tmp_path.rglob("*.failed.json"))) == 1
+    calls, _ = fake_run
+    monkeypatch.setattr(moo.runner, "run", lambda problem, algorithm, **kw: _FakeResult(
+        problem, algorithm, kw["seed"], kw["evals"], kw.get("n_obj"), kw["molsp"], kw["max_leaders"],
+        kw["pop_size"]))
+    report = run_experiment("zdt1", "nsga2", runs=2, evals=300, out=tmp_path, progress=False)
+    assert (report.skipped, report.completed, report.failed) == (3, 1, ())
+    assert not list(tmp_path.rglob("*.failed.json")) and len(load_records(tmp_path)) == 4
+
+
+def test_cli_failures_exit_1_with_one_line(tmp_path, failing_run, capsys):
+    args = ["experiment", "--problem", "zdt1", "--algorithms", "nsga2", "--runs", "3", "--evals", "300"]
+    assert main([*args, "--out", str(tmp_path / "a")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("python -m moo: error: run zdt1/nsga2+molsp run 1") and "boom in the run" in err[-1]
+    assert "rerun to resume" in err[-1]
+    assert main([*args, "--out", str(tmp_path / "b"), "--keep-going"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("python -m moo: error: 1 of 6 runs failed; tracebacks in ")
+    assert err[-1].endswith(".failed.json") and len(load_records(tmp_path / "b")) == 5
+
+
+def test_any_executor_thread_pool_gives_the_serial_records(tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+
+    kw = dict(runs=2, evals=60, pop_size=20, progress=False)
+    run_experiment("zdt1", "nsga2", out=tmp_path / "serial", **kw)
+    with ThreadPoolExecutor(2) as pool:
+        report = run_experiment("zdt1", "nsga2", out=tmp_path / "threads", executor=pool, **kw)
+    assert report.completed == 4
+    key = ("molsp", "seed", "F", "X", "hv_history", "n_evals")
+    assert [[r[k] for k in key] for r in load_records(tmp_path / "serial")] == \
+           [[r[k] for k in key] for r in load_records(tmp_path / "threads")]
+    with pytest.raises(ValueError, match="not both"):
+        run_experiment("zdt1", "nsga2", out=tmp_path / "x", executor=pool, workers=2, **kw)
+    with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
+        run_experiment("zdt1", "nsga2", out=tmp_path / "x", executor="dask", **kw)
+
+
+def test_executor_stops_at_a_failure_and_keeps_what_finished(tmp_path, failing_run, monkeypatch):
+    import time
+    from concurrent.futures import ThreadPoolExecutor
+
+    from moo.experiment import RunFailedError
+
+    calls, _ = failing_run
+    stub = moo.runner.run
+    monkeypatch.setattr(moo.runner, "run", lambda *a, **kw: (time.sleep(0.05), stub(*a, **kw))[1])
+    with ThreadPoolExecutor(1) as pool, pytest.raises(RunFailedError):
+        run_experiment("zdt1", "nsga2", runs=4, evals=300, out=tmp_path, executor=pool, progress=False)
+    # the 4th run failed; the queued ones were cancelled (at most the one in flight ran on)
+    assert len(list(tmp_path.rglob("*.failed.json"))) == 1 and len(calls) <= 4
+    assert 3 <= len(load_records(tmp_path)) <= 4
+    # with instant runs everything has finished when the failure is seen: all of it is kept
+    monkeypatch.setattr(moo.runner, "run", stub)
+    with ThreadPoolExecutor(1) as pool, pytest.raises(RunFailedError):
+        run_experiment("zdt1", "nsga2", runs=4, evals=300, out=tmp_path / "b", executor=pool, progress=False)
+    assert len(load_records(tmp_path / "b")) == 7
+
+
+# ----------------------------------------------------------------------------- CLI: --out, corrupt records, help
+
+@pytest.mark.parametrize("where, message", [("file/sub", "--out: cannot create directory"),
+                                            ("file", "--out: '{}' exists and is not a directory"),
+                                            ("/proc/moo-results", "--out: cannot create directory"),
+                                            ("", "--out must be a directory path")])
+def test_cli_experiment_unusable_out(tmp_path, capsys, where, message):
+    (tmp_path / "file").write_text("")
+    out = "" if not where else (where if where.startswith("/") else str(tmp_path / where))
+    code = main(["experiment", "--problem", "zdt1", "--runs", "1", "--evals", "300", "--out", out])
+    err = capsys.readouterr().err
+    assert code == 2 and message.format(out) in err and err.count("\n") == 1, err
+
+
+def test_cli_stats_and_plot_name_a_corrupt_record(tmp_path, fake_run, capsys):
+    run_experiment("zdt1", "nsga2", runs=2, evals=300, out=tmp_path / "res", progress=False)
+    bad = sorted((tmp_path / "res").rglob("seed_*.json"))[1]
+    bad.write_text('{"problem": "zdt1", "F": [[1')
+    for cmd in (["stats", str(tmp_path / "res")], ["plot", str(tmp_path / "res"), "--out", str(tmp_path / "fig")]):
+        assert main(cmd) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{bad} is not a readable run record" in err, err
+    bad.write_text('{"problem": "zdt1"}')
+    assert main(["stats", str(tmp_path / "res")]) == 2
+    assert f"{bad} is not a run record: missing field(s) n_obj" in capsys.readouterr().err
+
+
+def test_cli_deprecated_molsp_max_leaders_alias(tmp_path, fake_run, capsys):
+    calls, _ = fake_run
+    args = ["experiment", "--problem", "zdt1", "--algorithms", "nsga2", "--runs", "1", "--evals", "300"]
+    assert main([*args, "--molsp-max-leaders", "3", "--out", str(tmp_path / "a")]) == 0
+    assert "--molsp-max-leaders is deprecated, use --max-leaders" in capsys.readouterr().err
+    assert {r["max_leaders"] for r in load_records(tmp_path / "a") if r["molsp"]} == {3}
+    assert main([*args, "--molsp-max-leaders", "3", "--max-leaders", "3", "--out", str(tmp_path / "b")]) == 2
+    assert "give --max-leaders only" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [[], ["run"], ["experiment"], ["stats"], ["plot"]])
+def test_every_help_has_an_example_and_the_exit_codes(command, capsys):
+    with pytest.raises(SystemExit) as info:
+        main([*command, "--help"])
+    out = capsys.readouterr().out
+    assert info.value.code == 0 and "example" in out and "python -m moo " + " ".join(command) in out
+    assert "exit codes: 0 done; 1 the work failed" in out and "2 bad arguments" in out

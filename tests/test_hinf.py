@@ -206,6 +206,10 @@ def test_backoff_keeps_the_gain_finite():
     assert backed.gamma == pytest.approx(1.01 * backed.gamma_opt, rel=1e-12)
     assert np.linalg.norm(backed.K) < 1e-3 * np.linalg.norm(at_opt.K)
     assert cl_norm(plant, backed.K, EX7_B1, EX7_C1, EX7_D12) <= backed.gamma
+    # the optimum is singular here (X -> singular, |K| -> inf): the floored X gives a
+    # stabilising gain whose norm is the infimum up to the accuracy of the minimisation
+    assert at_opt.is_stabilizing()
+    assert cl_norm(plant, at_opt.K, EX7_B1, EX7_C1, EX7_D12) <= at_opt.gamma * (1 + 1e-6)
 
 
 def test_discrete_gain_is_certified_at_the_backed_off_level_without_a_second_solve():
@@ -231,12 +235,13 @@ def test_discrete_gain_is_certified_at_the_backed_off_level_without_a_second_sol
 
 def test_preconditioning_is_a_similarity(monkeypatch):
     """The LQR coordinates change the solver's path, not the level: same gamma_opt without them."""
-    hinf_module = importlib.import_module("robustctl.hinf")  # robustctl.hinf is also the function
+    synthesis = importlib.import_module("robustctl.hinf._synthesis")
 
     plant, Bw, Cz, Dzu, _ = random_case(2, 6, 2, 3, discrete=True)
     with_pre = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
-    monkeypatch.setattr(hinf_module._Problem, "precondition", lambda self: False)
+    monkeypatch.setattr(synthesis, "lqr_coordinates", lambda data, discrete: None)
     without = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    assert with_pre.info["solves"][0]["tol"] == 1e-8 and without.info["solves"][0]["tol"] == 1e-10
     ref = hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, rtol=1e-9)
     assert with_pre.gamma_opt == pytest.approx(ref.gamma, rel=RTOL)
     assert without.gamma_opt == pytest.approx(ref.gamma, rel=RTOL)
@@ -325,6 +330,43 @@ def test_input_bound_continuous_time():
     u_max = 0.7 * worst_case_input(plant, free.K, Bw, 2.0)[0]
     ctrl = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, u_max=u_max, w_energy=2.0)
     assert worst_case_input(plant, ctrl.K, Bw, 2.0)[0] <= u_max
+
+
+def check_input_bound_sweep(plant, Bw, Cz, Dzu, u_maxes, **kw):
+    """Every u_max from far too tight to absurdly loose, against the unbounded design (issue 12).
+
+    At least as loose as the unbounded design's guaranteed peak input
+    sqrt(k X k') (X its Lyapunov matrix): the unbounded level, and the bound
+    holds. Tighter: either a clear infeasibility or a design that pays for
+    the bound and meets it (exact worst-case input by the Gramian).
+    """
+    free = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, **kw)
+    peak = np.sqrt(np.einsum("ij,jk,ik->i", free.K, free.info["X"], free.K))
+    assert np.all(worst_case_input(plant, free.K, Bw, 1.0) <= peak * (1 + 1e-9))
+    loose = 0
+    for u_max in u_maxes:
+        try:
+            ctrl = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, u_max=u_max, **kw)
+        except (InfeasibleError, rc.ConvergenceError) as exc:
+            assert np.any(u_max < peak), f"u_max={u_max:g} is inactive (peak {peak}) but: {exc}"
+            assert "u_max" in str(exc) or "backoff" in str(exc)
+            continue
+        assert np.all(ctrl.info["u_bound"] <= u_max * (1 + 1e-9))
+        for p in [plant] + list(kw.get("vertices", [])):
+            assert np.all(worst_case_input(p, ctrl.K, Bw, 1.0) <= u_max * (1 + 1e-9))
+        assert ctrl.gamma_opt >= free.gamma_opt * (1 - RTOL)
+        if np.all(u_max >= peak):
+            loose += 1
+            assert ctrl.gamma_opt == pytest.approx(free.gamma_opt, rel=RTOL)
+            assert np.allclose(ctrl.K, free.K, rtol=1e-3, atol=0)
+    return loose
+
+
+def test_a_loose_input_bound_gives_the_unbounded_design():
+    """Issue 12: u_max = 1e5 raised InfeasibleError and 1e8, 1e12 a solver failure on this plant."""
+    plant = Plant([[1.1, .2], [0, .9]], [[0], [1]], .1)
+    Bw, Cz, Dzu = np.array([[0.0], [1]]), np.array([[1.0, 0], [0, 1], [0, 0]]), np.array([[0.0], [0], [1]])
+    assert check_input_bound_sweep(plant, Bw, Cz, Dzu, 10.0 ** np.arange(-1, 13)) == 12   # 1e1 .. 1e12
 
 
 def test_too_tight_input_bound_is_infeasible():

@@ -11,6 +11,7 @@ import pytest
 import cvxpy as cp  # noqa: E402  (a dependency: never skip)
 
 from robustctl import _cvx  # noqa: E402
+from robustctl import errors as rc_errors  # noqa: E402
 from robustctl.errors import InfeasibleError  # noqa: E402
 
 
@@ -73,3 +74,40 @@ def test_only_the_wrapper_calls_solve():
     offenders = [str(p.relative_to(root)) for p in root.rglob("*.py")
                  if p.name != "_cvx.py" and pattern.search(p.read_text())]
     assert offenders == []
+
+
+def test_certificate_of_constant_blocks():
+    """The same evaluation as after a solve, for a candidate point given as arrays."""
+    M = np.array([[2.0, 1.0], [1.0, 2.0]])
+    cert = _cvx.certificate([_cvx.LMI("M", M), _cvx.LMI("expr", cp.Constant(M) - 3.0 * np.eye(2))])
+    assert cert == pytest.approx({"M": 1.0, "expr": -2.0}, abs=1e-12)
+    with pytest.raises(rc_errors.ConvergenceError, match="non-finite values in LMI 'bad'"):
+        _cvx.certificate([_cvx.LMI("bad", np.array([[np.nan]]))])
+    with pytest.raises(ValueError, match="'skew' is not symmetric"):
+        _cvx.certificate([_cvx.LMI("skew", np.array([[1.0, 1.0], [0.0, 1.0]]))])
+
+
+def test_other_solvers_run_with_their_defaults():
+    X = cp.Variable((2, 2), symmetric=True)
+    rep = _cvx.solve_sdp(cp.Minimize(cp.trace(X)), [_cvx.LMI("X-I", X - np.eye(2))], solver="SCS")
+    assert rep.solver == "SCS" and rep.value == pytest.approx(2.0, rel=1e-3)
+
+
+def test_a_solver_crash_is_a_convergence_error(monkeypatch):
+    class PanicException(BaseException):  # what pyo3 raises for a Rust panic inside Clarabel
+        pass
+
+    def crash(self, *args, **kwargs):
+        raise PanicException("index out of bounds")
+
+    monkeypatch.setattr(cp.Problem, "solve", crash)
+    X = cp.Variable((2, 2), symmetric=True)
+    with pytest.raises(rc_errors.ConvergenceError, match="crashed internally.*index out of bounds"):
+        _cvx.solve_sdp(cp.Minimize(cp.trace(X)), [_cvx.LMI("X", X)])
+
+    def interrupt(self, *args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cp.Problem, "solve", interrupt)
+    with pytest.raises(KeyboardInterrupt):   # anything else is not swallowed
+        _cvx.solve_sdp(cp.Minimize(cp.trace(X)), [_cvx.LMI("X", X)])

@@ -93,3 +93,13 @@ def test_truck_curvature_disturbance_near_the_edge_of_feasibility(plants):
         for plant in plants:
             assert worst_input(plant, ctrl.K, Bw, 0.01) <= STEER_LIMIT * (1 + 1e-5)
             assert hinf_norm(plant, ctrl.K, Bw) <= ctrl.gamma * (1 + 1e-5)
+
+
+@pytest.mark.parametrize("polytopic", [False, True])
+def test_truck_loose_steering_limit_gives_the_unbounded_design(plants, polytopic):
+    """Issue 12: on the truck a bound from 1e6 upwards raised InfeasibleError or a solver failure."""
+    from test_hinf import check_input_bound_sweep
+
+    kw = dict(vertices=plants[1:]) if polytopic else {}
+    u_maxes = 10.0 ** np.arange(-1, 13, 2 if polytopic else 1)
+    assert check_input_bound_sweep(plants[0], plants[0].G, CZ, DZU, u_maxes, **kw) >= 6

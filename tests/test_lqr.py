@@ -26,6 +26,7 @@ def test_lqr_equals_minus_dlqr(seed):
 
 
 def test_dare_scipy_fallback_matches(monkeypatch):
+    pytest.importorskip("slycot")  # the optional robustctl[slycot] extra (make test installs it)
     rng = np.random.default_rng(3)
     plant = random_plant(rng, 4, 2, scale=1.5)
     P_sly, backend = dare(plant.F, plant.G, np.eye(4), np.eye(2))
@@ -65,3 +66,60 @@ def test_lqr_bad_weights(kw, err, match):
 def test_lqr_rejects_continuous_plant():
     with pytest.raises(ValueError, match="discrete-time"):
         rc.lqr(rc.Plant(np.eye(2), np.ones((2, 1)), None))
+
+
+_WITHOUT_SLYCOT = r'''
+import importlib.abc, json, sys
+
+class _Hide(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name == "slycot" or name.startswith("slycot."):
+            raise ImportError("slycot hidden for this test")
+
+sys.meta_path.insert(0, _Hide())
+for mod in [m for m in sys.modules if m == "slycot" or m.startswith("slycot.")]:
+    del sys.modules[mod]
+import numpy as np
+import robustctl as rc
+from robustctl.hinf_riccati import hinf_riccati
+
+try:
+    import slycot  # noqa: F401
+    hidden = False
+except ImportError:
+    hidden = True
+case = json.loads(sys.argv[1])
+plant = rc.Plant(case["F"], case["G"], 0.1)
+lqr = rc.lqr(plant, Q=np.eye(plant.n), R=np.eye(plant.m))
+Bw, Cz, Dzu = (np.array(case[k]) for k in ("Bw", "Cz", "Dzu"))
+h = rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+ref = hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+A, C = plant.F + plant.G @ h.K, Cz + Dzu @ h.K
+peak = max(np.linalg.svd(C @ np.linalg.solve(np.exp(1j * w) * np.eye(plant.n) - A, Bw), compute_uv=False)[0]
+           for w in np.linspace(0, np.pi, 4001))
+print(json.dumps({"hidden": hidden, "backend": lqr.info["backend"], "K": lqr.K.tolist(),
+                  "residual": lqr.info["residual"], "gamma": h.gamma, "gamma_opt": h.gamma_opt,
+                  "gamma_riccati": float(ref.gamma), "peak": float(peak)}))
+'''
+
+
+def test_lqr_and_hinf_work_with_slycot_hidden():
+    """slycot is an optional extra (GPL-2.0): with it hidden, lqr falls back to scipy's DARE and hinf to no
+    balancing; the results match slycot's LQR (this process) and the game-Riccati bisection (scipy)."""
+    import json
+    import subprocess
+    import sys
+
+    rng = np.random.default_rng(8)
+    plant = random_plant(rng, 3, 1, scale=1.3)
+    case = {"F": plant.F.tolist(), "G": plant.G.tolist(), "Bw": rng.standard_normal((3, 1)).tolist(),
+            "Cz": np.vstack([np.eye(3), np.zeros((1, 3))]).tolist(), "Dzu": [[0.0], [0.0], [0.0], [1.0]]}
+    run = subprocess.run([sys.executable, "-c", _WITHOUT_SLYCOT, json.dumps(case)], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout.strip().splitlines()[-1])
+    assert out["hidden"] and out["backend"] == "scipy" and out["residual"] < 1e-10
+    K_pc = -control.dlqr(plant.F, plant.G, np.eye(3), np.eye(1))[0]    # slycot in this process
+    np.testing.assert_allclose(out["K"], K_pc, atol=1e-8)
+    assert abs(out["gamma_opt"] - out["gamma_riccati"]) <= 1e-5 * out["gamma_riccati"]
+    assert out["gamma_opt"] * (1 - 1e-3) <= out["peak"] <= out["gamma"] * (1 + 1e-9)

@@ -12,6 +12,7 @@ against NSGA-III, DTLZ1 convergence) stay in each algorithm's own test file.
 
 from __future__ import annotations
 
+import copy
 import inspect
 import subprocess
 import sys
@@ -158,6 +159,7 @@ def test_initial_population_passes_through_the_survival(name):
     alg = _factory(name)(n_obj=3, pop_size=20)
     assert alg.advance_after_initial_infill is True
     calls = []
+    alg.survival = copy.deepcopy(alg.survival)        # pymoo's NSGA2 shares one default survival object
     survive = alg.survival.do
     alg.survival.do = lambda *a, **k: calls.append(len(a[1])) or survive(*a, **k)
     alg.setup(problem, termination=("n_eval", 40), seed=0)

@@ -118,12 +118,15 @@ def test_script_end_to_end(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "| nsga2/MO-LSP |" in text and "| NSGA-III |" in text
     assert re.search(r"Direction of the MO-LSP effect agrees in \d+/10 cells", text)
-    for suffix in (".md", ".tex", "_stats.csv", "_runs.csv", "_vs_paper.csv"):
+    for suffix in (".md", ".tex", "_stats.csv", "_runs.csv", "_ranks.csv", "_vs_paper.csv"):
         assert (out / f"moea_generic{suffix}").is_file()
     assert len((out / "moea_generic_vs_paper.csv").read_text().splitlines()) == 1 + 10
+    assert "mean ranks (Friedman, Nemenyi)" in text and "^w:" in text
+    assert {"hv_generic.png", "boxplots_generic.pdf", "fronts_generic_nsga3.png", "cd_generic_igd.png"} <= \
+        {p.name for p in (out / "figures").iterdir()}
     # resumable: a second call runs nothing
     assert main(["--problem", "generic", "--runs", "2", "--evals", "184", "--algorithms", "nsga2,nsga3",
-                 "--workers", "1", "--out", str(out)]) == 0
+                 "--workers", "1", "--out", str(out), "--no-plots"]) == 0
     assert "8 already done, 0 run now" in capsys.readouterr().out
 
 

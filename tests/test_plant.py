@@ -130,8 +130,68 @@ def test_continuous_controller_stability():
 
 def test_design_dispatch_errors():
     plant = rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1)
-    with pytest.raises(ValueError, match="unknown design method 'pid'; valid: hinf, lqr, rlqr"):
+    with pytest.raises(ValueError, match="unknown design method 'pid'; valid: h2, hinf, lqr, rlqr"):
         rc.design("pid", plant)
     with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
         rc.design("lqr", np.eye(2))
     assert rc.design("LQR", plant).method == "lqr"
+
+
+def test_closed_loop_statespace_is_python_controls_feedback_with_minus_K():
+    rng = np.random.default_rng(2)
+    plant = rc.Plant(rng.standard_normal((3, 3)) * 0.6, rng.standard_normal((3, 2)), 0.1)
+    c = rc.lqr(plant)
+    cl = c.to_statespace()
+    ref = control.feedback(plant.to_statespace(), -c.K)    # python-control feeds back with a minus sign
+    for ours, theirs in zip((cl.A, cl.B, cl.C, cl.D), (ref.A, ref.B, ref.C, ref.D)):
+        np.testing.assert_allclose(ours, theirs, atol=1e-14)
+    assert cl.dt == 0.1
+    x0 = rng.standard_normal(3)
+    resp = control.initial_response(cl, T=np.arange(20) * 0.1, X0=x0)
+    x = x0.copy()
+    for k in range(20):                                    # x+ = (F + G K) x, u = K x
+        np.testing.assert_allclose(resp.states[:, k], x, atol=1e-12)
+        x = plant.F @ x + plant.G @ c(x)
+    # around a perturbed plant, and for a continuous loop
+    other = rc.Plant(plant.F * 0.9, plant.G, 0.1)
+    np.testing.assert_allclose(c.to_statespace(other).A, other.F + other.G @ c.K)
+    cont = rc.Controller(np.array([[-1.0, -2.0]]), "x", rc.Plant.from_continuous(A, B, dt=None))
+    assert cont.to_statespace().dt == 0
+
+
+def test_from_continuous_errors_name_A():
+    with pytest.raises(ValueError, match=r"tustin.*I - A dt/2 invertible.*eigenvalue at 2/dt = 20"):
+        rc.Plant.from_continuous(np.diag([20.0, -1.0]), [[1.0], [1.0]], dt=0.1, method="tustin")
+    with pytest.raises(ValueError, match=r"^A is too large for dt=0.1"):
+        rc.Plant.from_continuous(1e300 * np.eye(2), [[1.0], [1.0]], dt=0.1)
+    with pytest.raises(ValueError, match=r"^B must be a rectangular array"):
+        rc.Plant.from_continuous(A, [[1.0, 2.0], [3.0]], dt=0.1)
+    with pytest.raises(ValueError, match=r"^A must be a rectangular array"):
+        rc.Plant.from_continuous([[1.0, 2.0], [3.0]], B, dt=0.1)
+
+
+def test_controller_rejects_non_numeric_and_non_finite_states():
+    plant = rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1)
+    c = rc.Controller(np.array([[-0.1, -0.2]]), "x", plant)
+    with pytest.raises(TypeError, match="^x must be an array of numbers"):
+        c("x")
+    with pytest.raises(ValueError, match="^x must have finite entries"):
+        c([np.nan, 1.0])
+    with pytest.raises(TypeError, match="^x must contain real numbers, got booleans"):
+        c([True, False])
+    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+        rc.Controller(np.zeros((1, 2)), "x", np.eye(2))
+
+
+def test_perturb_rejects_booleans_strings_and_non_plants():
+    plant = rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1)
+    unc = rc.NormBounded([1.0, 2.0], [[0.1, 0.2]], [[0.3]])
+    for bad, err, match in ((True, TypeError, "^Delta must be an array of numbers"),
+                            ("x", TypeError, "^Delta must be an array of numbers"),
+                            (1j, TypeError, "^Delta must contain real numbers, got complex")):
+        with pytest.raises(err, match=match):
+            unc.perturb(plant, bad)
+    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+        unc.perturb(np.eye(2), 0.5)
+    with pytest.raises(ValueError, match="^H must be a rectangular array"):
+        rc.NormBounded([[1.0], [2.0, 3.0]], [[0.1, 0.2]], [[0.3]])

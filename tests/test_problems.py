@@ -434,3 +434,56 @@ def test_applied_any_population_in_the_box_gives_finite_objectives(applied_tiny,
     f = applied_tiny.evaluate(np.maximum(z, 1e-6))
     assert f.shape == (z.shape[0], 4)
     assert np.all(np.isfinite(f)) and np.all(f > 0) and np.all(f <= 2 * applied_tiny.penalty)
+
+
+# ------------------------------------------------------------ engine, API --
+def test_backends_agree_on_both_problems(applied_short, generic):
+    """The compiled simulator (default) and the numpy reference give the same objectives."""
+    numpy_generic = GenericRLQRProblem(backend="numpy")
+    np.testing.assert_allclose(generic.evaluate(RANDOM_Z), numpy_generic.evaluate(RANDOM_Z), rtol=1e-12)
+    numpy_applied = AppliedRLQRProblem(path=applied_short.path, backend="numpy")
+    np.testing.assert_allclose(applied_short.evaluate(APPLIED_Z), numpy_applied.evaluate(APPLIED_Z), rtol=1e-12)
+    with pytest.raises(ValueError, match="backend"):
+        GenericRLQRProblem(backend="cuda")
+
+
+@pytest.mark.parametrize("make", [GenericRLQRProblem, lambda: AppliedRLQRProblem(path=default_route(duration=5.0))])
+def test_evaluate_names_the_bad_argument(make):
+    """Not pymoo's AssertionError: an error that names X and its expected shape."""
+    p = make()
+    with pytest.raises(ValueError, match=rf"X must have shape \(B, {p.n_var}\).*got shape \(2, {p.n_var + 1}\)"):
+        p.evaluate(np.ones((2, p.n_var + 1)))
+    with pytest.raises(TypeError, match="X must be an array of numbers"):
+        p.evaluate("x")
+    with pytest.raises(ValueError, match="X must have finite entries"):
+        p.evaluate(np.full((1, p.n_var), np.nan))
+    one = p.evaluate(p.paper_optimum)                       # a single vector still gives one row
+    assert one.shape == (p.n_obj,)
+    np.testing.assert_array_equal(one, p.evaluate(p.paper_optimum[None])[0])
+
+
+def test_stability_screen_uses_the_public_spectral_radius(applied_short):
+    K = applied_short.gains(APPLIED_Z).K
+    rho = applied_short.closed_loop_radius(np.where(np.isfinite(K), K, np.nan))
+    F_s, G_s, _ = truck.discretise(applied_short.overloads)
+    for b in range(K.shape[0]):
+        for s in range(F_s.shape[0]):
+            if np.all(np.isfinite(K[b])):
+                A = F_s[s] + G_s[s] @ K[b].sum(axis=0, keepdims=True)
+                assert rho[b, s] == pytest.approx(np.max(np.abs(np.linalg.eigvals(A))), rel=1e-12)
+    K_nan = K[:2].copy()
+    K_nan[0, 0, 0] = np.nan
+    assert np.isinf(applied_short.closed_loop_radius(K_nan)[0]).all()
+
+
+def test_applied_experiment_is_the_same_with_workers(tmp_path):
+    """Same seed, same records, whether the runs share one process or go to spawned workers
+    (which load the compiled kernel from the cache)."""
+    from moo.experiment import load_records, run_experiment
+
+    kw = dict(runs=2, evals=40, pop_size=20, progress=False)
+    run_experiment("applied", "nsga2", out=tmp_path / "serial", **kw)
+    run_experiment("applied", "nsga2", out=tmp_path / "parallel", workers=2, **kw)
+    serial, parallel = load_records(tmp_path / "serial"), load_records(tmp_path / "parallel")
+    assert len(serial) == 4
+    assert [(r["molsp"], r["seed"], r["F"]) for r in serial] == [(r["molsp"], r["seed"], r["F"]) for r in parallel]

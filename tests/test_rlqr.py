@@ -164,18 +164,28 @@ def test_generic_model_printed_z_star_is_stabilising(generic_plant):
 def test_finite_horizon_schedule():
     rng = np.random.default_rng(11)
     plant, Q, R, EF, EG, H, steady = _stable_case(rng, 100.0)
-    sch = rc.rlqr(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=400)
+    sch = rc.rlqr_schedule(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=400)
     assert sch.K.shape == (400, plant.m, plant.n) and sch.P.shape == (401, plant.n, plant.n)
     np.testing.assert_allclose(sch.P[-1], Q)
     assert _rel(sch.K[0], steady.K) < 1e-8  # long horizon: K_0 -> steady state
-    blk = rc.rlqr(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5, implementation="block")
-    short = rc.rlqr(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5)
+    blk = rc.rlqr_schedule(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5, implementation="block")
+    short = rc.rlqr_schedule(plant, EF, EG, 100.0, Q=Q, R=R, H=H, horizon=5)
     assert _rel(short.K, blk.K) < 1e-10 and _rel(short.L, blk.L) < 1e-10
     c3 = short.controller(3)
     np.testing.assert_array_equal(c3.K, short.K[3])
     # step 4 (the last) from P_N by hand with the block system
     L4, K4, P4 = rlqr_step_block(Q, plant.F, plant.G, EF, EG, Q, R, H, 100.0)
     assert _rel(short.K[4], K4) < 1e-10 and _rel(short.P[4], P4) < 1e-10
+
+
+def test_rlqr_with_horizon_is_deprecated_and_returns_the_schedule(generic_plant):
+    args = (generic_plant, [[0.1, 0.2, 0.2]], [[0.1]], 1e3)
+    with pytest.warns(DeprecationWarning, match="rlqr_schedule"):
+        old = rc.rlqr(*args, horizon=7)
+    new = rc.rlqr_schedule(*args, horizon=7)
+    assert isinstance(old, rc.RLQRSchedule)
+    np.testing.assert_array_equal(old.K, new.K)
+    np.testing.assert_array_equal(old.P, new.P)
 
 
 def test_errors_single_design(generic_plant):
@@ -276,12 +286,13 @@ def test_batch_broadcasting_and_shapes():
         ({"H": np.ones((2, 1))}, ValueError, "H must have 3 rows"),
         ({"Q": np.ones((3, 3)) - 2 * np.eye(3)}, ValueError, "Q must be positive semidefinite"),
         ({"R": [[-1.0]]}, ValueError, "R must be positive definite"),
-        ({"horizon": 0}, ValueError, "horizon must be a positive integer"),
+        ({"horizon": 0}, ValueError, "horizon must be a positive integer"),  # the deprecated form
         ({"tol": 0.0}, ValueError, "tol must be > 0"),
         ({"max_iter": 0}, ValueError, "max_iter must be a positive integer"),
         ({"implementation": "fast"}, ValueError, "implementation must be"),
     ],
 )
+@pytest.mark.filterwarnings("ignore:rlqr\\(\\.\\.\\., horizon=N\\) is deprecated:DeprecationWarning")
 def test_rlqr_bad_input(generic_plant, kw, err, match):
     args = {"EF": [[0.1, 0.2, 0.2]], "EG": [[0.1]], "mu": 1e3}
     args.update(kw)
@@ -295,3 +306,125 @@ def test_rlqr_rejects_continuous_and_non_plants():
         rc.rlqr(rc.Plant(np.eye(2), np.ones((2, 1)), None), [[1.0, 0.0]], [[1.0]], 1.0)
     with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
         rc.rlqr_gains(np.eye(2), [[1.0, 0.0]], [[1.0]], 1.0)
+
+
+# ---------------------------------------------------------------------------- ill-conditioned designs
+def _ill_conditioned_truck_designs(count, seed=2026):
+    """The doubled-column truck with the applied MOP's weights; EG2 / EG1 = 1 +- 0.002 (nearly dependent
+    split of the steering column: P reaches 1e15 and doubling misses the acceptance test on ~1/4)."""
+    from robustctl.models.truck import lqr_weights, truck_plant
+
+    rng = np.random.default_rng(seed)
+    z = rng.uniform(0, 500, (count, 7))
+    z[:, 5] = z[:, 4] * (1 + rng.uniform(-0.002, 0.002, count))
+    Q, R = lqr_weights(doubled=True)
+    return truck_plant(0.0, doubled=True), z[:, None, :4], z[:, None, 4:6], 10 ** np.sqrt(z[:, 6]), Q, R
+
+
+def test_newton_fallback_on_ill_conditioned_designs_matches_the_recursion():
+    plant, EF, EG, mu, Q, R = _ill_conditioned_truck_designs(60)
+    kw = dict(Q=Q, R=R, max_iter=2000)
+    rec = rc.rlqr_gains(plant, EF, EG, mu, **kw)
+    new = rc.rlqr_gains(plant, EF, EG, mu, fallback="newton", **kw)
+    refined = rec.iterations > 30                      # the designs the recursion had to redo
+    assert refined.sum() >= 5
+    # doubling-accepted designs are untouched
+    np.testing.assert_array_equal(new.K[~refined], rec.K[~refined])
+    assert (new.iterations[refined] <= 30).all()     # a few Newton steps instead of hundreds of recursion steps
+    # same acceptance rule: residual of one more recursion step below tol, rho(L) < 1
+    assert new.ok[rec.ok].all() and (new.residual[new.ok] < 1e-10).all()
+    assert (np.abs(np.linalg.eigvals(new.L[new.ok])).max(axis=1) < 1).all()
+    # reference: the plain recursion run to 3e-12 (on a few designs that is below its rounding floor)
+    compared = 0
+    for i in np.flatnonzero(refined):
+        try:
+            ref = rc.rlqr(plant, EF[i], EG[i], mu[i], Q=Q, R=R, accelerate=False, tol=3e-12, max_iter=20_000)
+        except rc.ConvergenceError:
+            continue
+        compared += 1
+        assert _rel(new.P[i], ref.info["P"]) < 1e-9, i  # the recursion stopped at tol 1e-10 is only ~1e-8 close
+        assert _rel(new.K[i], ref.K) < 1e-6, i          # K = f(P) amplifies P's rounding by ~1e4 here
+        if rec.ok[i]:
+            assert _rel(rec.P[i], ref.info["P"]) < 1e-7, i
+    assert compared >= 0.75 * refined.sum()
+
+
+def test_newton_fallback_accepts_a_slow_design_the_capped_recursion_flags(generic_plant):
+    """mu ~ 7e10 on the generic plant: rho(L) = 0.9986, the recursion needs ~10^4 steps."""
+    z = np.array([47.8069, 103.7683, 181.5866, 53.6425, 117.4085])
+    args = (generic_plant, z[None, None, :3], z[None, None, 3:4], 10 ** np.sqrt(z[4:]))
+    assert list(rc.rlqr_gains(*args, max_iter=50).reason) == ["not converged"]
+    new = rc.rlqr_gains(*args, max_iter=50, fallback="newton")
+    ref = rc.rlqr(generic_plant, z[None, :3], z[None, 3:4], 10 ** np.sqrt(z[4]), accelerate=False,
+                  max_iter=50_000, tol=1e-13)
+    assert new.ok[0] and new.iterations[0] < 50
+    assert _rel(new.P[0], ref.info["P"]) < 1e-9 and _rel(new.K[0], ref.K) < 1e-9
+
+
+def test_newton_fallback_keeps_failures_flagged():
+    plant = rc.Plant(GENERIC_F, GENERIC_G, 0.1)
+    EF = np.array([[[0.1, 0.2, 0.2]], [[1.0, 1.0, 1.0]], [[0.1, 0.2, 0.3]]])
+    EG = np.array([[[0.1]], [[0.0]], [[-2.0]]])
+    mu = np.array([1e6, np.inf, np.inf])
+    for p, ef, eg, m in ((plant, EF, EG, mu),
+                         (rc.Plant(np.diag([1.5, 0.5, 0.2]), [[1.0], [0.0], [0.0]], 0.1), [[0.0, 1.0, 0.0]],
+                          [[1.0]], np.inf)):
+        rec, new = rc.rlqr_gains(p, ef, eg, m), rc.rlqr_gains(p, ef, eg, m, fallback="newton")
+        assert list(new.reason) == list(rec.reason)
+    with pytest.raises(ValueError, match="fallback must be one of 'recursion', 'newton'"):
+        rc.rlqr_gains(plant, EF, EG, mu, fallback="fast")
+
+
+# ---------------------------------------------------------------------------- uncertainty object, stabilisability
+def test_uncertainty_object_equals_the_explicit_matrices(generic_plant):
+    H, EF, EG = np.array([[1.0], [0.5], [0.2]]), np.array([[0.1, 0.2, 0.2]]), np.array([[0.1]])
+    unc = rc.NormBounded(H, EF, EG)
+    explicit = rc.rlqr(generic_plant, EF, EG, 1e4, H=H)
+    for c in (rc.rlqr(generic_plant, mu=1e4, uncertainty=unc), rc.design("rlqr", generic_plant, mu=1e4, uncertainty=unc)):
+        np.testing.assert_array_equal(c.K, explicit.K)
+    b = rc.rlqr_gains(generic_plant, mu=[1e2, 1e4], uncertainty=unc)
+    np.testing.assert_array_equal(b.K[1], explicit.K)
+    sch = rc.rlqr_schedule(generic_plant, mu=1e4, uncertainty=unc, horizon=3)
+    np.testing.assert_array_equal(sch.K, rc.rlqr_schedule(generic_plant, EF, EG, 1e4, H=H, horizon=3).K)
+    with pytest.raises(TypeError, match="either uncertainty=NormBounded"):
+        rc.rlqr(generic_plant, EF, EG, 1e4, uncertainty=unc)
+    with pytest.raises(TypeError, match="uncertainty must be a robustctl.NormBounded"):
+        rc.rlqr(generic_plant, mu=1e4, uncertainty=(H, EF, EG))
+    with pytest.raises(ValueError, match="uncertainty is for n=3"):
+        rc.rlqr(rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1), mu=1e4, uncertainty=unc)
+    with pytest.raises(TypeError, match="mu is required"):
+        rc.rlqr(generic_plant, uncertainty=unc)
+    with pytest.raises(TypeError, match="give EF and EG"):
+        rc.rlqr(generic_plant, mu=1.0)
+
+
+def _with_uncontrollable_mode(rng, n_c, mode):
+    """F = T blkdiag(A_c, mode) T^-1, G = T [B_c; 0]: ``mode`` is uncontrollable by construction."""
+    n = n_c + 1
+    A_c = 0.5 * rng.standard_normal((n_c, n_c))
+    F = np.zeros((n, n))
+    F[:n_c, :n_c], F[n_c, n_c] = A_c, mode
+    F[:n_c, n_c] = rng.standard_normal(n_c)        # coupling from the uncontrollable part
+    G = np.vstack([rng.standard_normal((n_c, 1)), [[0.0]]])
+    T = rng.standard_normal((n, n)) + n * np.eye(n)
+    return rc.Plant(T @ F @ np.linalg.inv(T), T @ G, 0.1)
+
+
+@pytest.mark.parametrize("mode,stabilisable", [(1.3, False), (-1.0, False), (1.0, False), (0.99, True), (0.2, True)])
+def test_every_design_raises_the_same_error_on_an_unstabilisable_plant(mode, stabilisable):
+    plant = _with_uncontrollable_mode(np.random.default_rng(4), 2, mode)
+    assert plant.is_stabilizable == stabilisable
+    EF, EG = [[0.1, 0.2, 0.1]], [[0.5]]
+    if stabilisable:
+        assert plant.unstabilizable_modes.size == 0
+        assert rc.lqr(plant).is_stabilizing() and rc.rlqr(plant, EF, EG, 1e6).info["residual"] < 1e-10
+        return
+    np.testing.assert_allclose(plant.unstabilizable_modes, [mode], atol=1e-9)
+    for design in (lambda: rc.lqr(plant), lambda: rc.rlqr(plant, EF, EG, 1e6), lambda: rc.rlqr(plant, EF, EG, 10.0)):
+        with pytest.raises(rc.NotStabilizableError, match=rf"plant is not stabilisable: its mode lambda = {mode:g}"):
+            design()
+    # the same class serves handlers written for lqr (ConvergenceError) and hinf (InfeasibleError)
+    assert issubclass(rc.NotStabilizableError, rc.ConvergenceError)
+    assert issubclass(rc.NotStabilizableError, rc.InfeasibleError)
+    b = rc.rlqr_gains(plant, np.array(EF)[None].repeat(3, 0), EG, [1.0, 1e6, np.inf])
+    assert list(b.reason) == ["unstabilizable"] * 3 and np.isnan(b.K).all() and not b.stabilizing.any()

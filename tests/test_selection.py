@@ -184,7 +184,7 @@ def test_applied_errors_match_direct_simulations(applied, monkeypatch):
     ref = np.empty((3, 3))
     for d in range(3):
         for s, ov in enumerate([0.0, 150.0, 240.0]):
-            e = simulate(K[d], path, ov).errors[0, 0]          # (T, 4): x - x_ref
+            e = simulate(K[d], path, ov, input_map=truck.DOUBLED_INPUT_MAP).errors[0, 0]   # (T, 4): x - x_ref
             ref[d, s] = np.einsum("ti,ij,tj->", e, Qx, e)
     np.testing.assert_allclose(E, ref, rtol=1e-9)
     # scenario chunks do not change the numbers

@@ -188,3 +188,178 @@ def test_comparison_is_frozen():
     assert isinstance(c, Comparison)
     with pytest.raises(AttributeError):
         c.better = "molsp"
+
+
+# ----------------------------------------------------------------------------- nonparametric statistics
+
+from moo.stats import (FriedmanResult, friedman, friedman_test, holm, nemenyi_cd, rank_sum_test,  # noqa: E402
+                       ranks_to_csv, ranks_to_latex, ranks_to_markdown)
+
+# Demsar (2006), Table 6: AUC of C4.5, C4.5+m, C4.5+cf, C4.5+m+cf on 14 UCI data sets (as printed).
+DEMSAR_AUC = np.array([
+    [0.763, 0.768, 0.771, 0.798], [0.599, 0.591, 0.590, 0.569], [0.954, 0.971, 0.968, 0.967],
+    [0.628, 0.661, 0.654, 0.657], [0.882, 0.888, 0.886, 0.898], [0.936, 0.931, 0.916, 0.931],
+    [0.661, 0.668, 0.609, 0.685], [0.583, 0.583, 0.563, 0.625], [0.775, 0.838, 0.866, 0.875],
+    [1.000, 1.000, 1.000, 1.000], [0.940, 0.962, 0.965, 0.962], [0.619, 0.666, 0.614, 0.669],
+    [0.972, 0.981, 0.975, 0.975], [0.957, 0.978, 0.946, 0.970]])
+
+
+def test_friedman_and_nemenyi_against_demsar_2006():
+    ranks, chi2, p, cd = friedman_test(DEMSAR_AUC, higher_is_better=True, alpha=0.05)
+    # Demsar's mean ranks 3.143, 2.000, 2.893, 1.964 come from the unrounded AUCs: in the printed table
+    # C4.5+cf and C4.5+m+cf tie on one data set (0.975), which moves 0.5/14 between them.
+    assert ranks[0] == pytest.approx(3.143, abs=5e-4) and ranks[1] == pytest.approx(2.000, abs=5e-4)
+    assert ranks[2] == pytest.approx(2.893 + 0.5 / 14, abs=5e-4)
+    assert ranks[3] == pytest.approx(1.964 - 0.5 / 14, abs=5e-4)
+    # Demsar's chi2_F = 12N/(k(k+1)) [sum R_j^2 - k(k+1)^2/4] (9.28 with his ranks), divided by the usual
+    # tie correction 1 - sum(t^3 - t) / (N k (k^2 - 1)) over the groups of tied values in each block
+    N, k = DEMSAR_AUC.shape
+    assert 12 * N / (k * (k + 1)) * (np.sum(np.array([3.143, 2.000, 2.893, 1.964]) ** 2)
+                                     - k * (k + 1) ** 2 / 4) == pytest.approx(9.28, abs=0.01)
+    uncorrected = 12 * N / (k * (k + 1)) * (np.sum(ranks ** 2) - k * (k + 1) ** 2 / 4)
+    ties = sum(t ** 3 - t for row in DEMSAR_AUC for t in np.unique(row, return_counts=True)[1])
+    assert chi2 == pytest.approx(uncorrected / (1 - ties / (N * k * (k * k - 1))), rel=1e-12)
+    assert p == pytest.approx(sps.chi2.sf(chi2, k - 1), rel=1e-12)
+    # the critical differences of Demsar's Section 3.2.2: q_0.05 = 2.569, CD = 1.25; q_0.10 = 2.291, CD = 1.12
+    assert cd == pytest.approx(2.569 * math.sqrt(k * (k + 1) / (6 * N)), rel=2e-4)
+    assert round(cd, 2) == 1.25 and round(nemenyi_cd(4, 14, 0.10), 2) == 1.12
+    # Demsar's conclusion: at 0.05 no pair differs; at 0.10 C4.5 is worse than C4.5+m and C4.5+m+cf
+    names = ("C4.5", "C4.5+m", "C4.5+cf", "C4.5+m+cf")
+    for alpha, pairs in ((0.05, set()), (0.10, {("C4.5", "C4.5+m"), ("C4.5", "C4.5+m+cf")})):
+        res = FriedmanResult("demsar", "auc", names, tuple(ranks), N, chi2, p, nemenyi_cd(k, N, alpha), alpha)
+        assert {(a, b) for i, a in enumerate(names) for b in names[i + 1:] if res.differs(a, b)} == pairs
+        P = res.nemenyi_p()
+        assert np.array_equal(P < alpha, np.array([[res.differs(a, b) for b in names] for a in names]))
+        assert np.allclose(P, P.T) and np.all(np.diag(P) == 1)
+
+
+def test_nemenyi_q_table_of_demsar():
+    """Demsar (2006), Table 5(a): q_0.05 for k = 2..10 (Studentized range / sqrt 2, three decimals)."""
+    table = [1.960, 2.343, 2.569, 2.728, 2.850, 2.949, 3.031, 3.102, 3.164]
+    for k, q in zip(range(2, 11), table):
+        assert nemenyi_cd(k, 1, 0.05) / math.sqrt(k * (k + 1) / 6) == pytest.approx(q, abs=1.5e-3)
+
+
+def test_friedman_two_treatments_is_the_sign_test():
+    """With k = 2 and no ties, Friedman's chi2 equals (n_+ - n_-)^2 / n (the sign test's statistic)."""
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(15, 2)) + [0.0, 0.4]
+    ranks, chi2, p, _ = friedman_test(X)
+    wins = int(np.sum(X[:, 0] < X[:, 1]))
+    assert chi2 == pytest.approx((wins - (15 - wins)) ** 2 / 15, rel=1e-12)
+    assert ranks.sum() == pytest.approx(3.0) and p == pytest.approx(sps.chi2.sf(chi2, 1), rel=1e-12)
+    # three treatments: the same statistic as scipy on the untouched table
+    Y = rng.normal(size=(12, 3))
+    assert friedman_test(Y)[1] == pytest.approx(sps.friedmanchisquare(*Y.T).statistic, rel=1e-12)
+    with pytest.raises(ValueError, match="values must be a"):
+        friedman_test(np.ones((1, 3)))
+    with pytest.raises(ValueError, match="finite"):
+        friedman_test([[1.0, np.nan], [1.0, 2.0]])
+    assert friedman_test(np.ones((4, 3)))[1:3] == (0.0, 1.0)
+
+
+def test_holm_against_the_textbook_example():
+    """Holm (1979) step-down on four hypotheses (the example of Wikipedia's 'Holm-Bonferroni method'):
+    p = 0.01, 0.04, 0.03, 0.005 at alpha 0.05 rejects H1 and H4 only."""
+    adjusted = holm([0.01, 0.04, 0.03, 0.005])
+    assert np.allclose(adjusted, [0.03, 0.06, 0.06, 0.02], rtol=1e-12)
+    assert list(adjusted < 0.05) == [True, False, False, True]
+    # NaNs stay NaN and leave the family: the same as the finite values alone
+    assert np.allclose(holm([0.01, np.nan, 0.04])[[0, 2]], holm([0.01, 0.04])) and np.isnan(holm([np.nan])[0])
+    with pytest.raises(ValueError, match="p_values"):
+        holm([0.5, 1.5])
+
+
+def test_holm_is_the_step_down_procedure():
+    """The adjusted p-values reject exactly what the sequential procedure rejects, at every alpha."""
+    rng = np.random.default_rng(8)
+    for _ in range(200):
+        p = rng.random(rng.integers(1, 12)) ** 3
+        adj = holm(p)
+        for alpha in (0.01, 0.05, 0.2):
+            order, m, rejected = np.argsort(p), len(p), np.zeros(len(p), bool)
+            for i, j in enumerate(order):
+                if p[j] > alpha / (m - i):
+                    break
+                rejected[j] = True
+            assert np.array_equal(adj <= alpha, rejected)
+
+
+def test_rank_sum_against_the_scipy_example():
+    """scipy.stats.mannwhitneyu's documented example (ages of males and females): U = 17, exact p = 0.1111."""
+    males, females = [19, 22, 16, 29, 24], [20, 11, 17, 12]
+    assert rank_sum_test(males, females) == pytest.approx(0.1111111111111111, rel=1e-12)
+    assert sps.mannwhitneyu(males, females).statistic == 17
+    # complete separation of 3 vs 3: exact two-sided p = 2 / C(6, 3) = 0.1
+    assert rank_sum_test([1.0, 2.0, 3.0], [11.0, 12.0, 13.0]) == pytest.approx(0.1, rel=1e-12)
+    assert rank_sum_test([1.0, 1.0], [1.0, 1.0, 1.0]) == 1.0 and math.isnan(rank_sum_test([1.0], [2.0, 3.0]))
+
+
+def test_compare_wilcoxon_holm_family_is_the_column():
+    rng = np.random.default_rng(5)
+    runs = []
+    for alg, shift in (("a1", 3.0), ("a2", 0.0), ("a3", 1.0)):
+        runs += [_row(alg, False, s, igd=v) for s, v in enumerate(rng.normal(0, 1, 12))]
+        runs += [_row(alg, True, s, igd=v) for s, v in enumerate(rng.normal(shift, 1, 12))]
+    table = [c for c in compare(runs) if c.indicator == "igd"]
+    raw = [sps.mannwhitneyu([r.igd for r in runs if r.algorithm == c.algorithm and not r.molsp],
+                            [r.igd for r in runs if r.algorithm == c.algorithm and r.molsp]).pvalue for c in table]
+    assert [c.p_wilcoxon for c in table] == pytest.approx(raw, rel=1e-12)
+    assert [c.p_wilcoxon_holm for c in table] == pytest.approx(list(holm(raw)), rel=1e-12)
+    by = {c.algorithm: c for c in table}
+    assert by["a1"].significant_wilcoxon and not by["a2"].significant_wilcoxon
+    md = to_markdown(compare(runs))
+    assert "^a,w" in md and "^w:" in md and "Holm" in md         # the mark and its legend
+
+
+def _grid_runs(seeds=10):
+    """Three MOEAs x two variants, run i of each sharing seed i; 'good+molsp' best on every run."""
+    rng = np.random.default_rng(9)
+    quality = {"good": 1.0, "mid": 2.0, "bad": 3.0}
+    runs = []
+    for s in range(seeds):
+        noise = rng.normal(0, 0.1, 6)
+        for i, (alg, molsp) in enumerate((a, v) for a in quality for v in (True, False)):
+            runs.append(_row(alg, molsp, s, igd=quality[alg] - 0.5 * molsp + noise[i], hv=float(s)))
+    return runs
+
+
+def test_friedman_over_variants_blocks_by_seed():
+    runs = _grid_runs()
+    results = {r.indicator: r for r in friedman(runs)}
+    igd = results["igd"]
+    assert igd.variants == ("bad+molsp", "bad", "good+molsp", "good", "mid+molsp", "mid")   # not registered: by name
+    assert igd.n_blocks == 10 and igd.rejects
+    table = np.array([[r.igd for v in igd.variants for r in runs
+                       if r.seed == s and f"{r.algorithm}{'+molsp' if r.molsp else ''}" == v] for s in range(10)])
+    ranks, chi2, p, cd = friedman_test(table)
+    assert igd.mean_ranks == tuple(ranks) and (igd.statistic, igd.p_value, igd.cd) == (chi2, p, cd)
+    assert igd.differs("good+molsp", "bad") and not igd.differs("good+molsp", "good")
+    # HV constant within each block: every variant ties, the test does not reject
+    assert results["hv"].mean_ranks == (3.5,) * 6 and results["hv"].p_value == 1.0
+    # a run missing for one variant drops that seed's block
+    assert {r.indicator: r for r in friedman([r for r in runs if not (r.seed == 0 and r.algorithm == "bad")])}[
+        "igd"].n_blocks == 9
+
+
+def test_ranks_tables_marks_and_legend(tmp_path):
+    results = friedman(_grid_runs())
+    md = ranks_to_markdown(results)
+    row = next(line for line in md.splitlines() if line.startswith("| good/MO-LSP |"))
+    assert row.split("|")[2].strip().startswith("**1.")                    # best mean rank in bold
+    bad = next(line for line in md.splitlines() if line.startswith("| bad |"))
+    assert bad.split("|")[2].strip().endswith("^n")                       # Nemenyi: worse than the best
+    assert "| Friedman p |" in md and "| CD |" in md and "^n:" in md and "Bold:" in md
+    tex = ranks_to_latex(results)
+    assert r"\textbf{" in tex and "$^{n}$" in tex and r"\end{tabular}" in tex
+    rows = list(csv.DictReader(io.StringIO(ranks_to_csv(results, tmp_path / "r.csv"))))
+    assert len(rows) == 5 * 6 and (tmp_path / "r.csv").exists()
+    igd_bad = next(r for r in rows if r["indicator"] == "igd" and r["variant"] == "bad")
+    assert igd_bad["worse_than_best"] == "True" and float(igd_bad["mean_rank"]) > 5
+
+
+def test_comparison_legend_explains_every_mark():
+    md, tex = to_markdown(_table()), to_latex(_table())
+    for mark in ("Bold:", "^a:", "^w:", "^*:"):
+        assert mark in md
+    assert "$^{a}$:" in tex and "$^{*}$:" in tex and r"\%" in tex

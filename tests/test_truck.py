@@ -204,3 +204,14 @@ def test_lqr_weights_doubled_column_costs_the_same():
     K2 = rc.design("lqr", p2, Q=Q2, R=R2).K
     np.testing.assert_allclose(K2.sum(axis=0), K[0], rtol=1e-8)
     np.testing.assert_allclose(K2[0], K2[1], rtol=1e-8)
+
+
+def test_truck_plant_does_not_import_python_control():
+    """The applied MOP's import cost: the ZOH is scipy's expm, python-control stays unloaded."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from robustctl.models import truck; truck.truck_plant(0.0, doubled=True); "
+            "print('control' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

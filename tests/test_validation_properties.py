@@ -81,3 +81,253 @@ def test_batch_never_returns_unflagged_nan(B, seed):
     assert np.isfinite(b.K[b.ok]).all() and np.isfinite(b.P[b.ok]).all()
     assert np.isnan(b.K[~b.ok]).all()
     assert set(b.reason) <= {"ok", "rank", "diverged", "not converged"}
+
+
+# ---------------------------------------------------------------------------- issue 12, causes 2-7
+# Every public function of robustctl's core gets, for each of its arguments, values of each bad kind:
+# a boolean, a string (also numeric-looking), a complex number, a ragged nested list, None, a non-finite
+# entry, a junk object. Handled well = ValueError/TypeError whose message starts with the argument's name
+# (the project's subclasses count). TALLY counts cases tried / handled well per (function, cause); set
+# ROBUSTCTL_TALLY=<file> to write the table.
+import collections
+import os
+import re
+
+TALLY = collections.defaultdict(lambda: [0, 0])
+
+F2, G2 = np.array([[1.1, 0.2], [0.0, 0.9]]), np.array([[0.0], [1.0]])
+PLANT = rc.Plant(F2, G2, 0.1)
+EF2, EG2, H2 = np.array([[0.1, 0.2]]), np.array([[0.1]]), np.ones((2, 1))
+UNC = rc.NormBounded(H2, EF2, EG2)
+CTRL = rc.rlqr(PLANT, EF2, EG2, 1e4)
+A2 = np.array([[0.0, 1.0], [-2.0, -3.0]])
+RLQR_ARGS = {"EF": EF2, "EG": EG2, "mu": 1e4, "Q": np.eye(2), "R": np.eye(1), "H": H2, "alpha": 0.1,
+             "tol": 1e-10, "max_iter": 100}
+
+
+def _rlqr(**kw):
+    a = {**RLQR_ARGS, **kw}
+    return rc.rlqr(PLANT, a.pop("EF"), a.pop("EG"), a.pop("mu"), **a)
+
+
+def _gains(**kw):
+    a = {**RLQR_ARGS, "EF": np.ones((3, 1, 2)) * EF2, "mu": [1e2, 1e4, np.inf], **kw}
+    return rc.rlqr_gains(PLANT, a.pop("EF"), a.pop("EG"), a.pop("mu"), **a)
+
+
+def _schedule(**kw):
+    a = {**RLQR_ARGS, "horizon": 3, **kw}
+    a.pop("tol"), a.pop("max_iter")
+    return rc.rlqr_schedule(PLANT, a.pop("EF"), a.pop("EG"), a.pop("mu"), **a)
+
+
+def _step(**kw):
+    a = {"P_next": np.eye(2), "F": F2, "G": G2, "EF": EF2, "EG": EG2, "Q": np.eye(2), "R": np.eye(1), "H": H2,
+         "mu": 1e4, "alpha": 0.1, **kw}
+    return rlqr_step(**a), rlqr_step_block(**a)
+
+
+from robustctl.lqr import dare  # noqa: E402
+from robustctl.rlqr import rlqr_step, rlqr_step_block  # noqa: E402
+from robustctl.stability import unstabilizable_modes  # noqa: E402
+
+# function -> {argument: (valid value, kind)}; kind "matrix", "scalar" (inf allowed where the function says),
+# "int", "flag", "choice"
+CASES = {
+    "Plant": (lambda F=F2, G=G2, dt=0.1: rc.Plant(F, G, dt), {"F": F2, "G": G2, "dt": 0.1}),
+    "Plant.from_continuous": (lambda A=A2, B=G2, dt=0.1, method="zoh": rc.Plant.from_continuous(A, B, dt, method),
+                              {"A": A2, "B": G2, "dt": 0.1, "method": "zoh"}),
+    "NormBounded": (lambda H=H2, EF=EF2, EG=EG2: rc.NormBounded(H, EF, EG), {"H": H2, "EF": EF2, "EG": EG2}),
+    "NormBounded.perturb": (lambda plant=PLANT, Delta=0.5: UNC.perturb(plant, Delta), {"plant": PLANT, "Delta": 0.5}),
+    "NormBounded.perturbed_matrices": (lambda Delta=np.array([0.5, -0.5]): UNC.perturbed_matrices(PLANT, Delta),
+                                       {"Delta": np.array([0.5, -0.5])}),
+    "Controller": (lambda K=CTRL.K, plant=PLANT: rc.Controller(K, "x", plant), {"K": CTRL.K, "plant": PLANT}),
+    "Controller.__call__": (lambda x=np.ones(2): CTRL(x), {"x": np.ones(2)}),
+    "Controller.closed_loop": (lambda plant=PLANT: CTRL.closed_loop(plant), {"plant": PLANT}),
+    "Controller.to_statespace": (lambda plant=PLANT: CTRL.to_statespace(plant), {"plant": PLANT}),
+    "design": (lambda method="lqr": rc.design(method, PLANT), {"method": "lqr"}),
+    "lqr": (lambda plant=PLANT, Q=np.eye(2), R=np.eye(1): rc.lqr(plant, Q=Q, R=R),
+            {"plant": PLANT, "Q": np.eye(2), "R": np.eye(1)}),
+    "dare": (lambda F=F2, G=G2, Q=np.eye(2), R=np.eye(1): dare(F, G, Q, R),
+             {"F": F2, "G": G2, "Q": np.eye(2), "R": np.eye(1)}),
+    "rlqr": (_rlqr, {**RLQR_ARGS, "accelerate": True, "implementation": "kkt", "fallback": "newton",
+                     "P_N": np.eye(2)}),
+    "rlqr_schedule": (_schedule, {"horizon": 3, "EF": EF2, "EG": EG2, "mu": 1e4, "H": H2, "alpha": 0.1,
+                                  "P_N": np.eye(2), "implementation": "kkt"}),
+    "rlqr_gains": (_gains, {"EF": np.ones((3, 1, 2)) * EF2, "EG": EG2, "mu": np.array([1e2, 1e4, np.inf]),
+                            "Q": np.eye(2), "R": np.eye(1), "H": H2, "alpha": 0.1, "tol": 1e-10,
+                            "max_iter": 100, "P0": np.eye(2), "fallback": "newton"}),
+    "rlqr_step": (_step, {"P_next": np.eye(2), "F": F2, "G": G2, "EF": EF2, "EG": EG2, "Q": np.eye(2),
+                          "R": np.eye(1), "H": H2, "mu": 1e4, "alpha": 0.1}),
+    "spectral_radius": (lambda A=F2: rc.spectral_radius(A), {"A": F2}),
+    "is_schur_stable": (lambda A=F2: rc.is_schur_stable(A), {"A": F2}),
+    "unstabilizable_modes": (lambda F=F2, G=G2: unstabilizable_modes(F, G), {"F": F2, "G": G2}),
+}
+FLAGS, CHOICES, INTS = {"accelerate"}, {"method", "implementation", "fallback"}, {"max_iter", "horizon"}
+INF_OK = {"mu"}  # inf is a valid value of these
+CAUSES = ["bool", "string", "numeric string", "complex", "ragged", "None", "nan", "inf", "object"]
+_JUNK = st.sampled_from([{"key": 1}, object(), {1, 2}, b"bytes", print])
+
+
+def _at_one_entry(arr, make):
+    """A nested list like ``arr`` with one (drawn) entry replaced by ``make(entry)``."""
+    @st.composite
+    def draw(draw_):
+        flat = arr.ravel().tolist()
+        k = draw_(st.integers(0, len(flat) - 1))
+        flat[k] = draw_(make(flat[k]))
+        return np.array(flat, dtype=object).reshape(arr.shape).tolist()
+    return draw()
+
+
+def _bad(valid, cause, name):
+    """A strategy of bad values of kind ``cause`` shaped like ``valid`` (None when the cause does not apply)."""
+    if cause == "None":
+        return st.none()
+    if cause == "object":
+        return _JUNK
+    if name in FLAGS:
+        return {"bool": None, "string": st.text(max_size=5), "numeric string": st.sampled_from(["1", "0", "True"]),
+                "complex": st.just(1j), "ragged": st.just([[True], []]), "nan": st.just(np.nan),
+                "inf": st.sampled_from([0, 1, 1.0])}[cause]
+    if name in CHOICES:
+        return {"bool": st.booleans(), "string": st.text(max_size=6).filter(lambda t: t not in ("kkt", "block",
+                "recursion", "newton", "zoh", "tustin", "euler", "lqr", "rlqr", "hinf", "LQR", "RLQR", "HINF")),
+                "numeric string": st.just("1"), "complex": st.just(1j), "ragged": st.just([["kkt"], []]),
+                "nan": st.just(np.nan), "inf": st.just(np.inf)}[cause]
+    if isinstance(valid, rc.Plant):
+        return {"bool": st.booleans(), "string": st.text(max_size=5), "numeric string": st.just("1"),
+                "complex": st.just(1j), "ragged": st.just([[1.0], [1.0, 2.0]]), "nan": st.just(np.nan),
+                "inf": st.just(np.inf)}[cause]
+    arr = np.asarray(valid, dtype=float)
+    finite = st.floats(-10, 10, allow_nan=False)
+    if cause == "bool":
+        if arr.ndim == 0:
+            return st.sampled_from([True, False, np.True_, np.False_])
+        return st.one_of(st.just(np.ones(arr.shape, dtype=bool)), _at_one_entry(arr, lambda x: st.booleans()))
+    if cause == "string":
+        text = st.text(min_size=1, max_size=4)
+        return text if arr.ndim == 0 else _at_one_entry(arr, lambda x: text)
+    if cause == "numeric string":
+        return st.just(repr(float(arr))) if arr.ndim == 0 else st.just(arr.astype(str).tolist())
+    if cause == "complex":
+        imag = st.floats(0.1, 10).map(lambda b: complex(0, b))
+        return imag.map(lambda z: float(arr) + z) if arr.ndim == 0 else _at_one_entry(arr, lambda x: imag.map(
+            lambda z: x + z))
+    if cause == "ragged":
+        if arr.ndim == 0:
+            return st.just([[1.0], [1.0, 2.0]])
+        rows = np.atleast_2d(arr).tolist()
+
+        @st.composite
+        def ragged(draw_):
+            out = [list(r) for r in rows] + [list(rows[-1])]
+            k = draw_(st.integers(0, len(out) - 1))
+            out[k] = out[k] + [draw_(finite)] if draw_(st.booleans()) or len(out[k]) == 1 else out[k][:-1]
+            return out if arr.ndim <= 2 else [out, [[1.0]]]
+        return ragged()
+    if name in INF_OK and cause == "inf":
+        return None
+    bad = st.just(np.nan) if cause == "nan" else st.sampled_from([np.inf, -np.inf])
+    if arr.ndim == 0:
+        return bad
+    return _at_one_entry(arr, lambda x: bad).map(lambda v: np.array(v, dtype=float))
+
+
+def _handled_well(call, name) -> bool:
+    try:
+        with np.errstate(all="ignore"):
+            call()
+    except (TypeError, ValueError) as exc:
+        return re.match(rf"{re.escape(name)}\b", str(exc)) is not None or (
+            name == "plant" and str(exc).startswith("plant must"))
+    except Exception:  # anything else (numpy, scipy, AttributeError, ...) is not handled well
+        return False
+    return False  # a bad value accepted
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _write_tally():
+    yield
+    if os.environ.get("ROBUSTCTL_TALLY") and TALLY:
+        with open(os.environ["ROBUSTCTL_TALLY"], "w") as fh:
+            for (func, cause), (tried, good) in sorted(TALLY.items()):
+                fh.write(f"{func}\t{cause}\t{tried}\t{good}\n")
+
+
+@pytest.mark.parametrize("func", sorted(CASES))
+@pytest.mark.parametrize("cause", CAUSES)
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_every_bad_argument_is_named(func, cause, data):
+    call, args = CASES[func]
+    for name, valid in args.items():
+        if cause == "None" and (name in ("P_N", "P0", "H", "Q", "R", "dt") or func.startswith("Controller.")):
+            continue  # None is a documented value there (default, identity, continuous time, the design plant)
+        if cause in ("nan", "inf") and func in ("spectral_radius", "is_schur_stable"):
+            continue  # documented: radius inf, unstable (checked in test_stability)
+        strategy = _bad(valid, cause, name)
+        if strategy is None:
+            continue
+        value = data.draw(strategy, label=name)
+        TALLY[(func, cause)][0] += 1
+        ok = _handled_well(lambda: call(**{name: value}), name)
+        TALLY[(func, cause)][1] += ok
+        assert ok, (func, name, cause, value)
+
+
+@pytest.mark.parametrize("func", sorted(CASES))
+def test_the_valid_calls_of_the_table_work(func):
+    CASES[func][0]()
+
+
+@SETTINGS
+@given(seed=st.integers(0, 10_000), mode=st.one_of(st.floats(1.0, 3.0), st.floats(-3.0, -1.0), st.floats(-0.95, 0.95)),
+       mu=st.sampled_from([1.0, 1e6, np.inf]))
+def test_unstabilisable_plants_raise_in_every_design_and_flag_in_the_batch(seed, mode, mu):
+    """Cause 2: a constructed uncontrollable mode; |mode| >= 1 -> NotStabilizableError from lqr and rlqr."""
+    rng = np.random.default_rng(seed)
+    T = rng.standard_normal((3, 3)) + 3 * np.eye(3)
+    F = np.zeros((3, 3))
+    F[:2, :2], F[:2, 2], F[2, 2] = 0.5 * rng.standard_normal((2, 2)), rng.standard_normal(2), mode
+    G = np.vstack([rng.standard_normal((2, 1)), [[0.0]]])
+    plant = rc.Plant(T @ F @ np.linalg.inv(T), T @ G, 0.1)
+    EF, EG = rng.uniform(0.1, 1, (1, 3)), rng.uniform(0.5, 1, (1, 1))
+    TALLY[("lqr / rlqr / rlqr_gains", "unstabilisable")][0] += 1
+    if abs(mode) < 1:
+        assert plant.is_stabilizable
+        assert rc.lqr(plant).is_stabilizing()
+        TALLY[("lqr / rlqr / rlqr_gains", "unstabilisable")][1] += 1
+        return
+    for design in (lambda: rc.lqr(plant), lambda: rc.rlqr(plant, EF, EG, mu)):
+        with pytest.raises(rc.NotStabilizableError, match=r"^plant is not stabilisable: its mode lambda"):
+            design()
+    b = rc.rlqr_gains(plant, EF, EG, [mu, 2 * mu])
+    assert list(b.reason) == ["unstabilizable"] * 2 and np.isnan(b.K).all()
+    TALLY[("lqr / rlqr / rlqr_gains", "unstabilisable")][1] += 1
+
+
+@SETTINGS
+@given(dt=st.floats(0.01, 1.0), other=st.floats(-5.0, 5.0), scale=st.floats(1e200, 1e300))
+def test_discretisation_failures_name_A(dt, other, scale):
+    """Cause 6 (tustin with I - A dt/2 singular) and 5 (A dt overflowing is A's fault, not F's)."""
+    A = np.diag([2.0 / dt, other])
+    for bad, method, match in ((A, "tustin", r"^method='tustin' needs I - A dt/2 invertible"),
+                               (scale * np.eye(2), "zoh", r"^A is too large")):
+        TALLY[("Plant.from_continuous", "discretisation")][0] += 1
+        with pytest.raises(ValueError, match=match):
+            rc.Plant.from_continuous(bad, [[1.0], [1.0]], dt=dt, method=method)
+        TALLY[("Plant.from_continuous", "discretisation")][1] += 1
+
+
+@SETTINGS
+@given(shape=st.sampled_from([(2,), (4, 2), (3, 5, 2)]), seed=st.integers(0, 1000),
+       value=st.sampled_from([np.nan, np.inf, -np.inf]))
+def test_controller_refuses_non_finite_states(shape, seed, value):
+    """Cause 7: a NaN or inf state anywhere in a stack is refused, never passed through."""
+    x = np.random.default_rng(seed).standard_normal(shape)
+    x.flat[seed % x.size] = value
+    TALLY[("Controller.__call__", "non-finite state")][0] += 1
+    with pytest.raises(ValueError, match="^x must have finite entries"):
+        CTRL(x)
+    TALLY[("Controller.__call__", "non-finite state")][1] += 1

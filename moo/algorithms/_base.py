@@ -87,7 +87,7 @@ def check_ref_dirs_fit(ref_dirs, problem) -> None:
 
 
 class NormalizationForwarding:
-    """Mixin for a survival holding a :class:`HyperplaneNormalization` in ``self.norm``.
+    """Mixin for a survival holding a :class:`~moo.algorithms._normalize.HyperplaneNormalization` in ``self.norm``.
 
     Exposes its ideal and nadir estimates, its ``normalize`` and its ``reset``.
     """

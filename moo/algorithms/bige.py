@@ -2,7 +2,7 @@
 
 Reference
 ---------
-.. [1] M. Li, S. Yang and X. Liu, "Bi-goal evolution for many-objective
+[1] M. Li, S. Yang and X. Liu, "Bi-goal evolution for many-objective
    optimization problems", Artificial Intelligence 228, 45-65, 2015.
 
 What is implemented

@@ -2,10 +2,10 @@
 
 References
 ----------
-.. [1] M. Li, S. Yang and X. Liu, "Shift-based density estimation for
+[1] M. Li, S. Yang and X. Liu, "Shift-based density estimation for
    Pareto-based algorithms in many-objective optimization", IEEE Trans.
    Evol. Comput. 18(3), 348-365, 2014.
-.. [2] E. Zitzler, M. Laumanns and L. Thiele, "SPEA2: Improving the strength
+[2] E. Zitzler, M. Laumanns and L. Thiele, "SPEA2: Improving the strength
    Pareto evolutionary algorithm", TIK-Report 103, ETH Zurich, 2001.
 
 What is implemented

@@ -6,8 +6,8 @@ with the doubled steering column (``G2 = [G G]``, steering ``alpha = u1 + u2``,
 :func:`robustctl.models.truck.truck_plant`), designed on the nominal-payload
 model with ``H = [1, 1, 1, 1]^T`` and ``mu = 10**sqrt(z7)``. The gain then
 drives the truck along a reference path at several payloads
-(:func:`robustctl.simulate.simulate`), and the four objectives are the mean
-squared path-following errors
+(:class:`robustctl.pathfollow.PathFollowing`, built once per problem), and the
+four objectives are the mean squared path-following errors
 
 * ``f1``: lateral displacement ``rho`` [m^2],
 * ``f2``: yaw rate ``psidot`` [(rad/s)^2],
@@ -32,14 +32,12 @@ from typing import Literal
 
 import numpy as np
 
-from robustctl._validation import check_positive_scalar
+from robustctl.batchsim import DEFAULT_BOUND
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
-from robustctl.simulate import DEFAULT_BOUND, simulate
+from robustctl.pathfollow import PathFollowing
 
-from .._validation import check_int
-from .generic import (_as_population, _check_aggregate, _check_penalty, _check_ref_point, _penalise,
-                      _RLQRTuningProblem, _spectral_radius, _weights)
+from ._rlqr_problem import RLQRTuningProblem
 
 __all__ = ["AppliedRLQRProblem"]
 
@@ -48,7 +46,7 @@ Z_LOWER = 1e-6
 Z_UPPER = 500.0
 
 
-class AppliedRLQRProblem(_RLQRTuningProblem):
+class AppliedRLQRProblem(RLQRTuningProblem):
     r"""Truck path-following RLQR tuning problem: 7 variables in ``(0, 500]``, 4 objectives.
 
     For each decision vector ``z`` (one row of the population):
@@ -58,7 +56,7 @@ class AppliedRLQRProblem(_RLQRTuningProblem):
        doubled-column truck at the nominal payload, ``H = ones((4, 1))``,
        weights ``Q``, ``R``; the whole population is designed in one batched call;
     3. the closed loop is simulated, for all designs and payload scenarios in
-       one array recursion (:func:`robustctl.simulate.simulate`): true truck at
+       one compiled run (:class:`robustctl.pathfollow.PathFollowing`): true truck at
        each overload, steering ``alpha = sat_0.45(u1 + u2 + alpha_ff)``, the
        nominal model's steady-cornering reference states and feedforward, the
        truck starting 1 m off the path;
@@ -88,11 +86,27 @@ class AppliedRLQRProblem(_RLQRTuningProblem):
     alpha : float
         RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin.
     max_iter : int
-        Recursion steps of :func:`robustctl.rlqr_gains` before its Newton phase;
-        a design not converged by then counts as not computable. Default 2000:
-        of 3000 uniformly random designs, the 2710 stable ones converged within
-        12 steps except two with ``E_G1 ~ E_G2`` (a nearly singular split of the
-        doubled column), which took 346 and 872.
+        Steps of the plain recursion :func:`robustctl.rlqr_gains` may take for
+        a design that neither the doubling nor the Newton refinement settles;
+        a design not converged by then counts as not computable. Default 500.
+        With ``fallback="newton"`` only designs with ``E_G1 / E_G2`` within
+        about 1e-5 of 1 (a nearly singular split of the doubled column, a
+        region SPEA2+SDE's runs crowd into) reach the recursion at all:
+        uniformly random designs (3000) and ratios ``1 +- 2e-3`` (1500) need
+        at most 26 steps; of 4500 designs with ratios ``1 +- 1e-5`` and the
+        552 of six SPEA2+SDE generations, caps of 500 and 2000 give identical
+        objectives (300: one design of the 4500 differs), and each step of the
+        recursion costs about 60 us per call whatever the number of designs,
+        so the cap bounds the cost of a population (one SPEA2+SDE run of
+        10000 evaluations: 15.2 s with a cap of 2000, 5.6 s with 500, on the
+        loaded 2-core machine).
+    fallback : {"newton", "recursion"}
+        How :func:`robustctl.rlqr_gains` treats the designs the doubling
+        leaves unsettled (those ill-conditioned ``E_G1 ~ E_G2`` splits): Newton
+        refinement of the doubling result (default; within 4e-11 of a 1e-13
+        reference recursion, and on ill-conditioned designs about 12x cheaper
+        than the plain recursion: 24 against 294 us per design in
+        ``benchmarks/bench_rlqr.py``), or the plain recursion.
     path : ReferencePath, optional
         Reference path (default :func:`robustctl.path.default_route`, 540 s).
     overloads : sequence of float
@@ -106,6 +120,9 @@ class AppliedRLQRProblem(_RLQRTuningProblem):
         Base penalty (default ``1e7``).
     hv_ref_point, molsp_ref_point : (4,) array_like, optional
         Override the reference points.
+    backend : {"numba", "numpy"}
+        Simulator (:mod:`robustctl.batchsim`): the compiled kernel (default)
+        or the numpy reference.
 
     Attributes
     ----------
@@ -144,79 +161,45 @@ class AppliedRLQRProblem(_RLQRTuningProblem):
         Q=None,
         R=None,
         alpha: float = 0.1,
-        max_iter: int = 2000,
+        max_iter: int = 500,
+        fallback: Literal["newton", "recursion"] = "newton",
         path: ReferencePath | None = None,
         overloads=(0.0, 100.0),
         aggregate: Literal["mean", "max"] = "mean",
         penalty: float = 1e7,
         hv_ref_point=None,
         molsp_ref_point=None,
+        backend: Literal["numba", "numpy"] = "numba",
     ):
-        self.plant = truck.truck_plant(0.0, doubled=True)
-        n, m = self.plant.n, self.plant.m
-        self.H = np.ones((n, 1))
+        plant = truck.truck_plant(0.0, doubled=True)
         Q_default, R_default = truck.lqr_weights(doubled=True)
-        self.Q, self.R = _weights(Q_default if Q is None else Q, R_default if R is None else R, n, m)
-        self.alpha = check_positive_scalar(alpha, "alpha")
-        self.max_iter = check_int(max_iter, "max_iter", 1)
         if path is None:
             path = default_route()
-        elif not isinstance(path, ReferencePath):
-            raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
-        par = truck.PAPER_PARAMETERS
-        if abs(path.speed - par.v) > 1e-9 * par.v or abs(path.dt - par.dt) > 1e-12:
-            raise ValueError(f"path speed and dt ({path.speed:g} m/s, {path.dt:g} s) must equal the truck "
-                             f"model's ({par.v:g} m/s, {par.dt:g} s)")
-        self.path = path
         if isinstance(overloads, (str, bytes)) or np.ndim(overloads) != 1 or len(overloads) == 0:
             raise ValueError(f"overloads must be a non-empty 1-D sequence of percentages, got {overloads!r}")
         self.overloads = np.asarray(truck.check_overload(list(overloads), "overloads"), dtype=float)
-        self.aggregate = _check_aggregate(aggregate)
-        self.penalty = _check_penalty(penalty)
+        # checks path; discretises the scenarios and builds the reference once
+        self._sim = PathFollowing(path, tuple(self.overloads), input_map=truck.DOUBLED_INPUT_MAP)
+        self.path = path
+        F_s, G_s, _ = truck.discretise(self.overloads)       # true plants of the scenarios (S, 4, 4), (S, 4, 1)
+        super().__init__(plant, np.ones((plant.n, 1)), F_s, G_s, truck.DOUBLED_INPUT_MAP,
+                         Q=Q_default if Q is None else Q, R=R_default if R is None else R, alpha=alpha,
+                         max_iter=max_iter, fallback=fallback, aggregate=aggregate, penalty=penalty,
+                         hv_ref_point=hv_ref_point, molsp_ref_point=molsp_ref_point, default_hv=self._HV_REF,
+                         default_molsp=self._MOLSP_REF, n_obj=4, xl=Z_LOWER, xu=Z_UPPER, backend=backend)
         if self.penalty <= DEFAULT_BOUND**2:
             raise ValueError(f"penalty must exceed the largest simulated MSE ({DEFAULT_BOUND**2:g}), "
                              f"got {self.penalty:g}")
-        self.hv_ref_point = _check_ref_point(hv_ref_point, "hv_ref_point", self._HV_REF)
-        self.molsp_ref_point = _check_ref_point(molsp_ref_point, "molsp_ref_point", self._MOLSP_REF)
-        # true plants of the scenarios, for the stability screen: F_s (S, 4, 4), G_s (S, 4, 1)
-        self._F_s, self._G_s, _ = truck.discretise(self.overloads)
-        super().__init__(n_var=n + m + 1, n_obj=4, xl=Z_LOWER, xu=Z_UPPER, vtype=float)
 
     # -- public helpers -----------------------------------------------------
-    def closed_loop_radius(self, K: np.ndarray) -> np.ndarray:
-        """Spectral radius (B, S) of ``F_s + G_s [1 1] K`` at each scenario payload (NaN for non-finite K)."""
-        K = self._check_K(K)
-        finite = np.all(np.isfinite(K), axis=(1, 2))
-        Ksteer = np.where(finite[:, None, None], K, 0.0).sum(axis=1, keepdims=True)   # (B, 1, 4)
-        rho = _spectral_radius(self._F_s[None] + self._G_s[None] @ Ksteer[:, None])
-        rho[~finite] = np.nan
-        return rho
-
-    def mse(self, K: np.ndarray) -> np.ndarray:
+    def mse(self, K) -> np.ndarray:
         """Per-scenario MSE (B, S, 4) of gains ``K`` (B, 2, 4), in the order f1..f4 (no penalties)."""
-        K = self._check_K(K)
-        return simulate(K, self.path, tuple(self.overloads), keep_trajectories=False).mse()
+        K = self.check_gains(K)
+        return self._sim.run(K, keep_trajectories=False, backend=self.backend).mse()
 
-    # -- pymoo hook -----------------------------------------------------------
-    def _evaluate(self, x, out, *args, **kwargs):
-        z = _as_population(x, self.n_var)
-        batch = self.gains(z)
-        ok = np.asarray(batch.ok, dtype=bool) & np.all(np.isfinite(batch.K), axis=(1, 2))
-        K = np.where(ok[:, None, None], batch.K, np.nan)
-        rho = np.max(self.closed_loop_radius(K), axis=1)
-        run = ok & (rho < 1.0)
-        J = np.full((z.shape[0], self.n_obj), np.inf)
-        if run.any():
-            e = self.mse(K[run])
-            J[run] = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
-        out["F"] = _penalise(J, ok, rho, self.penalty)
-
-    def _check_K(self, K) -> np.ndarray:
-        K = np.asarray(K, dtype=float)
-        n, m = self.plant.n, self.plant.m
-        if K.ndim != 3 or K.shape[1:] != (m, n):
-            raise ValueError(f"K must have shape (B, {m}, {n}), got shape {K.shape}")
-        return K
+    def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
+        """:meth:`mse` (the objectives before aggregation and penalties)."""
+        return self.mse(K)
 
     def __repr__(self) -> str:
         return (f"AppliedRLQRProblem(n_var={self.n_var}, n_obj={self.n_obj}, "

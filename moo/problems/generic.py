@@ -15,8 +15,10 @@ in ``[0, 200]^5`` parametrises a steady-state robust LQR (RLQR) gain
 ``mu = 10**sqrt(z5)``; the three objectives are the regulation errors of
 ``x1, x2, x3`` that gain achieves on the *true* uncertain system.
 
-The module also holds the small helpers both control-design MOPs share
-(decoding of ``z``, stability screening and the penalty rule); they are private.
+The steps both control-design MOPs share (decoding of ``z``, the batched
+RLQR, the stability screen and the penalty rule) are in
+:mod:`moo.problems._rlqr_problem`; the regulation errors are simulated by
+:class:`robustctl.batchsim.LinearSimulator` (compiled kernel by default).
 
 References
 ----------
@@ -32,101 +34,14 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pymoo.core.problem import Problem
 
 import robustctl as rc
-from robustctl._validation import as_matrix, check_positive_scalar, check_spd
+from robustctl.batchsim import LinearSimulator
 
-from .._validation import check_int
+from .._validation import as_matrix, check_int
+from ._rlqr_problem import RLQRTuningProblem
 
 __all__ = ["GenericRLQRProblem"]
-
-# --------------------------------------------------------------------------
-# helpers shared with moo.problems.applied (private)
-# --------------------------------------------------------------------------
-
-
-def _decode(z: np.ndarray, n: int, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Split a population ``z`` (B, n + m + 1) into ``EF`` (B, 1, n), ``EG`` (B, 1, m), ``mu`` (B,).
-
-    ``mu = 10 ** sqrt(z[:, -1])`` (the paper searches ``(log10 mu)^2``).
-    """
-    EF = z[:, None, :n].copy()
-    EG = z[:, None, n:n + m].copy()
-    mu = 10.0 ** np.sqrt(z[:, n + m])
-    return EF, EG, mu
-
-
-def _as_population(x, n_var: int) -> np.ndarray:
-    """``x`` as a finite (B, n_var) float array (a single (n_var,) vector becomes B = 1)."""
-    arr = np.asarray(x, dtype=np.float64)
-    if arr.ndim == 1:
-        arr = arr[None, :]
-    if arr.ndim != 2 or arr.shape[1] != n_var:
-        raise ValueError(f"x must have shape (B, {n_var}) (one decision vector per row), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError("x must have finite entries (found NaN or inf)")
-    if np.any(arr[:, -1] < 0):
-        raise ValueError(f"the last variable, (log10 mu)^2, must be >= 0, got {arr[:, -1].min():g}")
-    return arr
-
-
-def _spectral_radius(A: np.ndarray) -> np.ndarray:
-    """Largest eigenvalue modulus of each matrix in a (..., n, n) stack."""
-    return np.max(np.abs(np.linalg.eigvals(A)), axis=-1)
-
-
-def _penalise(J: np.ndarray, ok: np.ndarray, rho: np.ndarray, penalty: float) -> np.ndarray:
-    """Apply the penalty rule of both MOPs to raw objectives ``J`` (B, M).
-
-    * not computable (``ok`` False: the RLQR failed or did not converge):
-      ``2 * penalty`` on every objective;
-    * computable but unstable (``rho >= 1``, ``rho`` the largest closed-loop
-      spectral radius over the scenarios): ``penalty * min(rho, 2)`` on every
-      objective, so that the MOEA still prefers the less unstable designs;
-    * stable: ``min(J, penalty)`` (a non-finite ``J`` also becomes ``penalty``).
-
-    Every returned value is finite and the penalised ones are ``>= penalty``.
-    """
-    out = np.where(np.isfinite(J), np.minimum(J, penalty), penalty)
-    unstable = ok & ~(rho < 1.0)
-    out[unstable] = (penalty * np.minimum(np.nan_to_num(rho[unstable], nan=2.0), 2.0))[:, None]
-    out[~ok] = 2.0 * penalty
-    return out
-
-
-def _check_penalty(penalty) -> float:
-    return check_positive_scalar(penalty, "penalty")
-
-
-def _check_ref_point(value, name: str, default: np.ndarray) -> np.ndarray:
-    if value is None:
-        return default.copy()
-    arr = as_matrix(value, name, rows=1, cols=default.size, cols_what="the number of objectives").ravel()
-    if np.any(arr <= 0):
-        raise ValueError(f"{name} must have positive entries, got {arr}")
-    return arr
-
-
-def _check_aggregate(aggregate) -> str:
-    if aggregate not in ("mean", "max"):
-        raise ValueError(f"aggregate must be 'mean' or 'max', got {aggregate!r}")
-    return aggregate
-
-
-def _weights(Q, R, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
-    Q = np.eye(n) if Q is None else check_spd(
-        as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
-                  cols_what="the number of states"), "Q")
-    R = np.eye(m) if R is None else check_spd(
-        as_matrix(R, "R", rows=m, cols=m, rows_what="the number of inputs",
-                  cols_what="the number of inputs"), "R")
-    return Q, R
-
-
-# --------------------------------------------------------------------------
-# the generic MOP
-# --------------------------------------------------------------------------
 
 #: Nominal model of the paper's Section 4.4.
 F_GENERIC = np.array([[0.9, 0.8, 0.7], [0.01, 0.1, 0.3], [0.0, 0.25, 0.1]])
@@ -134,39 +49,13 @@ G_GENERIC = np.array([[0.6], [0.1], [0.25]])
 H_GENERIC = np.ones((3, 1))
 EF_TRUE = np.array([[0.1, 0.2, 0.2]])
 EG_TRUE = np.array([[0.1]])
+#: Divergence bound of the regulation runs: far above the transient of any
+#: Schur-stable loop from the initial states; it only keeps the unstable
+#: scenarios finite (their errors are reported as inf).
+_REGULATION_BOUND = 1e100
 
 
-class _RLQRTuningProblem(Problem):
-    """What the RLQR tuning problems share: ``z = (E_F, E_G, (log10 mu)^2)`` -> batched RLQR gains.
-
-    A subclass sets ``plant`` (``n`` states, ``m`` inputs), ``H``, ``Q``, ``R``,
-    ``alpha`` and ``max_iter``, and has ``n_var = n + m + 1``.
-    """
-
-    plant: rc.Plant
-    H: np.ndarray
-    Q: np.ndarray
-    R: np.ndarray
-    alpha: float
-    max_iter: int
-
-    # -- public helpers -----------------------------------------------------
-    def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(EF (B, 1, n), EG (B, 1, m), mu (B,))`` of a population ``z`` (B, n + m + 1) or one ``z``.
-
-        ``(n, m)`` is ``(3, 1)`` for the generic problem and ``(4, 2)`` for the applied one.
-        """
-        z = _as_population(z, self.n_var)
-        return _decode(z, self.plant.n, self.plant.m)
-
-    def gains(self, z) -> "rc.RLQRBatch":
-        """The batched RLQR design of a population ``z`` (B, n + m + 1)."""
-        EF, EG, mu = self.decode(z)
-        return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
-                             max_iter=self.max_iter)
-
-
-class GenericRLQRProblem(_RLQRTuningProblem):
+class GenericRLQRProblem(RLQRTuningProblem):
     r"""Generic RLQR tuning problem: 5 variables in ``[0, 200]``, 3 objectives.
 
     Decision vector ``z = (E_F1, E_F2, E_F3, E_G, (log10 mu)^2)``. For each ``z`` the
@@ -208,15 +97,18 @@ class GenericRLQRProblem(_RLQRTuningProblem):
     alpha : float
         RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin (see :func:`robustctl.rlqr_gains`).
     max_iter : int
-        Recursion steps :func:`robustctl.rlqr_gains` may take before its Newton
-        phase (default 50, against the library's 10000); a design that has not
-        converged by then counts as not computable (``2 * penalty``). Slowly
-        converging designs cost up to seconds per batch (MO-LSP's mutants
-        produce many) and are worthless here: of 12000 sampled designs
-        (uniform, and around the slow region MO-LSP's mutants reach), the 6844
-        stable ones all converged within 10 steps, none of the 521 that needed
-        more than 300 steps was stable on the true plant, and caps of 30, 50,
-        100 and 200 gave identical objectives.
+        Steps of the plain recursion :func:`robustctl.rlqr_gains` may take for a
+        design the doubling leaves unsettled (default 50, against the
+        library's 10000); a design not converged by then counts as not
+        computable (``2 * penalty``). Slowly converging designs cost up to
+        seconds per batch (MO-LSP's mutants produce many) and are worthless
+        here: of 12000 sampled designs (uniform, and around the slow region
+        MO-LSP's mutants reach), the 6844 stable ones all converged within 10
+        steps, none of the 521 that needed more than 300 steps was stable on
+        the true plant, and caps of 30, 50, 100 and 200 gave identical
+        objectives. The fallback is the plain recursion
+        (``rlqr_gains(..., fallback="recursion")``): it is what penalises
+        those slow designs through ``max_iter``.
     deltas : 1-D array_like, optional
         The uncertainty realisations, each in ``[-1, 1]``. Default: ``-1``, ``+1``
         and ``n_deltas - 2`` values drawn from ``U(-1, 1)`` with ``seed``.
@@ -235,6 +127,10 @@ class GenericRLQRProblem(_RLQRTuningProblem):
         design's error at the default settings).
     hv_ref_point, molsp_ref_point : (3,) array_like, optional
         Override the reference points (see below).
+    backend : {"numba", "numpy"}
+        Simulator of the regulation runs (:mod:`robustctl.batchsim`): the
+        compiled kernel (default) or the numpy reference. One run per
+        scenario and initial state, ``horizon + 1`` samples, zero reference.
 
     Attributes
     ----------
@@ -288,15 +184,11 @@ class GenericRLQRProblem(_RLQRTuningProblem):
         penalty: float = 1e6,
         hv_ref_point=None,
         molsp_ref_point=None,
+        backend: Literal["numba", "numpy"] = "numba",
     ):
-        n, m = G_GENERIC.shape
-        self.plant = rc.Plant(F_GENERIC, G_GENERIC, dt=1.0)
-        self.H = H_GENERIC.copy()
+        n = F_GENERIC.shape[0]
         self.EF_true = EF_TRUE.copy()
         self.EG_true = EG_TRUE.copy()
-        self.Q, self.R = _weights(Q, R, n, m)
-        self.alpha = check_positive_scalar(alpha, "alpha")
-        self.max_iter = check_int(max_iter, "max_iter", 1)
         if deltas is None:
             n_deltas = check_int(n_deltas, "n_deltas", 2)
             rng = np.random.default_rng(seed)
@@ -306,55 +198,48 @@ class GenericRLQRProblem(_RLQRTuningProblem):
             if np.any(np.abs(deltas) > 1.0):
                 raise ValueError(f"deltas must lie in [-1, 1] (||Delta|| <= 1), got {deltas}")
         self.deltas = np.asarray(deltas, dtype=float)
-        x0 = np.eye(n) if initial_states is None else as_matrix(
+        self.initial_states = np.eye(n) if initial_states is None else as_matrix(
             initial_states, "initial_states", cols=n, cols_what="the number of states")
-        self.initial_states = x0
         self.horizon = check_int(horizon, "horizon", 1)
-        self.aggregate = _check_aggregate(aggregate)
-        self.penalty = _check_penalty(penalty)
-        self.hv_ref_point = _check_ref_point(hv_ref_point, "hv_ref_point", self._HV_REF)
-        self.molsp_ref_point = _check_ref_point(molsp_ref_point, "molsp_ref_point", self._MOLSP_REF)
-        # true closed-loop pieces per scenario: F_s (S, n, n), G_s (S, n, m)
-        self._F_s = F_GENERIC + self.deltas[:, None, None] * (self.H @ self.EF_true)
-        self._G_s = G_GENERIC + self.deltas[:, None, None] * (self.H @ self.EG_true)
-        super().__init__(n_var=n + m + 1, n_obj=n, xl=0.0, xu=200.0, vtype=float)
+        # true plants per scenario: F_s (S, n, n), G_s (S, n, m)
+        F_s = F_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EF_true)
+        G_s = G_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EG_true)
+        super().__init__(rc.Plant(F_GENERIC, G_GENERIC, dt=1.0), H_GENERIC.copy(), F_s, G_s, None, Q=Q, R=R,
+                         alpha=alpha, max_iter=max_iter, fallback="recursion", aggregate=aggregate, penalty=penalty,
+                         hv_ref_point=hv_ref_point, molsp_ref_point=molsp_ref_point, default_hv=self._HV_REF,
+                         default_molsp=self._MOLSP_REF, n_obj=n, xl=0.0, xu=200.0, backend=backend)
+        # one regulation run per (scenario, initial state): scenario index s * n0 + i
+        n0 = self.initial_states.shape[0]
+        self._regulation = LinearSimulator(
+            np.repeat(F_s, n0, axis=0), np.repeat(G_s, n0, axis=0), np.zeros((self.horizon + 1, n)),
+            x0=np.tile(self.initial_states, (self.deltas.size, 1)), bound=_REGULATION_BOUND)
 
     # -- public helpers -----------------------------------------------------
-    def regulation_errors(self, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def regulation_errors(self, K) -> tuple[np.ndarray, np.ndarray]:
         """Raw errors of gains ``K`` (B, 1, 3): ``(e (B, S, 3), rho (B, S))``.
 
         ``e[b, s, j]`` is the regulation error of state ``j`` in scenario ``s``
         (see the class docstring) and ``rho`` the closed-loop spectral radius.
-        Rows of ``K`` with non-finite entries, and unstable closed loops, are not
-        simulated: their ``e`` is ``inf`` (``rho`` is ``nan`` for non-finite ``K``).
+        Rows of ``K`` with non-finite entries (``rho = inf``) and unstable closed
+        loops get ``e = inf``; designs with no stable scenario are not simulated.
         """
-        K = np.asarray(K, dtype=float)
-        n, m = self.plant.n, self.plant.m
-        if K.ndim != 3 or K.shape[1:] != (m, n):
-            raise ValueError(f"K must have shape (B, {m}, {n}), got shape {K.shape}")
-        finite = np.all(np.isfinite(K), axis=(1, 2))
-        Ksafe = np.where(finite[:, None, None], K, 0.0)
-        A = self._F_s[None] + self._G_s[None] @ Ksafe[:, None]              # (B, S, n, n)
-        rho = _spectral_radius(A)
-        rho[~finite] = np.nan
-        stable = rho < 1.0                                                   # nan -> False
-        A[~stable] = 0.0                                                     # never simulate them
-        X = np.broadcast_to(self.initial_states.T, A.shape[:2] + self.initial_states.T.shape).copy()
-        e = np.zeros(A.shape[:3])
-        for _ in range(self.horizon + 1):                                    # k = 0 .. N
-            e += np.einsum("bsji,bsji->bsj", X, X)
-            X = A @ X
+        rho = self.closed_loop_radius(K)
+        stable = rc.is_schur_stable(self.closed_loops(K))
+        e = np.full(rho.shape + (self.plant.n,), np.inf)
+        some = stable.any(axis=1)
+        if some.any():
+            e[some] = self._simulate(np.asarray(K, dtype=float)[some])
         e[~stable] = np.inf
         return e, rho
 
-    # -- pymoo hook -----------------------------------------------------------
-    def _evaluate(self, x, out, *args, **kwargs):
-        z = _as_population(x, self.n_var)
-        batch = self.gains(z)
-        ok = np.asarray(batch.ok, dtype=bool) & np.all(np.isfinite(batch.K), axis=(1, 2))
-        e, rho = self.regulation_errors(np.where(ok[:, None, None], batch.K, np.nan))
-        J = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
-        out["F"] = _penalise(J, ok, np.max(rho, axis=1), self.penalty)
+    def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
+        """Regulation errors (B, S, 3) of stable gains (:meth:`regulation_errors` without the screen)."""
+        return self._simulate(K)
+
+    def _simulate(self, K: np.ndarray) -> np.ndarray:
+        S, n0, n = self.deltas.size, self.initial_states.shape[0], self.plant.n
+        sums = self._regulation.run(K, keep_trajectories=False, backend=self.backend).sq_state_sum
+        return sums.reshape(K.shape[0], S, n0, n).sum(axis=2)
 
     def __repr__(self) -> str:
         return (f"GenericRLQRProblem(n_var={self.n_var}, n_obj={self.n_obj}, S={self.deltas.size}, "

@@ -57,7 +57,8 @@ import numpy as np
 import robustctl as rc
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
-from robustctl.simulate import simulate
+from robustctl.batchsim import check_gains
+from robustctl.pathfollow import PathFollowing
 
 from .._validation import as_matrix, check_int
 from .applied import AppliedRLQRProblem
@@ -228,18 +229,14 @@ def overload_from_delta(deltas) -> np.ndarray:
 
 def _as_gains(K, n: int, ms: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
     """(D, m, n) float gains (non-finite rows zeroed) and the (D,) mask of finite rows."""
-    if isinstance(K, (str, bytes)) or K is None:
-        raise TypeError(f"K must be a (D, m, {n}) array of gains, got {type(K).__name__}")
+    want = " or ".join(f"(D, {m}, {n})" for m in ms)
     try:
-        arr = np.array(K, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"K must be a (D, m, {n}) array of real numbers") from None
-    if arr.ndim != 3 or arr.shape[0] < 1 or arr.shape[1] not in ms or arr.shape[2] != n:
-        want = " or ".join(f"(D, {m}, {n})" for m in ms)
-        raise ValueError(f"K must have shape {want} (one gain per design), got shape {arr.shape}")
-    ok = np.all(np.isfinite(arr), axis=(1, 2))
-    arr[~ok] = 0.0
-    return arr, ok
+        arr, bad = check_gains(K, n, "flag")
+    except ValueError:
+        arr = None
+    if arr is None or np.ndim(K) != 3 or arr.shape[1] not in ms:
+        raise ValueError(f"K must have shape {want} (one gain per design), got shape {np.shape(K)}")
+    return arr, ~bad
 
 
 def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> np.ndarray:
@@ -281,7 +278,7 @@ def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> n
         raise TypeError(f"problem must be a GenericRLQRProblem, got {type(problem).__name__}")
     Kb, ok = _as_gains(K, problem.plant.n, (problem.plant.m,))
     mc = GenericRLQRProblem(deltas=_as_deltas(deltas), initial_states=problem.initial_states,
-                            horizon=problem.horizon)
+                            horizon=problem.horizon, backend=problem.backend)
     e, _ = mc.regulation_errors(np.where(ok[:, None, None], Kb, np.nan))
     E = e.sum(axis=2)
     E[~ok] = np.inf
@@ -302,7 +299,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
 
     Each ``Delta_s`` is a payload overload ``150 (1 + Delta_s)`` % held over the
     run (:func:`overload_from_delta`); every design drives the true truck at
-    that payload along ``path`` (:func:`robustctl.simulate.simulate`: nominal
+    that payload along ``path`` (:class:`robustctl.pathfollow.PathFollowing`: nominal
     reference states and feedforward, 0.45 rad steering limit, 1 m initial
     offset), and
 
@@ -320,7 +317,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
     the units the designs trade them in. ``E = T * sum_i f_i / sigma_i^2``
     with ``f_i`` the MOP's per-scenario MSEs. A gain with non-finite entries
     gets ``+inf``; a run that diverges is frozen by the simulator at its bound
-    (a huge finite error, see :mod:`robustctl.simulate`).
+    (a huge finite error, see :mod:`robustctl.batchsim`).
 
     Parameters
     ----------
@@ -348,12 +345,12 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
         path = default_route()
     elif not isinstance(path, ReferencePath):
         raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
-    obj = list(truck.OBJECTIVE_STATES)
+    steering = np.ones((1, Kb.shape[1]))                   # alpha = u1 (+ u2 on the doubled column)
     E = np.empty((Kb.shape[0], overloads.size))
     for start in range(0, overloads.size, _SCENARIO_CHUNK):
         chunk = overloads[start:start + _SCENARIO_CHUNK]
-        res = simulate(Kb, path, tuple(chunk.tolist()), keep_trajectories=False)
-        E[:, start:start + chunk.size] = (res.sq_error_sum[..., obj] / sigma**2).sum(axis=2)
+        res = PathFollowing(path, tuple(chunk.tolist()), input_map=steering).run(Kb, keep_trajectories=False)
+        E[:, start:start + chunk.size] = (res.sq_error_sum[..., list(res.objectives)] / sigma**2).sum(axis=2)
     E[~ok] = np.inf
     return E
 
@@ -418,7 +415,7 @@ def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     Generic: ``[front (N), nominal, random]``; applied: ``[front (N), nominal,
     RLQR^A, random]`` (the paper's order, see the module docstring). The front
     and random designs are computed in one batched RLQR call
-    (:meth:`problem.gains`), with the problem's ``Q``, ``R``, ``alpha`` and
+    (:meth:`~moo.problems.generic.GenericRLQRProblem.gains`), with the problem's ``Q``, ``R``, ``alpha`` and
     ``max_iter``; a design that fails keeps NaN gains (``ok`` False) and can
     never win.
 

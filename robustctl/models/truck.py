@@ -66,7 +66,7 @@ __all__ = [
     "STEER_LIMIT", "continuous_model", "truck_plant", "discretise", "steady_state_cornering",
     "reference_states", "AlgebraicUncertainty", "algebraic_uncertainty", "uncertainty_from_z",
     "RLQR_MOP_Z", "PRINTED_EF", "PRINTED_EG", "PRINTED_LOG10_MU_SQ", "check_overload",
-    "MAX_ERRORS", "MAX_STEER", "lqr_weights",
+    "MAX_ERRORS", "MAX_STEER", "lqr_weights", "DOUBLED_INPUT_MAP",
 ]
 
 #: State names, in the model's order.
@@ -76,6 +76,9 @@ STATE_UNITS = ("m/s", "rad/s", "m", "rad")
 OBJECTIVE_STATES = (2, 1, 0, 3)
 #: Steering saturation used in the paper's simulations [rad].
 STEER_LIMIT = 0.45
+#: Input map of the doubled steering column: the steering angle is ``alpha = u1 + u2``
+#: (``input_map`` of :func:`robustctl.pathfollow.simulate`).
+DOUBLED_INPUT_MAP = ((1.0, 1.0),)
 
 #: RLQR^A uncertainty as printed in the paper (Section 4.5, after Eq. 18).
 PRINTED_EF = (6.85718e-4, -8.62010e-4, 0.0, -6.6666e-3)
@@ -232,15 +235,15 @@ def truck_plant(overload: float = 0.0, *, params: TruckParameters | None = None,
     Returns
     -------
     Plant
-        ``x[k+1] = F x[k] + G u[k]``, discretised by python-control's ``c2d``
-        through :meth:`robustctl.Plant.from_continuous`. The curvature input is
+        ``x[k+1] = F x[k] + G u[k]``, the exact ZOH of :func:`discretise`
+        (``expm`` of the augmented matrix; bit-identical to python-control's
+        ``c2d`` through :meth:`robustctl.Plant.from_continuous`, which a test
+        checks, without importing python-control). The curvature input is
         not part of the plant; see :func:`discretise`.
     """
-    A, B, _ = continuous_model(overload, params=params)
-    plant = Plant.from_continuous(A, B, dt=_params(params).dt)
-    if doubled:
-        return Plant(plant.F, np.hstack([plant.G, plant.G]), plant.dt)
-    return plant
+    p = _params(params)
+    F, G, _ = _discrete_batch(p, 1.0 + check_overload(overload) / 100.0)
+    return Plant(F[0], np.hstack([G[0], G[0]]) if doubled else G[0], p.dt)
 
 
 def _zoh(A: np.ndarray, BE: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,114 @@
+"""Where an experiment grid runs: this process, a local process pool, or a Dask cluster.
+
+:func:`open_executor` checks its arguments when called and returns a context
+manager that yields a :class:`concurrent.futures.Executor` (or ``None`` for
+"in this process") and releases it on exit::
+
+    with open_executor("dask", scheduler="tcp://10.0.0.5:8786") as ex:
+        run_experiment(..., executor=ex)
+
+``"process"``
+    ``workers`` spawned processes (:class:`~concurrent.futures.ProcessPoolExecutor`);
+    ``workers=1`` (the default) runs in this process. A pool process killed
+    mid-grid breaks the pool (``BrokenProcessPool``): the grid stops, the
+    records written stay, and a rerun resumes.
+``"dask"``
+    With ``scheduler``: the workers of an existing ``dask.distributed``
+    scheduler (started with ``dask scheduler`` / ``dask worker``, or by
+    dask-jobqueue on a batch system). Without: a
+    :class:`~distributed.LocalCluster` of ``workers`` worker processes, one
+    thread each. The scheduler recomputes the runs of a lost worker on the
+    others (up to ``distributed.scheduler.allowed-failures`` times per run).
+    The workers need ``moo`` installed (the same version), not the results
+    directory.
+
+On leaving the block because of an error (a failed run, Ctrl-C), queued runs
+are cancelled; a local pool or cluster is shut down without waiting for the
+runs in flight.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import AbstractContextManager, contextmanager
+from multiprocessing import get_context
+
+from moo._validation import check_choice, check_int
+
+__all__ = ["EXECUTORS", "open_executor"]
+
+#: Executor kinds of :func:`open_executor` (and ``python -m moo experiment --executor``).
+EXECUTORS: tuple[str, ...] = ("process", "dask")
+
+
+def open_executor(kind: str = "process", *, workers: int | None = None,
+                  scheduler: str | None = None) -> AbstractContextManager[Executor | None]:
+    """A context manager yielding the executor of ``kind`` (see the module docstring).
+
+    Parameters
+    ----------
+    kind : {"process", "dask"}
+        A local process pool, or Dask.
+    workers : int, optional
+        Processes of the pool or of the local Dask cluster (default 1). Not
+        with ``scheduler``: a running cluster has its own workers.
+    scheduler : str, optional
+        Address of a running Dask scheduler, e.g. ``"tcp://10.0.0.5:8786"``
+        (``kind="dask"`` only).
+
+    Raises
+    ------
+    ValueError, TypeError
+        At the call, for bad arguments. ``ConnectionError`` on entering the
+        block when the scheduler cannot be reached.
+    """
+    kind = check_choice(kind, "executor", EXECUTORS)
+    if workers is not None:
+        workers = check_int(workers, "workers", 1)
+    if scheduler is not None:
+        if not isinstance(scheduler, str) or not scheduler.strip():
+            raise ValueError(f"scheduler must be an address such as 'tcp://HOST:8786', got {scheduler!r}")
+        if kind != "dask":
+            raise ValueError("scheduler needs the 'dask' executor")
+        if workers is not None:
+            raise ValueError("workers sizes a local cluster; the cluster at scheduler has its own workers")
+    if kind == "process":
+        return _process_pool(workers or 1)
+    return _dask(scheduler, workers or 1)
+
+
+@contextmanager
+def _process_pool(workers: int) -> Iterator[Executor | None]:
+    if workers == 1:
+        yield None
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+    try:
+        yield pool
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+
+
+@contextmanager
+def _dask(scheduler: str | None, workers: int) -> Iterator[Executor]:
+    from distributed import Client, LocalCluster
+
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+        client = Client(cluster)
+    else:
+        try:
+            client = Client(scheduler)
+        except OSError as exc:
+            raise ConnectionError(f"cannot reach the Dask scheduler at {scheduler}: "
+                                  f"{str(exc).splitlines()[0]}") from None
+    try:
+        yield client.get_executor()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

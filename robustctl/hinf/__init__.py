@@ -1,0 +1,134 @@
+r"""H-infinity state feedback by LMI optimisation (cvxpy + Clarabel).
+
+Plant, with the gain ``u = K x`` (the paper's sign convention)::
+
+    x+ = F x + Bw w + G u         (discrete, dt > 0; x' = ... for dt = None)
+    z  = Cz x + Dzw w + Dzu u
+
+The closed loop ``T_zw`` has ``A_K = F + G K``, ``C_K = Cz + Dzu K``. With the
+change of variables ``Y = K X`` (Bernussou, Peres & Geromel 1989) the
+bounded-real lemma becomes linear in ``(X, Y, gamma^2)``.
+
+Discrete time (``X > 0``; storage ``V(x) = x' X^-1 x``)::
+
+    [ X      A X + G Y   Bw   0               ]
+    [ *      X           0    (Cz X + Dzu Y)' ]  > 0
+    [ *      *           I    Dzw'            ]
+    [ *      *           *    gamma^2 I       ]
+
+Continuous time::
+
+    [ He(F X + G Y)   Bw    (Cz X + Dzu Y)' ]
+    [ *               -I    Dzw'            ]  < 0,   He(M) = M + M'
+    [ *               *     -gamma^2 I      ]
+
+Either inequality says ``V(x+) - V(x) <= |w|^2 - |z|^2 / gamma^2`` (or
+``dV/dt <= ...``), hence ``||T_zw||_inf < gamma`` and internal stability.
+This is the *gamma^2 form*: the same ``X`` bounds the reachable set,
+``x' X^-1 x <= E`` for every disturbance of energy ``sum |w|^2 <= E``
+(Boyd, El Ghaoui, Feron & Balakrishnan 1994, Sec. 6.1.3), so
+``|u_j| = |k_j x| <= u_max_j`` holds whenever (Sec. 7.2.3)::
+
+    [ u_max_j^2 / E   y_j ]
+    [ y_j'            X   ]  >= 0       (y_j: row j of Y).
+
+Polytopic plants: the LMI is imposed at every vertex ``(F_i, G_i)`` with one
+common ``(X, Y)``; it is affine in ``(F, G)``, so the gain is guaranteed for
+every plant in the convex hull (even time-varying). The *extended* (slack
+variable) discrete-time condition of de Oliveira, Bernussou & Geromel (1999)
+and de Oliveira, Geromel & Bernussou (2002) uses a vertex-dependent ``P_i``
+and a common slack ``S`` (not symmetric), ``K = L S^-1``::
+
+    [ P_i    F_i S + G_i L   Bw   0               ]
+    [ *      S + S' - P_i    0    (Cz S + Dzu L)' ]  > 0
+    [ *      *               I    Dzw'            ]
+    [ *      *               *    gamma^2 I       ]
+
+It reduces to the standard one for ``S = P_i = X`` (never more
+conservative) and guarantees the bound for every *constant* plant of the
+hull (storage ``x' P(a)^-1 x`` with ``P(a) = sum a_i P_i``). The input bound
+then uses ``[[u_max_j^2/E, l_j], [l_j', S + S' - P_i]] >= 0`` at each vertex
+(``S + S' - P <= S' P^-1 S``).
+
+Robust synthesis (``uncertainty=NormBounded(H, EF, EG)``): every plant
+``(F + H Delta EF, G + H Delta EG)`` with ``||Delta|| <= 1`` (also
+time-varying). With ``q = (EF + EG K) x`` and ``p = Delta q`` the loop is
+the nominal one with an extra input ``H p`` and ``|p| <= |q|``; the
+S-procedure (a multiplier ``eps > 0``, one per vertex; equivalently the
+scaled small-gain theorem) adds ``eps (|q|^2 - |p|^2) >= 0`` to the storage
+inequality. In the gamma^2 form, with ``E X = EF X + EG Y`` (Xie, Fu & de
+Souza 1992; Boyd et al. 1994, Sec. 7.5)::
+
+    [ X - eps H H'   A X + G Y   Bw   0               0       ]
+    [ *              X           0    (Cz X + Dzu Y)' (E X)'  ]
+    [ *              *           I    Dzw'            0       ]  > 0     (discrete)
+    [ *              *           *    gamma^2 I       0       ]
+    [ *              *           *    *               eps I   ]
+
+(continuous: ``He(F X + G Y) + eps H H'`` in the bounded-real LMI, with the
+extra row ``[E X, 0, 0, -eps I]``). Linear in ``(X, Y, gamma^2, eps)``: the
+convex counterpart of the RLQR (:func:`robustctl.rlqr`), whose penalty
+parameter plays the part of ``1 / eps``.
+
+Pole regions (``poles=Disk(...)``, :mod:`robustctl.regions`): the LMI
+``M_D(F X + G Y, X) < 0`` of Chilali & Gahinet (1996) at every vertex, with
+the same ``X`` as the H-infinity bound.
+
+Numerics
+--------
+The synthesis is a sequence of pure stages (:mod:`robustctl.hinf._synthesis`
+lists them; every tolerance is named in ``robustctl.hinf._tolerances``):
+
+* Coordinates (:mod:`._coordinates`): states balanced (SLICOT ``TB01ID``)
+  and scaled so that ``||Bw|| = 1``; ``w`` scaled to unit energy when
+  ``u_max`` is given; ``z`` scaled so that the fixed level of a centring
+  problem is 1; ``[Cz Dzu Dzw]`` replaced by a factor with the same Gram
+  matrix when that has fewer rows. A single plant is solved in coordinates
+  where the inverse of its LQR Riccati solution (weight
+  ``[Cz Dzu]'[Cz Dzu]``) is ~ I: the optimal ``X`` has roughly that shape,
+  so the optimum is well conditioned (on the benchmark plants with n = 10:
+  13-16 interior-point iterations instead of ~27 ending
+  ``optimal_inaccurate``).
+* Blocks (:mod:`._lmis`): the constant disturbance block ``I`` is
+  eliminated by a Schur complement (e.g. the discrete block becomes
+  ``[[X - Bw Bw', A X + G Y, -Bw Dzw'], [*, X, (Cz X + Dzu Y)'], [*, *,
+  gamma^2 I - Dzw Dzw']] >= 0``): same set, ``q`` rows smaller.
+* Level (:mod:`._level`): ``gamma_opt`` minimises ``gamma^2`` (non-strict
+  LMIs: the infimum), in the LQR coordinates of one plant at tolerance
+  1e-8, first without Clarabel's iterative refinement (see
+  :func:`robustctl._cvx.solve_sdp`), otherwise at 1e-10 with refinement
+  (the truck polytope is badly conditioned), with fallbacks to the
+  balanced coordinates, to a restart of the extended LMI from the standard
+  one, and a polish of an ``optimal_inaccurate`` result.
+* Gain (:mod:`._gains`): at the optimum ``X`` can be nearly singular and
+  ``K = Y X^-1`` huge, so unless ``backoff=0`` the gain is certified at
+  ``gamma = (1 + backoff) gamma_opt`` by the first of an ordered list of
+  strategies (the optimum's own gain with a Riccati-built certificate for
+  one discrete plant; centring re-solves; a raised backoff).
+  ``info["gain_from"]`` names the route.
+* Every solve goes through :func:`robustctl._cvx.solve_sdp`: status check,
+  explicit symmetrisation, certificate eigenvalues; solver failures are
+  retried with looser tolerances, the certificate is checked regardless.
+* A fixed ``gamma`` is a feasibility problem posed as "maximise the common
+  margin ``t <= 1``" (always feasible); ``t <= 0`` means infeasible.
+
+References
+----------
+S. Boyd, L. El Ghaoui, E. Feron, V. Balakrishnan, *Linear Matrix Inequalities
+in System and Control Theory*, SIAM 1994, Sec. 6.1.3, 7.2.3, 7.5.
+M. C. de Oliveira, J. Bernussou, J. C. Geromel, "A new discrete-time robust
+stability condition", Systems & Control Letters 37, 1999.
+M. C. de Oliveira, J. C. Geromel, J. Bernussou, "Extended H2 and H-infinity
+norm characterizations and controller parametrizations for discrete-time
+systems", Int. J. Control 75(9), 2002.
+L. Xie, M. Fu, C. E. de Souza, "H-infinity control and quadratic stabilization of systems with
+parameter uncertainty via output feedback", IEEE TAC 37(8), 1992.
+M. Chilali, P. Gahinet, "H-infinity design with pole placement constraints: an LMI approach",
+IEEE TAC 41(3), 1996.
+P. Gahinet, P. Apkarian, "A linear matrix inequality approach to
+H-infinity control", Int. J. Robust Nonlinear Control 4, 1994.
+"""
+
+from ._synthesis import HinfController, hinf
+
+__all__ = ["hinf", "HinfController"]

@@ -1,0 +1,183 @@
+"""Stage 2 of the synthesis: the state coordinates in which the LMIs are posed.
+
+Every change here is a similarity ``x = T x^`` or a recorded scaling of
+``w`` and ``z``: levels and input bounds are unchanged up to the recorded
+factors, only the solver's path (iterations, accuracy) changes.
+
+* :func:`normalised`: states balanced by a diagonal similarity (SLICOT
+  ``TB01ID`` on ``[[F, [Bw G]], [Cz, 0]]``) and scaled so that
+  ``||Bw~|| = 1``; ``w`` scaled by ``w_scale`` (``sqrt(w_energy)`` with an
+  input bound: the bound then reads for unit energy); ``[Cz Dzu Dzw]``
+  replaced by a factor with the same Gram matrix when that has fewer rows.
+* :func:`lqr_coordinates`: coordinates in which the inverse of the LQR
+  Riccati solution of the nominal vertex is ~ I.
+* :func:`recentred`: coordinates in which a given Lyapunov matrix is ~ I.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Sequence
+
+import numpy as np
+import scipy.linalg
+
+from . import _tolerances as tol
+
+__all__ = ["Coordinates", "normalised", "lqr_coordinates", "recentred"]
+
+
+@dataclass(frozen=True, eq=False)
+class Coordinates:
+    """The synthesis data in the solver's state coordinates ``x = T x^``.
+
+    ``F``, ``G`` hold one matrix per vertex. ``Bw`` and ``Dzw`` include the
+    disturbance scaling ``w = w_scale w~``; ``Cz``, ``Dzu``, ``Dzw`` may be
+    the compressed factor (``p`` rows, see :func:`normalised`). ``H``,
+    ``EF``, ``EG`` are the norm-bounded uncertainty ``[dF dG] = H Delta [EF
+    EG]`` (``None`` without one). ``original`` is ``(F, G, Bw, Cz, H, EF)``
+    at ``T = I``; ``balancing`` the diagonal similarity of
+    :func:`normalised` (reported in ``info["scaling"]``).
+    """
+
+    F: tuple[np.ndarray, ...]
+    G: tuple[np.ndarray, ...]
+    Bw: np.ndarray
+    Cz: np.ndarray
+    Dzu: np.ndarray
+    Dzw: np.ndarray
+    T: np.ndarray
+    original: tuple
+    w_scale: float
+    balancing: np.ndarray
+    H: np.ndarray | None = None
+    EF: np.ndarray | None = None
+    EG: np.ndarray | None = None
+
+    @property
+    def n(self) -> int:
+        return self.T.shape[0]
+
+    @property
+    def m(self) -> int:
+        return self.Dzu.shape[1]
+
+    @property
+    def p(self) -> int:
+        return self.Cz.shape[0]
+
+    def to(self, T: np.ndarray) -> "Coordinates":
+        """The same data in the coordinates ``x = T x^`` (``T`` relative to the original states)."""
+        Fs, Gs, Bw, Cz, H, EF = self.original
+        return replace(self, T=T, F=tuple(np.linalg.solve(T, F @ T) for F in Fs),
+                       G=tuple(np.linalg.solve(T, G) for G in Gs), Bw=np.linalg.solve(T, Bw), Cz=Cz @ T,
+                       H=None if H is None else np.linalg.solve(T, H), EF=None if EF is None else EF @ T)
+
+    def from_original(self, X: np.ndarray) -> np.ndarray:
+        """A Lyapunov matrix of the original states in these coordinates, ``T^-1 X T^-T``."""
+        return np.linalg.solve(self.T, np.linalg.solve(self.T, X).T)
+
+    def to_original(self, K: np.ndarray, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A gain and a Lyapunov matrix of these coordinates in the original ones, ``(K T^-1, T X T')``."""
+        return np.linalg.solve(self.T.T, K.T).T, self.T @ X @ self.T.T
+
+
+def normalised(F: Sequence[np.ndarray], G: Sequence[np.ndarray], Bw: np.ndarray, Cz: np.ndarray,
+               Dzu: np.ndarray, Dzw: np.ndarray, w_scale: float = 1.0, uncertainty=None) -> Coordinates:
+    """Balanced, ``||Bw~|| = 1`` coordinates of the vertices ``(F[i], G[i])``, with ``z`` compressed.
+
+    ``uncertainty`` (a :class:`~robustctl.NormBounded` or ``None``) is carried
+    along (``H`` and ``EF`` change with the coordinates).
+
+    Only ``z'z`` matters to every synthesis here, so ``[Cz Dzu Dzw]`` is
+    replaced by ``R`` with ``R'R = [Cz Dzu Dzw]'[Cz Dzu Dzw]`` (full row
+    rank, from the SVD) when ``R`` has fewer rows.
+    """
+    Fs, Gs = tuple(F), tuple(G)
+    n, m = Cz.shape[1], Dzu.shape[1]
+    d = _balance(Fs[0], Bw, Gs[0], Cz)
+    bw = np.linalg.norm(Bw / d[:, None] * w_scale, 2)
+    if bw > 0 and np.isfinite(bw):
+        d = d * bw
+    CD = np.hstack([Cz, Dzu, Dzw])
+    _, sv, Vt = np.linalg.svd(CD, full_matrices=False)
+    r = int(np.sum(sv > tol.Z_RANK * max(1.0, sv[0] if sv.size else 0.0)))
+    if 0 < r < CD.shape[0]:
+        CD = sv[:r, None] * Vt[:r]
+        Cz, Dzu, Dzw = CD[:, :n], CD[:, n:n + m], CD[:, n + m:]
+    H, EF, EG = (None, None, None) if uncertainty is None else (uncertainty.H, uncertainty.EF, uncertainty.EG)
+    base = Coordinates(F=Fs, G=Gs, Bw=Bw * w_scale, Cz=Cz, Dzu=Dzu, Dzw=Dzw * w_scale, T=np.eye(n),
+                       original=(Fs, Gs, Bw * w_scale, Cz, H, EF), w_scale=float(w_scale), balancing=d,
+                       H=H, EF=EF, EG=EG)
+    return base.to(np.diag(d))
+
+
+def _balance(F, Bw, G, Cz) -> np.ndarray:
+    """Diagonal state scaling ``d`` (x = diag(d) x~) balancing ``[[F, [Bw G]], [Cz, 0]]``; ones without slycot."""
+    n = F.shape[0]
+    B = np.hstack([Bw, G])
+    try:
+        from slycot import tb01id
+
+        _, _, _, _, d = tb01id(n, B.shape[1], Cz.shape[0], 0.0, F.copy(), B.copy(), Cz.copy(), job="A")
+        d = np.asarray(d, dtype=float)
+    except Exception:  # slycot missing or failed: no scaling
+        return np.ones(n)
+    if d.shape != (n,) or not np.all(np.isfinite(d)) or np.any(d <= 0):
+        return np.ones(n)
+    # TB01ID returns D with A~ = D^-1 A D, i.e. x = D x~.
+    return d
+
+
+def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
+    """Coordinates in which the LQR storage of the nominal vertex is ~ I, or ``None``.
+
+    The optimal Lyapunov matrix ``X`` has roughly the shape of ``P^-1``,
+    ``P`` the stabilising Riccati solution of the LQR problem with the
+    weight ``[Cz Dzu]'[Cz Dzu]`` (both diagonal blocks regularised by
+    ``LQR_REG`` of their norm). In coordinates where ``P^-1 ~ I`` (then
+    scaled so that ``||Bw|| = 1`` again) the optimum is usually well
+    conditioned: fewer interior-point iterations, rarely
+    ``optimal_inaccurate``. ``None`` if the Riccati solve fails.
+    """
+    F, G, C, D = data.F[0], data.G[0], data.Cz, data.Dzu
+    n, m = data.n, data.m
+    Q, R, S = C.T @ C, D.T @ D, C.T @ D
+    Q = Q + tol.LQR_REG * max(1.0, np.linalg.norm(Q, 2)) * np.eye(n)
+    R = R + tol.LQR_REG * max(1.0, np.linalg.norm(R, 2)) * np.eye(m)
+    are = scipy.linalg.solve_discrete_are if discrete else scipy.linalg.solve_continuous_are
+    try:
+        with np.errstate(all="ignore"):
+            P = are(F, G, Q, R, s=S)
+        lam = np.linalg.eigvalsh(0.5 * (P + P.T))
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    if not (np.all(np.isfinite(lam)) and lam[-1] > 0):
+        return None
+    X = np.linalg.inv(0.5 * (P + P.T) + max(0.0, tol.RECENTRE_REG * lam[-1] - lam[0]) * np.eye(n))
+    moved = recentred(data, X, tol.RECENTRE_REG)  # X > 0 by construction
+    bw = np.linalg.norm(moved[0].Bw, 2) if moved is not None else 0.0
+    if not (bw > 0 and np.isfinite(bw)):  # no disturbance: nothing to normalise by
+        return None
+    return moved[0].to(moved[0].T * bw)
+
+
+def recentred(data: Coordinates, X: np.ndarray, reg: float) -> tuple[Coordinates, float] | None:
+    """Coordinates in which the Lyapunov matrix ``X`` (given in ``data``'s coordinates) becomes ~ I.
+
+    With ``X + reg lambda_max(X) I = R R'`` (Cholesky; the shift only if
+    needed to reach that floor) the new coordinates are ``x^ = R^-1 x~``:
+    margins of the next solve are then measured relative to the shape of
+    ``X``. Returns the new coordinates and ``lambda_max`` of ``X`` in them
+    (<= 1), or ``None`` if ``X`` is unusable (not finite, or ``lambda_max <= 0``).
+    """
+    X = 0.5 * (X + X.T)
+    if not np.all(np.isfinite(X)):
+        return None
+    lam = np.linalg.eigvalsh(X)
+    if not lam[-1] > 0:
+        return None
+    # smallest eigenvalue of the shifted matrix >= reg lambda_max > 0: the Cholesky factor exists
+    R = np.linalg.cholesky(X + max(0.0, reg * lam[-1] - lam[0]) * np.eye(data.n))
+    Xh = np.linalg.solve(R, np.linalg.solve(R, X).T)
+    return data.to(data.T @ R), float(np.linalg.eigvalsh(0.5 * (Xh + Xh.T))[-1])

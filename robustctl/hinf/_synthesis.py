@@ -1,0 +1,237 @@
+"""The H-infinity synthesis driver: the stages in order.
+
+1. :func:`._problem.validate` - every argument, and stabilisability (PBH);
+2. :func:`._coordinates.normalised` and :func:`._coordinates.lqr_coordinates`
+   - the balanced coordinates, and for one plant the LQR ones;
+3. :mod:`._lmis` - the named LMI blocks (used by every solve and every
+   certificate);
+4. :func:`._level.minimise_level` - ``gamma_opt`` (or, with a fixed ``gamma``,
+   :func:`._gains.gain_at_level`);
+5. :func:`._gains.gain_near_optimum` - the first of the gain strategies that
+   returns a strictly feasible certificate at ``(1 + backoff) gamma_opt``;
+6. :func:`check_closed_loop` and the input bound - internal checks of the
+   returned gain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..controller import Controller
+from ..errors import ConvergenceError
+from ..plant import Plant
+from ..regions import Region
+from ..uncertainty import NormBounded
+from . import _tolerances as tol
+from ._coordinates import lqr_coordinates, normalised
+from ._gains import Gain, gain_at_level, gain_near_optimum
+from ._level import minimise_level
+from ._problem import Problem, validate
+
+__all__ = ["hinf", "HinfController", "check_closed_loop", "guaranteed_input_bound"]
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class HinfController(Controller):
+    """An H-infinity state feedback ``u = K x`` with its guaranteed level.
+
+    Attributes
+    ----------
+    gamma : float
+        Level guaranteed by the returned gain: ``||T_zw||_inf < gamma`` for
+        the plant (and every plant of the hull of ``vertices``). Equals
+        ``(1 + backoff) * gamma_opt``, or the requested ``gamma``.
+    gamma_opt : float or None
+        The optimal level of the LMI problem (``None`` when ``gamma`` was fixed).
+    """
+
+    gamma: float = float("nan")
+    gamma_opt: float | None = None
+
+    def __repr__(self) -> str:
+        opt = "None" if self.gamma_opt is None else f"{self.gamma_opt:.6g}"
+        base = super().__repr__()
+        return base.replace("Controller(", f"HinfController(gamma={self.gamma:.6g}, gamma_opt={opt}, ", 1)
+
+
+def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: ArrayLike | None = None,
+         vertices: Sequence[Plant] | None = None, gamma: float | None = None, u_max: ArrayLike | None = None,
+         w_energy: float | None = None, backoff: float = 1e-3, extended: bool = False,
+         poles: Region | Sequence[Region] | None = None, uncertainty: NormBounded | None = None,
+         solver: str = "CLARABEL") -> HinfController:
+    r"""H-infinity state feedback ``u = K x`` by LMI optimisation.
+
+    Finds ``K`` minimising ``gamma`` such that ``||T_zw||_inf < gamma`` for
+
+    ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u`` (discrete plant) or
+    ``x' = F x + Bw w + G u`` (continuous plant, ``plant.dt is None``; ``F``,
+    ``G`` are then ``A``, ``B``). The LMIs are given in the docstring of :mod:`robustctl.hinf`;
+    the stages in that of :mod:`robustctl.hinf._synthesis`.
+
+    Parameters
+    ----------
+    plant : Plant
+        The nominal plant ``(F, G)``.
+    Bw : (n, q) array_like
+        Disturbance input matrix.
+    Cz : (p, n) array_like
+        Performance output matrix.
+    Dzu : (p, m) array_like
+        Feedthrough from ``u`` to ``z``. With ``Dzu`` not of full column rank
+        the optimum may need an unbounded gain (the backoff then matters).
+    Dzw : (p, q) array_like, optional
+        Feedthrough from ``w`` to ``z`` (default zero).
+    vertices : list of Plant, optional
+        Further plants (same ``n``, ``m``, ``dt``). The bound then holds for
+        every plant in the convex hull of ``[plant] + vertices``.
+    gamma : float, optional
+        Fixed level: solve the feasibility problem at this ``gamma`` (no
+        minimisation). Raises :class:`~robustctl.errors.InfeasibleError`
+        naming ``gamma`` if no gain achieves it.
+    u_max : float or (m,) array_like, optional
+        Bound on each ``|u_j|``, guaranteed (from ``x0 = 0``) for every
+        disturbance with ``sum_k |w_k|^2 <= w_energy`` (continuous time:
+        ``int |w|^2 dt <= w_energy``). Uses the reachable-set ellipsoid of
+        the same Lyapunov matrix, so ``gamma_opt`` is then the best level
+        *subject to* the bound.
+    w_energy : float, optional
+        Disturbance energy for ``u_max`` (default 1). Only valid with ``u_max``.
+    backoff : float, default 1e-3
+        The gain is computed at ``gamma = (1 + backoff) gamma_opt`` from a
+        well-centred strictly feasible point. ``0`` returns the optimal
+        point's gain (can be badly conditioned; eigenvalues of ``X`` below
+        ``1e-8 lambda_max(X)``, the accuracy of the minimisation, are raised
+        to that floor first, so that a singular optimum gives a stabilising,
+        reproducible gain). If no strictly feasible point
+        with a positive certificate is found at that level (nearly infeasible
+        problems, e.g. a tight ``u_max``), the backoff is raised tenfold, at
+        most twice; ``info["backoff"]`` and ``gamma`` report the value used.
+    extended : bool, default False
+        Use the slack-variable condition of de Oliveira et al. (discrete time
+        only): less conservative with ``vertices``, equal without.
+    poles : Region or list of Region, optional
+        Pole regions (:mod:`robustctl.regions`: ``Disk``, ``HalfPlane``,
+        ``ConicSector``; a list means their intersection): every pole of
+        ``F + G K`` of every vertex lies in them (Chilali & Gahinet 1996),
+        imposed with the same Lyapunov matrix as the H-infinity bound, so
+        ``gamma_opt`` is the best level *subject to* the regions (a
+        conservative bound: one ``X`` for both). Standard LMI only.
+    uncertainty : NormBounded, optional
+        Robust synthesis for ``[dF dG] = H Delta [EF EG]`` with every
+        ``||Delta||_2 <= 1`` (also time-varying) around every vertex: the
+        bound ``gamma`` then holds for every such plant (quadratic
+        stability and performance, by the S-procedure with one multiplier
+        per vertex; see :mod:`robustctl.hinf`). The convex counterpart of
+        :func:`robustctl.rlqr`. ``H = 0`` or ``[EF EG] = 0`` is the nominal
+        design. Pole regions apply to the nominal vertices. Standard LMI only.
+    solver : str, default "CLARABEL"
+        cvxpy SDP solver. Clarabel is run with explicit tolerances (1e-8 for
+        the level of one plant, 1e-10 with vertices, 1e-7 for centring);
+        other solvers use their defaults and may not reach 1e-5 accuracy.
+
+    Returns
+    -------
+    HinfController
+        ``K`` (``u = K x``), ``gamma``, ``gamma_opt`` and ``info`` with
+        ``status``, ``solve_time`` (s, summed over solves), ``iterations``,
+        ``certificate`` (smallest eigenvalue of each LMI block at the
+        returned point), ``gain_from`` (``"optimum-certified"``,
+        ``"optimum"`` for ``backoff=0``, or the centring variant),
+        ``X_min_eig``, ``margin`` (centring margin ``t``), ``solves``
+        (per-solve diagnostics), ``X`` (Lyapunov matrix; ``P`` of the
+        nominal vertex when ``extended``), ``u_bound`` (guaranteed
+        ``max |u_j|`` for ``w_energy``, when ``u_max`` is given),
+        ``scaling`` (state balancing), ``lmi``, ``vertices``, ``backoff``
+        (the value used), ``poles`` (the regions), ``uncertainty`` and, with
+        one, ``multipliers`` (the S-procedure multipliers). Each entry of
+        ``solves`` has the solver's ``status``, ``value``, ``tol``,
+        ``solve_time``, ``iterations`` and ``certificate``; centring solves
+        also name their ``centring`` variant.
+
+    Raises
+    ------
+    InfeasibleError
+        A vertex is not stabilisable, the fixed ``gamma`` or the input bound
+        cannot be met, no common Lyapunov matrix exists for the vertices (or
+        the uncertainty), or the pole regions cannot be reached (the reason:
+        regions without a common stable point, a mode outside them that the
+        input cannot move, or no common Lyapunov matrix).
+    ValueError, TypeError
+        Bad arguments (named in the message).
+
+    Examples
+    --------
+    >>> ctrl = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)   # doctest: +SKIP
+    >>> ctrl.gamma, ctrl.info["gamma_opt"]                       # doctest: +SKIP
+    """
+    problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
+                       w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
+                       uncertainty=uncertainty)
+    w_scale = float(np.sqrt(problem.w_energy)) if problem.u_max is not None else 1.0
+    balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
+                          problem.Dzu, problem.Dzw, w_scale, problem.uncertainty)
+    lqr = None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
+    if problem.gamma is not None:
+        gain, solves = gain_at_level(problem, lqr or balanced, problem.gamma)
+        level, gamma_opt, used_backoff = problem.gamma, None, None
+    else:
+        opt = minimise_level(problem, balanced, lqr)
+        gain, used_backoff, centring = gain_near_optimum(problem, opt)
+        level, gamma_opt, solves = opt.gamma_opt * (1.0 + used_backoff), opt.gamma_opt, opt.solves + centring
+    K, X = gain.data.to_original(gain.point.gain(), gain.point.nominal_lyapunov())
+    check_closed_loop(K, problem.plants, problem.regions)
+    info = _info(problem, gain, K, X, level, gamma_opt, used_backoff, solves)
+    return HinfController(K=K, method="hinf", plant=plant, info=info, gamma=float(level), gamma_opt=gamma_opt)
+
+
+def check_closed_loop(K: np.ndarray, plants, regions: Sequence[Region] = ()) -> None:
+    """ConvergenceError unless ``K`` is finite and stabilises every vertex with its poles in the regions.
+
+    An internal check of the returned gain (the LMI certificate implies both).
+    """
+    if not np.all(np.isfinite(K)):
+        raise ConvergenceError("the gain K = Y X^-1 is not finite; increase backoff")
+    for i, p in enumerate(plants):
+        poles = np.linalg.eigvals(p.F + p.G @ K)
+        stable = np.max(np.abs(poles)) < 1 if p.is_discrete else np.max(poles.real) < 0
+        where = "plant" if i == 0 else f"vertices[{i - 1}]"
+        if not stable:
+            raise ConvergenceError(f"internal check failed: the LMI gain does not stabilise {where}; "
+                                   "increase backoff")
+        for r in regions:
+            if not np.all(r.contains(poles)):
+                raise ConvergenceError(f"internal check failed: a closed-loop pole of {where} lies outside {r!r} "
+                                       f"(poles {np.round(poles, 6).tolist()}); increase backoff")
+
+
+def guaranteed_input_bound(gain: Gain) -> np.ndarray:
+    """``max_i sqrt(k_j P_i k_j')`` over the Lyapunov matrices of the point (unit energy after scaling ``w``)."""
+    Ks = gain.point.gain()
+    return np.max([np.sqrt(np.einsum("ij,jk,ik->i", Ks, P, Ks)) for P in gain.point.lyapunov_matrices()], axis=0)
+
+
+def _info(problem: Problem, gain: Gain, K, X, level, gamma_opt, backoff, solves) -> dict:
+    Xs = 0.5 * (X + X.T)
+    info = {
+        "gamma": level, "gamma_opt": gamma_opt, "backoff": backoff,
+        "lmi": ("extended" if problem.extended else "standard") + ("-discrete" if problem.discrete else "-continuous"),
+        "vertices": len(problem.plants), "status": solves[-1]["status"],
+        "solve_time": float(sum(s["solve_time"] for s in solves)),
+        "iterations": int(sum(s["iterations"] or 0 for s in solves)),
+        "certificate": gain.certificate, "gain_from": gain.route, "X_min_eig": float(np.linalg.eigvalsh(Xs).min()),
+        "margin": float(gain.margin), "solves": list(solves), "X": Xs, "scaling": gain.data.balancing,
+        "solver": problem.solver, "poles": problem.regions, "uncertainty": problem.uncertainty,
+    }
+    if problem.uncertainty is not None:
+        info["multipliers"] = gain.point.eps   # S-procedure multipliers (solver coordinates)
+    if problem.u_max is not None:
+        u_bound = guaranteed_input_bound(gain)
+        info.update(u_bound=u_bound, u_max=problem.u_max, w_energy=problem.w_energy)
+        if np.any(u_bound > problem.u_max * (1.0 + tol.U_BOUND_CHECK)):
+            raise ConvergenceError(f"internal check failed: the guaranteed input bound {u_bound.tolist()} "
+                                   f"exceeds u_max = {problem.u_max.tolist()} (solver inaccuracy); increase backoff")
+    return info

@@ -1,0 +1,132 @@
+"""Stability tests shared by every design and tuning problem.
+
+One tolerance for "stable": a discrete-time matrix ``A`` is Schur stable
+when its spectral radius is below ``1 - STABILITY_MARGIN``; a continuous-time
+one (Hurwitz) when every eigenvalue has real part below ``-STABILITY_MARGIN``.
+The margin keeps a loop with a pole on the unit circle up to rounding (an
+integrator left in place, ``rho = 1 - 1e-15``) from counting as stable.
+
+A plant ``(F, G)`` is stabilisable when every mode that is not stable can be
+moved by the input: ``rank [F - lambda I, G] = n`` at each eigenvalue
+``lambda`` of ``F`` with ``|lambda| >= 1 - UNSTABLE_TOL`` (continuous time:
+``Re lambda >= -UNSTABLE_TOL``), the Popov-Belevitch-Hautus test (Hautus
+1969; Zhou, Doyle & Glover, *Robust and Optimal Control*, 1996, Thm 3.2),
+with the rank decided by the smallest singular value against
+``PBH_TOL * max(1, ||[F G]||_2)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validation import as_float_array, as_matrix, check_square
+from .errors import NotStabilizableError
+
+__all__ = ["STABILITY_MARGIN", "spectral_radius", "is_schur_stable", "is_stable", "unstabilizable_modes",
+           "check_stabilizable"]
+
+#: A discrete loop is stable when ``rho(A) < 1 - STABILITY_MARGIN``.
+STABILITY_MARGIN = 1e-9
+#: Modes with ``|lambda| >= 1 - UNSTABLE_TOL`` (``Re lambda >= -UNSTABLE_TOL``) must be controllable.
+UNSTABLE_TOL = 1e-12
+#: PBH rank test: rank deficient when the smallest singular value is below ``PBH_TOL * max(1, ||[F G]||)``.
+PBH_TOL = 1e-9
+# Batches of at most this many matrices get eigenvalues directly (cheaper than the squaring certificate).
+_EIG_BATCH = 8
+_SQUARINGS = 10
+
+
+def _stack(A, name: str = "A") -> np.ndarray:
+    A = as_float_array(A, name)
+    if A.ndim < 2 or A.shape[-1] != A.shape[-2]:
+        raise ValueError(f"{name} must be a square matrix or a stack of them (..., n, n), got shape {A.shape}")
+    return A
+
+
+def _radius(A: np.ndarray) -> np.ndarray:
+    """Spectral radius of a stack (B, n, n); ``inf`` where an entry is not finite."""
+    rho = np.full(A.shape[0], np.inf)
+    finite = np.isfinite(A).all(axis=(1, 2))
+    if finite.any():
+        rho[finite] = np.abs(np.linalg.eigvals(A[finite])).max(axis=1)
+    return rho
+
+
+def spectral_radius(A) -> np.ndarray | float:
+    """``max |eig(A)|`` of a matrix (n, n) or of each matrix of a stack (..., n, n).
+
+    Non-finite matrices have radius ``inf``. Returns a float for one matrix.
+    """
+    A = _stack(A)
+    rho = _radius(A.reshape(-1, *A.shape[-2:])).reshape(A.shape[:-2])
+    return float(rho) if rho.ndim == 0 else rho
+
+
+def _schur(A: np.ndarray, bound: float) -> np.ndarray:
+    """``rho(A) < bound`` for a stack (B, n, n).
+
+    Certificate first: ``rho(M) <= ||M^k||_F``, so ``||(A/bound)^(2^j)||_F < 1``
+    for some ``j`` proves stability with a few stacked products; only the
+    matrices left undecided get eigenvalues.
+    """
+    if A.shape[0] <= _EIG_BATCH:
+        return _radius(A) < bound
+    M = A / bound
+    stable = np.zeros(A.shape[0], dtype=bool)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(_SQUARINGS):
+            stable |= np.sqrt(np.add.reduce(M * M, axis=(1, 2))) < 1.0
+            if stable.all():
+                return stable
+            M = M @ M
+    undecided = ~stable
+    stable[undecided] = _radius(A[undecided]) < bound
+    return stable
+
+
+def is_schur_stable(A, margin: float = STABILITY_MARGIN) -> np.ndarray | bool:
+    """``rho(A) < 1 - margin`` for a matrix or each matrix of a stack (..., n, n).
+
+    Non-finite matrices are unstable. Returns a bool for one matrix.
+    """
+    A = _stack(A)
+    out = _schur(A.reshape(-1, *A.shape[-2:]), 1.0 - margin).reshape(A.shape[:-2])
+    return bool(out) if out.ndim == 0 else out
+
+
+def is_stable(A, *, discrete: bool, margin: float = STABILITY_MARGIN) -> bool:
+    """One matrix: Schur stable (``discrete``) or Hurwitz stable (every ``Re lambda < -margin``)."""
+    A = _stack(A)
+    if A.ndim != 2:
+        raise ValueError(f"A must be one square matrix, got shape {A.shape}")
+    if discrete:
+        return bool(is_schur_stable(A, margin))
+    return bool(np.isfinite(A).all() and np.linalg.eigvals(A).real.max() < -margin)
+
+
+def unstabilizable_modes(F, G, *, discrete: bool = True) -> np.ndarray:
+    """Eigenvalues of ``F`` that are not stable and that ``G`` cannot move (PBH test, module docstring)."""
+    F = check_square(as_matrix(F, "F"), "F")
+    n = F.shape[0]
+    G = as_matrix(G, "G", rows=n, vector="column", rows_what="the number of states, from F")
+    scale = max(1.0, float(np.linalg.norm(np.hstack([F, G]), 2)))
+    modes = np.linalg.eigvals(F)
+    unstable = np.abs(modes) >= 1.0 - UNSTABLE_TOL if discrete else modes.real >= -UNSTABLE_TOL
+    stuck = [lam for lam in modes[unstable]
+             if np.linalg.svd(np.hstack([F - lam * np.eye(n), G]), compute_uv=False)[-1] <= PBH_TOL * scale]
+    return np.array(stuck, dtype=complex)
+
+
+def check_stabilizable(plant, name: str = "plant") -> None:
+    """Raise :class:`~robustctl.errors.NotStabilizableError` if ``plant`` (a :class:`~robustctl.Plant`) is not stabilisable.
+
+    ``lqr`` and ``rlqr`` call this first: no gain ``u = K x`` stabilises such a
+    plant, so there is no design to return. ``name`` names the plant in the
+    message (e.g. ``"vertices[0]"``).
+    """
+    stuck = plant.unstabilizable_modes  # cached on the plant
+    if stuck.size:
+        kind = "|lambda| >= 1" if plant.is_discrete else "Re(lambda) >= 0"
+        raise NotStabilizableError(
+            f"{name} is not stabilisable: its mode lambda = {complex(stuck[0]):.6g} ({kind}) cannot be moved "
+            "by the input G (PBH rank test), so no gain u = K x makes the loop stable")
