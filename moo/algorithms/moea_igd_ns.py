@@ -63,6 +63,28 @@ resolve doubts, nothing ported).
 * Infeasible individuals are placed after the feasible ones by pymoo's
   :class:`~pymoo.core.survival.Survival` (least violation first) and never
   enter the archive.
+
+Behaviour worth knowing
+-----------------------
+* DTLZ4 (3 objectives): runs often lose a whole region of the front in the
+  first five generations and never recover (8 of 10 under the Deb & Jain
+  budget, 8 of 20 at the paper's setting; NSGA-III 0 and 5). DTLZ4's
+  ``x^100`` places nearly all of a random population near one axis; the few
+  points in the other regions are dominated at first, so they reach only the
+  last front, and there IGD-NS removes first the non-contributing solution
+  farthest from the archive (the second term of IGD-NS, Eq. 2) - exactly
+  those points. Polynomial mutation then cannot reach the lost region (it
+  needs ``x >= 0.97``). PlatEMO's implementation has the same rule.
+* 5 objectives, DTLZ1 / DTLZ3 (Deb & Jain budget): no convergence (dense-front
+  IGD 5.5x / 40x NSGA-III's, ``benchmarks/results/protocol_dense_m5.md``).
+  From about generation 100 all ``2N`` candidates are non-dominated, so the
+  selection is IGD-NS against the archive, which holds the non-dominated
+  solutions of everything seen - with 5 objectives almost all of them, the
+  unconverged ones included (its truncation keeps the largest value of each
+  objective first): the population is pulled towards them, not towards the
+  front. The method targets multi-objective problems; PlatEMO, maintained
+  by the paper's authors' group, lists it for them only (``<multi>``, not
+  ``<many>``).
 """
 
 from __future__ import annotations

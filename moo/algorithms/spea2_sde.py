@@ -64,6 +64,16 @@ Readings where the papers leave a choice
   and in the paper being reproduced.
 * Survival is a function of the set it receives (no hidden state), so it can
   be called again on any merged population, as MO-LSP does.
+
+Behaviour worth knowing
+-----------------------
+DTLZ4 (3 objectives): runs lose a region of the front in the first
+generations (7 of 10 under the Deb & Jain budget, 7 of 20 at the paper's
+setting; NSGA-III 0 and 5): while fewer than ``N`` individuals are
+non-dominated, SPEA2 fills the archive by raw fitness (Zitzler et al. 2001,
+Sec. 3.2), so the dominated points of the few rare regions DTLZ4's
+``x^100`` leaves go first, and polynomial mutation cannot reach those regions
+again (it needs ``x >= 0.97``).
 """
 
 from __future__ import annotations
