@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_protocol.py [--parts protocol,dense,paper,wfg] [--algorithms a,b,...]
+    python benchmarks/bench_protocol.py [--parts protocol,dense,paper,wfg] [--algorithms a,b,...] [--wfg-evals 25000]
                                         [--problems dtlz1,...] [--objectives 3,5,8] [--runs 20]
                                         [--processes 2] [--out benchmarks/results/protocol.md]
 
@@ -114,6 +114,7 @@ class Task:
     n_obj: int
     seed: int
     operators: str
+    evals: int = 0          # the budget of the paper and wfg parts
 
 
 @dataclass(frozen=True)
@@ -197,11 +198,8 @@ def build(task: Task):
         termination = ("n_gen", GENERATIONS[task.problem][task.n_obj])
     else:
         pop_size = POP_SIZE
-        termination = ("n_eval", PAPER_EVALS if task.part == "paper" else WFG_EVALS)
+        termination = ("n_eval", task.evals)
     return problem, make_algorithm(task.algorithm, n_obj=task.n_obj, pop_size=pop_size, **options), termination
-
-
-WFG_EVALS = 25000
 
 
 def run_task(task: Task) -> Result:
@@ -244,7 +242,9 @@ def tasks_for(args: argparse.Namespace) -> list[Task]:
             algs = args.names
             cases = [(f"wfg{i}", 3) for i in range(1, 10)]
         ops = args.operators if part in ("protocol", "dense") else "paper"
-        tasks += [Task(part, a, p, M, s, ops) for (p, M) in cases for s in range(args.runs_for[part]) for a in algs]
+        evals = {"paper": PAPER_EVALS, "wfg": args.wfg_evals}.get(part, 0)
+        tasks += [Task(part, a, p, M, s, ops, evals) for (p, M) in cases for s in range(args.runs_for[part])
+                  for a in algs]
     return tasks
 
 
@@ -279,7 +279,7 @@ def subset(args: argparse.Namespace) -> str:
                 "dense": f"{', '.join(args.problems)} at M = {', '.join(map(str, args.dense_objectives))}, "
                          f"operators `{args.operators}`",
                 "paper": ", ".join(f"{p} M={m}" for p, m in PAPER_CASES),
-                "wfg": f"WFG1-9 M=3, {WFG_EVALS} evaluations"}[part]
+                "wfg": f"WFG1-9 M=3, {args.wfg_evals} evaluations"}[part]
         parts.append(f"{part} ({what}; {args.runs_for[part]} runs)")
     algs = [a for a in args.names]
     return "; ".join(parts) + f"; algorithms {', '.join(algs)}"
@@ -339,7 +339,7 @@ def paper_section(results: list[Result]) -> list[str]:
 
 def wfg_section(results: list[Result]) -> list[str]:
     return _relative_section("## WFG1-9, M = 3 (population 92, paper operators; IGD to pymoo's 861-point front)",
-                             results, lambda p, M: f"{WFG_EVALS} evals")
+                             results, lambda p, M: f"{results[0].task.evals} evals")
 
 
 SECTIONS = {"protocol": protocol_section, "dense": dense_section, "paper": paper_section, "wfg": wfg_section}
@@ -361,7 +361,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                     help="runs per case (default: 20 for protocol, 10 for the other parts)")
     ap.add_argument("--operators", default="protocol", choices=("protocol", "original", "paper"),
                     help="variation settings of the protocol and dense parts")
-    ap.add_argument("--wfg-evals", type=int, default=WFG_EVALS, help="evaluations per WFG run")
+    ap.add_argument("--wfg-evals", type=int, default=25000, help="evaluations per WFG run")
     ap.add_argument("--processes", type=int, default=2, help="worker processes (1 or 2)")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "protocol.md"), help="Markdown output")
     args = ap.parse_args(argv)
@@ -389,14 +389,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 
 def main(argv: list[str] | None = None) -> int:
-    global WFG_EVALS
     args = parse_args(argv)
-    WFG_EVALS = args.wfg_evals
     tasks = tasks_for(args)
     print(f"{len(tasks)} runs on {args.processes} process(es)", file=sys.stderr, flush=True)
     t0 = time.perf_counter()
     results = []
-    with mp.get_context("fork").Pool(args.processes, initializer=_init_worker, initargs=(WFG_EVALS,)) as pool:
+    with mp.get_context("fork").Pool(args.processes) as pool:
         for i, r in enumerate(pool.imap_unordered(run_task, tasks, chunksize=1), 1):
             results.append(r)
             t = r.task
@@ -411,11 +409,6 @@ def main(argv: list[str] | None = None) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(table + "\n")
     return 0
-
-
-def _init_worker(wfg_evals: int) -> None:
-    global WFG_EVALS
-    WFG_EVALS = wfg_evals
 
 
 if __name__ == "__main__":
