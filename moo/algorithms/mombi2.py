@@ -63,9 +63,10 @@ resolve doubts, nothing ported). Where those differ:
   zero component (74 of the 84 for 4 objectives), and 1e-6 makes each of them
   rank the points by their smallest objective alone, which crowds the
   population onto the edges of the front. Measured on DTLZ2 (population 92,
-  10000 evaluations, 10 seeds, dense-front IGD over NSGA-III's): 1e-6 gives
-  1.15x (3 objectives) and 1.37x (4), 1e-2 gives 1.03x and 1.03x
-  (``benchmarks/bench_protocol.py`` and ``bench_moeas.py`` have the current
+  10000 evaluations, 10 seeds, dense-front IGD over NSGA-III's; both with
+  the stagnation rule below): 1e-6 gives 1.15x (3 objectives) and 1.37x (4),
+  1e-2 gives 1.03x and 1.03x; with neither change 1.22x and 1.53x
+  (``benchmarks/results/moeas.md`` and ``protocol.md`` have the current
   figures).
 * "``v_i = 0``" in rule c. The authors' code tests the variance of the record
   for exact equality with zero, which in floating point holds only when the
@@ -139,6 +140,8 @@ ZERO_WEIGHT = 1e-2
 def zero_weight(n_obj: int) -> float:
     """The ASF's stand-in for a zero weight component: :data:`ZERO_WEIGHT_2D` for 2 objectives, else :data:`ZERO_WEIGHT`."""
     return ZERO_WEIGHT_2D if n_obj == 2 else ZERO_WEIGHT
+
+
 #: Smallest range z_max - z_min used in the normalisation (avoids 0/0).
 _TINY_RANGE = 1e-12
 
