@@ -123,7 +123,10 @@ __all__ = [
     "r2_ranking",
     "r2_tournament",
     "update_reference_points",
+    "zero_weight",
     "ORIGINAL_OPERATORS",
+    "ZERO_WEIGHT",
+    "ZERO_WEIGHT_2D",
 ]
 
 #: MOMBI-II's own settings (SBX pc = 0.9, eta_c = 20; polynomial mutation pm = 1/n, eta_m = 20:

@@ -34,7 +34,7 @@ def make_nsga2(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | Operato
 
 def make_nsga3(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
                ref_dirs: np.ndarray | None = None) -> NSGA3:
-    """NSGA-III with ``ref_dirs``, by default those of :func:`reference_directions` (91 for 3 objectives).
+    """NSGA-III with ``ref_dirs``, by default :func:`~moo.algorithms.operators.reference_directions` (91 for M = 3).
 
     The population is ``max(pop_size, len(ref_dirs))``; ``operators="original"``:
     :data:`NSGA3_ORIGINAL_OPERATORS`.
