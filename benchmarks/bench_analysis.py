@@ -68,14 +68,14 @@ def main(argv=None) -> int:
     warm = case(3, 0, True)
     rc.robust_stability((warm[0], warm[1]), warm[2])  # import cvxpy, fill caches
     load = os.getloadavg()[0]
-    lines = [f"# bench_analysis ({datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, "
-             f"{platform.processor() or platform.machine()}, Python {platform.python_version()}, "
-             f"{os.cpu_count()} cores, load average {load:.1f} at start: shared machine)", "",
-             "`robust_stability` (bounded-real LMI, Clarabel, certificate) against python-control's `linfnorm` "
-             "of the same loop `E (zI - A)^-1 H`; p = 2, l = 3, m = 2, margin 2. Best of "
-             f"{args.reps} runs per loop, median over {args.seeds} loops.", "",
-             "| time | n | robust_stability [ms] | solver, one call [ms] | iterations | linfnorm [ms] "
-             "| **ratio** (median, max) | max rel. margin difference |",
+    lines = [(f"# bench_analysis ({datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, "
+              f"{platform.processor() or platform.machine()}, Python {platform.python_version()}, "
+              f"{os.cpu_count()} cores, load average {load:.1f} at start: shared machine)"), "",
+             ("`robust_stability` (bounded-real LMI, Clarabel, certificate) against python-control's `linfnorm` "
+              "of the same loop `E (zI - A)^-1 H`; p = 2, l = 3, m = 2, margin 2. Best of "
+              f"{args.reps} runs per loop, median over {args.seeds} loops."), "",
+             ("| time | n | robust_stability [ms] | solver, one call [ms] | iterations | linfnorm [ms] "
+              "| **ratio** (median, max) | max rel. margin difference |"),
              "|---|---|---|---|---|---|---|---|"]
     print("\n".join(lines), flush=True)
     for discrete in (True, False):

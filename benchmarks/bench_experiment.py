@@ -227,35 +227,35 @@ def runs(problems, algorithms, evals: int, seed: int) -> list[dict]:
 
 # -- report ---------------------------------------------------------------------------------------
 def report(args, comp, kern, rows) -> str:
-    now = datetime.datetime.now(datetime.timezone.utc)
+    now = datetime.datetime.now(datetime.UTC)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    lines = [f"# bench_experiment ({now:%Y-%m-%d %H:%M} UTC, {platform.machine()}, Python "
-             f"{platform.python_version()}, load average {load:.1f} on {os.cpu_count()} cores"
-             f"{', --quick' if args.quick else ''})", "",
-             "Timings on a shared machine are noisy: every ratio is against a peer measured in the same "
-             "process next to it.", "",
+    lines = [(f"# bench_experiment ({now:%Y-%m-%d %H:%M} UTC, {platform.machine()}, Python "
+              f"{platform.python_version()}, load average {load:.1f} on {os.cpu_count()} cores"
+              f"{', --quick' if args.quick else ''})"), "",
+             ("Timings on a shared machine are noisy: every ratio is against a peer measured in the same "
+              "process next to it."), "",
              "## Compilation (numba cache)", "",
              "| step | seconds |", "|---|---:|",
              f"| fresh copy, first simulation (compiles, writes the cache) | {comp['fresh']['first']:.2f} |",
-             f"| fresh copy, second process, first simulation (loads the cache: {comp['cached']['hits']} hit) "
-             f"| {comp['cached']['first']:.2f} |",
-             f"| import of robustctl.batchsim (numpy, scipy; numba is imported on the first call) "
-             f"| {comp['cached']['imp']:.2f} |",
+             (f"| fresh copy, second process, first simulation (loads the cache: {comp['cached']['hits']} hit) "
+              f"| {comp['cached']['first']:.2f} |"),
+             (f"| import of robustctl.batchsim (numpy, scipy; numba is imported on the first call) "
+              f"| {comp['cached']['imp']:.2f} |"),
              f"| spawned worker: import moo.problems | {comp['worker']['imp']:.2f} |",
              f"| spawned worker: build the applied MOP | {comp['worker']['build']:.2f} |",
-             f"| spawned worker: first evaluation of 92 designs (kernel from the cache) "
-             f"| {comp['worker']['evaluate']:.2f} |", "",
+             (f"| spawned worker: first evaluation of 92 designs (kernel from the cache) "
+              f"| {comp['worker']['evaluate']:.2f} |"), "",
              "## Kernel", "",
-             f"Applied MOP simulation, {kern['B']} stable random designs x {kern['S']} payloads x {kern['T']} "
-             f"steps (best of the repeats).", "",
+             (f"Applied MOP simulation, {kern['B']} stable random designs x {kern['S']} payloads x {kern['T']} "
+              f"steps (best of the repeats)."), "",
              "| path | us per design | vs numba |", "|---|---:|---:|",
              f"| compiled kernel (numba) | {kern['numba'] * 1e6:.1f} | 1.0 |",
              f"| numpy reference | {kern['numpy'] * 1e6:.1f} | {kern['numpy'] / kern['numba']:.0f}x slower |",
-             f"| compute bound ({kern['flops']} flops at 16 flops/cycle, {kern['hz'] / 1e9:.2f} GHz) "
-             f"| {kern['bound'] * 1e6:.1f} | {kern['numba'] / kern['bound']:.1f}x of the bound |", ""]
+             (f"| compute bound ({kern['flops']} flops at 16 flops/cycle, {kern['hz'] / 1e9:.2f} GHz) "
+              f"| {kern['bound'] * 1e6:.1f} | {kern['numba'] / kern['bound']:.1f}x of the bound |"), ""]
     lines += [f"## One run per configuration, {args.evals} evaluations, seed {args.seed}", "",
-              "| MOP | MOEA | MO-LSP | wall s | CPU s | RLQR s | simulation s | peer wall s | wall / peer "
-              "| CPU / peer |", "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+              ("| MOP | MOEA | MO-LSP | wall s | CPU s | RLQR s | simulation s | peer wall s | wall / peer "
+               "| CPU / peer |"), "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         lines.append(f"| {r['problem']} | {r['algorithm']} | {'yes' if r['molsp'] else 'no'} | {r['wall']:.2f} "
                      f"| {r['cpu']:.2f} | {r['rlqr']:.2f} | {r['sim']:.2f} | {r['peer_wall']:.2f} "

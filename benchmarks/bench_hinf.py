@@ -15,9 +15,12 @@ warm-up that imports cvxpy). BLAS threads are pinned to 1 unless the
 environment says otherwise (on a shared 2-core machine multithreaded BLAS
 makes the Riccati timings erratic).
 
-Last lines: the truck polytope with the steering limit, and robust H-infinity
+Last lines: the truck polytope with the steering limit, robust H-infinity
 for a norm-bounded payload model against the polytopic design
-(:func:`robust_vs_polytopic`).
+(:func:`robust_vs_polytopic`), and the truck with the weights of the
+authors' code given unscaled against the same channels scaled by hand
+(:func:`units`: the synthesis scales them inside, so both are the same
+problem for the solver).
 
 Usage: python benchmarks/bench_hinf.py [--sizes 4 10 20] [--reps 3] [--seeds 5]
 """
@@ -106,6 +109,21 @@ def robust_vs_polytopic(reps: int) -> dict:
                 worst_rob=worst(rob.K), rank=r)
 
 
+def units(reps: int) -> dict:
+    """The truck with ``Q = diag(1, 1, 25000, 100)``, ``R = 33535``, ``Bw = ones``: unscaled vs ``z / sqrt(r)``."""
+    from robustctl.models.truck import authors_weights, truck_plant
+
+    plant = truck_plant(0.0)
+    Q, R = authors_weights()
+    Bw, Cz, Dzu = np.ones((4, 1)), np.vstack([np.sqrt(Q), np.zeros((1, 4))]), np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+    s = 1.0 / np.sqrt(R[0, 0])
+    raw, t_raw = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu), reps)
+    by_hand, t_hand = best_time(lambda: hinf(plant, Bw=Bw, Cz=s * Cz, Dzu=s * Dzu), reps)
+    ric = hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    return dict(t_raw=t_raw, t_hand=t_hand, gamma_raw=raw.gamma_opt, gamma_hand=by_hand.gamma_opt / s,
+                gamma_ric=ric.gamma)
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=[4, 10, 20])
@@ -142,6 +160,10 @@ def main(argv=None) -> None:
           f"time {rb['t_rob']:.3f} s vs {rb['t_poly']:.3f} s (ratio {rb['t_rob'] / rb['t_poly']:.2f}); "
           f"gamma {rb['gamma_rob']:.5g} vs {rb['gamma_poly']:.5g}; worst linfnorm on 0..300 % "
           f"{rb['worst_rob']:.5g} vs {rb['worst_poly']:.5g}")
+    un = units(args.reps)
+    print(f"truck, authors' weights (R = 33535, Bw = ones), unscaled vs z / sqrt(r) by hand: time {un['t_raw']:.3f} s "
+          f"vs {un['t_hand']:.3f} s (ratio {un['t_raw'] / un['t_hand']:.2f}); gamma_opt {un['gamma_raw']:.10g} vs "
+          f"{un['gamma_hand']:.10g}, Riccati bisection (unscaled) {un['gamma_ric']:.10g}")
 
 
 if __name__ == "__main__":

@@ -44,16 +44,16 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # run from a checkout without install
 
-from pymoo.core.problem import ElementwiseProblem  # noqa: E402
-from pymoo.optimize import minimize  # noqa: E402
+from pymoo.core.problem import ElementwiseProblem
+from pymoo.optimize import minimize
 
-import robustctl as rc  # noqa: E402
-from moo.algorithms import make_algorithm  # noqa: E402
-from moo.molsp import molsp  # noqa: E402
-from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
-from moo.problems.generic import GenericRLQRProblem  # noqa: E402
-from robustctl.models import truck  # noqa: E402
-from robustctl.pathfollow import simulate  # noqa: E402
+import robustctl as rc
+from moo.algorithms import make_algorithm
+from moo.molsp import molsp
+from moo.problems.applied import AppliedRLQRProblem
+from moo.problems.generic import GenericRLQRProblem
+from robustctl.models import truck
+from robustctl.pathfollow import simulate
 
 
 class ElementwiseApplied(ElementwiseProblem):
@@ -80,7 +80,7 @@ class ElementwiseApplied(ElementwiseProblem):
             out["F"] = np.full(b.n_obj, 2.0 * pen)
             return
         rho = max(np.max(np.abs(np.linalg.eigvals(Fs + Gs @ K.sum(axis=0, keepdims=True))))
-                  for Fs, Gs in zip(self.F_s, self.G_s))
+                  for Fs, Gs in zip(self.F_s, self.G_s, strict=True))
         if rho >= 1.0:
             out["F"] = np.full(b.n_obj, pen * min(rho, 2.0))
             return
@@ -169,8 +169,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=None, help="also write the report (Markdown) here")
     args = ap.parse_args(argv)
 
-    lines = [f"# bench_mop ({datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, "
-             f"{platform.processor() or platform.machine()}, Python {platform.python_version()})", ""]
+    lines = [(f"# bench_mop ({datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, "
+              f"{platform.processor() or platform.machine()}, Python {platform.python_version()})"), ""]
     b = batched_vs_elementwise(args.pop, args.elementwise, args.seed)
     lines += ["## Applied MOP: batched vs elementwise", "",
               "| evaluation | evals/s |", "|---|---|",
@@ -181,15 +181,15 @@ def main(argv=None) -> int:
     if not args.skip_runs:
         rows = nsga2_runs(args.evals, args.seed, args.repeats)
         part = [f"## NSGA-II, {args.evals} evaluations, seed {args.seed}, fastest of {args.repeats}", "",
-                "| problem | MO-LSP | seconds | of which evaluating | evaluations | generations | mutants "
-                "| MO-LSP extra time |",
+                ("| problem | MO-LSP | seconds | of which evaluating | evaluations | generations | mutants "
+                 "| MO-LSP extra time |"),
                 "|---|---|---|---|---|---|---|---|"]
         for r in rows:
             extra = f"{r['overhead']:+.1f} %" if "overhead" in r else ""
             part.append(f"| {r['problem']} | {'yes' if r['molsp'] else 'no'} | {r['seconds']:.1f} "
                         f"| {r['eval_seconds']:.1f} | {r['n_eval']} | {r['n_gen']} | {r['mutants']} | {extra} |")
-        print("\n".join(part + [""]), flush=True)
-        lines += part + [""]
+        print("\n".join([*part, ""]), flush=True)
+        lines += [*part, ""]
     part = ["## Objective scales (random designs)", "",
             "| problem | sample | stable | dominate hv_ref | dominate molsp_ref | f(z*) |", "|---|---|---|---|---|---|"]
     for r in scales(args.seed + 1):

@@ -16,7 +16,7 @@ import robustctl  # noqa: E402  (after the path set-up)
 
 project = "robustctl + moo"
 author = "the robustctl developers"
-copyright = "2026, the robustctl developers"
+copyright = "2026, the robustctl developers"  # noqa: A001 - the name Sphinx reads
 release = version = robustctl.__version__
 
 extensions = [

@@ -2,10 +2,10 @@
 
 ::
 
-    python -m moo run --problem {generic,applied,zdt1..6,dtlz1..7} [--n-obj M]
+    python -m moo run --problem {generic,applied,zdt1..6,dtlz1..7} [--n-obj M] [--setup S]
                       --algorithm NAME [--molsp [--max-leaders K]] --seed S
                       --evals N [--pop-size P] --out FILE.json
-    python -m moo experiment --problem P [--n-obj M] [--algorithms all|a,b] --runs N
+    python -m moo experiment --problem P [--n-obj M] [--setup S] [--algorithms all|a,b] --runs N
                       --evals E [--max-leaders K] [--pop-size P] [--seed BASE] --out DIR
                       [--executor {process,dask}] [--workers W] [--scheduler ADDRESS]
                       [--keep-going]
@@ -30,9 +30,10 @@ Exit codes (the same for every command):
 * 0 - done;
 * 1 - the work failed: a run raised (``experiment``: without ``--keep-going``
   the grid stops there; with it, the grid finishes and the failed runs are
-  listed), or the executor failed (a pool process killed, the scheduler
-  unreachable). One line on stderr says what and where the traceback is; the
-  records already written stay, and rerunning the command resumes;
+  listed), or the executor failed (pool processes killed more often than
+  the pool restarts, the scheduler unreachable). One line on stderr says
+  what and where the traceback is; the records already written stay, and
+  rerunning the command resumes;
 * 2 - bad arguments (a one-line message on stderr; nothing was run or written),
   including an unusable ``--out``, a results directory holding runs with
   other settings, and a corrupt record read by ``stats`` or ``plot``;
@@ -59,6 +60,7 @@ __all__ = ["main"]
 
 _PROG = "python -m moo"
 
+_SETUP_HELP = "set-up of the applied problem: ours (default) or authors (the authors' published code)"
 _EXIT_CODES = """exit codes: 0 done; 1 the work failed (a run raised, or the executor failed; records
 already written stay, rerun to resume); 2 bad arguments (nothing run); 130 interrupted"""
 
@@ -92,6 +94,7 @@ def _parser() -> argparse.ArgumentParser:
                    f"{_PROG} run --problem applied --algorithm nsga3 --molsp --seed 1 --evals 10000 --out run.json")
     r.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}")
     r.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
+    r.add_argument("--setup", default=None, help=_SETUP_HELP)
     r.add_argument("--algorithm", required=True, help=f"one of {', '.join(ALGORITHMS)}")
     r.add_argument("--molsp", action="store_true", help="add MO-LSP to the algorithm")
     r.add_argument("--max-leaders", type=int, default=None, help="MO-LSP cap on candidates per generation")
@@ -105,6 +108,7 @@ def _parser() -> argparse.ArgumentParser:
                    "--out results/generic --executor dask --workers 2")
     e.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}")
     e.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
+    e.add_argument("--setup", default=None, help=_SETUP_HELP)
     e.add_argument("--algorithms", default="all", help="'all' or a comma-separated list (default all)")
     e.add_argument("--runs", type=int, required=True, help="independent runs per algorithm and variant")
     e.add_argument("--evals", type=int, required=True, help="evaluation budget of each run")
@@ -144,7 +148,7 @@ def _parser() -> argparse.ArgumentParser:
 _FLAGS = {"seed": "--seed", "base_seed": "--seed", "evals": "--evals", "pop_size": "--pop-size",
           "max_leaders": "--max-leaders", "n_obj": "--n-obj", "runs": "--runs", "workers": "--workers",
           "scheduler": "--scheduler", "executor": "--executor", "alpha": "--alpha", "algorithms": "--algorithms",
-          "out": "--out"}
+          "out": "--out", "setup": "--setup"}
 
 
 def _flagged(message: str) -> str:
@@ -173,7 +177,7 @@ class _Progress:
 
     def __call__(self, done: int, total: int) -> None:
         frac = min(done / total, 1.0)
-        bar = "#" * int(round(frac * self.width))
+        bar = "#" * round(frac * self.width)
         sys.stderr.write(f"\r{self.label} [{bar:<{self.width}}] {done}/{total} evals")
         sys.stderr.flush()
 
@@ -202,12 +206,12 @@ def _cmd_run(args) -> int:
     with _usage():
         out = check_output_file(args.out, "--out")
         job = prepare(args.problem, args.algorithm, seed=args.seed, evals=args.evals, n_obj=args.n_obj,
-                      molsp=args.molsp, pop_size=args.pop_size, max_leaders=args.max_leaders)
+                      molsp=args.molsp, pop_size=args.pop_size, max_leaders=args.max_leaders, setup=args.setup)
     bar = _Progress(f"{args.algorithm}{'+molsp' if args.molsp else ''} {args.problem} s{args.seed}") \
         if sys.stderr.isatty() else None
     try:
         result = job.run(progress=bar)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - the CLI's boundary: traceback, then one line naming it
         return _failure(exc, "the run failed")
     finally:
         if bar is not None:
@@ -229,7 +233,7 @@ def _cmd_experiment(args) -> int:
         executor = open_executor(args.executor, workers=args.workers, scheduler=args.scheduler)
         grid = prepare(args.problem, args.algorithms, runs=args.runs, evals=args.evals, out=args.out,
                        n_obj=args.n_obj, base_seed=args.seed, pop_size=args.pop_size,
-                       max_leaders=args.max_leaders)
+                       max_leaders=args.max_leaders, setup=args.setup)
     if grid.skipped:
         retry = f", {grid.retried} failed before and retried" if grid.retried else ""
         print(f"{grid.skipped} of {len(grid.specs)} runs already done in {grid.out} (skipped); "
@@ -241,7 +245,7 @@ def _cmd_experiment(args) -> int:
         return _error(f"{exc}; the records written stay, rerun to resume", 1)
     except ConnectionError as exc:
         return _error(str(exc), 1)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
     print(report, file=sys.stderr)
     if report.failed:

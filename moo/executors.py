@@ -8,10 +8,14 @@ manager that yields a :class:`concurrent.futures.Executor` (or ``None`` for
         run_experiment(..., executor=ex)
 
 ``"process"``
-    ``workers`` spawned processes (:class:`~concurrent.futures.ProcessPoolExecutor`);
+    ``workers`` spawned processes (a :class:`~concurrent.futures.ProcessPoolExecutor`);
     ``workers=1`` (the default) runs in this process. A pool process killed
-    mid-grid breaks the pool (``BrokenProcessPool``): the grid stops, the
-    records written stay, and a rerun resumes.
+    mid-grid breaks the pool (``BrokenProcessPool``: every run in flight or
+    queued is lost); the experiment driver then starts a fresh pool and
+    resubmits the lost runs, at most :data:`POOL_RESTARTS` times per grid (a
+    run that kills its process every time would otherwise loop forever), with
+    a message on stderr. After that the grid stops; the records written stay
+    and a rerun resumes.
 ``"dask"``
     With ``scheduler``: the workers of an existing ``dask.distributed``
     scheduler (started with ``dask scheduler`` / ``dask worker``, or by
@@ -29,17 +33,22 @@ runs in flight.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from concurrent.futures import Executor, ProcessPoolExecutor
+from collections.abc import Callable, Iterator
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from contextlib import AbstractContextManager, contextmanager
 from multiprocessing import get_context
+from typing import Any
 
 from moo._validation import check_choice, check_int
 
-__all__ = ["EXECUTORS", "open_executor"]
+__all__ = ["EXECUTORS", "POOL_RESTARTS", "open_executor"]
 
 #: Executor kinds of :func:`open_executor` (and ``python -m moo experiment --executor``).
 EXECUTORS: tuple[str, ...] = ("process", "dask")
+
+#: How often the ``"process"`` pool is replaced after a pool process died, per grid (as Dask's
+#: ``distributed.scheduler.allowed-failures``, 3 by default, bounds the recomputations of a run).
+POOL_RESTARTS = 3
 
 
 def open_executor(kind: str = "process", *, workers: int | None = None,
@@ -78,12 +87,38 @@ def open_executor(kind: str = "process", *, workers: int | None = None,
     return _dask(scheduler, workers or 1)
 
 
+class _RestartingPool(Executor):
+    """A pool of ``workers`` spawned processes that :meth:`restart` replaces once it is broken."""
+
+    def __init__(self, workers: int, restarts: int = POOL_RESTARTS):
+        self.workers, self.restarts_left = workers, restarts
+        self._pool = self._new()
+
+    def _new(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"))
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
+        return self._pool.submit(fn, *args, **kwargs)
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        self._pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+    def restart(self) -> bool:
+        """Replace the (broken) pool by a fresh one; False once :data:`POOL_RESTARTS` are used up."""
+        if self.restarts_left == 0:
+            return False
+        self.restarts_left -= 1
+        self._pool.shutdown(wait=True)      # a broken pool has already terminated its processes
+        self._pool = self._new()
+        return True
+
+
 @contextmanager
 def _process_pool(workers: int) -> Iterator[Executor | None]:
     if workers == 1:
         yield None
         return
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+    pool = _RestartingPool(workers)
     try:
         yield pool
     except BaseException:

@@ -13,8 +13,10 @@ results directory) followed by :meth:`PreparedExperiment.run`.
 Resuming
 --------
 A rerun skips every run whose file holds the expected record: the same
-problem, objectives, algorithm, variant, seed, budget, population size (the
-one the algorithm uses) and MO-LSP cap. An interrupted experiment therefore
+problem, its set-up (``applied``: ``ours`` or ``authors``; a record written
+before set-ups existed counts as the default), objectives, algorithm, variant,
+seed, budget, population size (the one the algorithm uses) and MO-LSP cap.
+An interrupted experiment therefore
 continues where it stopped and never recomputes a finished run. A file that
 holds a run with *other* settings (say another budget) is an error naming the
 file and the setting, raised before any run starts: results of two settings
@@ -42,8 +44,11 @@ where they run. ``executor=None`` runs them in this process (or, with
 (:func:`moo.executors.open_executor` opens the first two). Workers compute and
 *return* records; only this process (the driver) writes them, atomically, so
 the workers need no shared file system. A Dask worker lost mid-grid has its
-runs recomputed on the others by the scheduler; the driver keeps every
-record that arrived.
+runs recomputed on the others by the scheduler; a process of the ``"process"``
+pool of :func:`~moo.executors.open_executor` killed mid-grid breaks the pool,
+and the driver starts a fresh pool and resubmits the runs lost with it (at
+most :data:`~moo.executors.POOL_RESTARTS` times, with a message on stderr).
+Either way the driver keeps every record that arrived.
 
 Failures
 --------
@@ -52,8 +57,10 @@ A run that raises is recorded beside its cell as ``seed_<s>.failed.json``
 the grid (:class:`RunFailedError`; queued runs are cancelled, the records
 already written stay, and a rerun resumes); with ``keep_going`` the grid goes
 on and the report lists the failures. A failure of the executor itself
-(``BrokenProcessPool`` when a pool process is killed, Dask's ``KilledWorker``
-when a run has killed several workers) stops the grid in the same way.
+(``BrokenProcessPool`` when the pool broke once more after its last restart,
+or when a pool that cannot restart - an executor passed in - lost a process;
+Dask's ``KilledWorker`` when a run has killed several workers) stops the grid
+in the same way.
 """
 
 from __future__ import annotations
@@ -64,6 +71,7 @@ import time
 import traceback
 from collections.abc import Sequence
 from concurrent.futures import Executor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -72,6 +80,7 @@ import numpy as np
 from moo._validation import check_int
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
+from moo.executors import POOL_RESTARTS, _RestartingPool, open_executor
 from moo.store import FAILED_SUFFIX, load_records, prepare_results_dir, read_record, write_json_atomic
 
 __all__ = ["RunSpec", "ExperimentReport", "PreparedExperiment", "RunFailedError", "plan", "run_seeds",
@@ -94,6 +103,7 @@ class RunSpec:
     evals: int
     pop_size: int = POP_SIZE
     max_leaders: int | None = None
+    setup: str | None = None
 
     @property
     def variant(self) -> str:
@@ -170,7 +180,7 @@ def _algorithms(algorithms: str | Sequence[str]) -> list[str]:
 
 def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int, n_obj: int | None = None,
          base_seed: int = 0, pop_size: int = POP_SIZE, max_leaders: int | None = None,
-         variants: Sequence[bool] = (False, True)) -> list[RunSpec]:
+         variants: Sequence[bool] = (False, True), setup: str | None = None) -> list[RunSpec]:
     """The grid as a list of :class:`RunSpec`, ordered run index first.
 
     Parameters
@@ -193,6 +203,8 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
         MO-LSP's cap on candidates per generation (MO-LSP runs only).
     variants : sequence of bool
         Which variants to run: ``False`` plain, ``True`` with MO-LSP.
+    setup : str, optional
+        The problem's set-up (``applied`` only, see :func:`moo.runner.prepare`).
     """
     from moo.problems import PROBLEMS
 
@@ -210,14 +222,18 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
         raise ValueError("variants must hold at least one of False (plain), True (MO-LSP)")
     seeds = run_seeds(runs, base_seed)
     return [RunSpec(problem=problem.lower(), n_obj=n_obj, algorithm=name, molsp=v, run_index=i, seed=s,
-                    evals=evals, pop_size=pop_size, max_leaders=max_leaders if v else None)
+                    evals=evals, pop_size=pop_size, max_leaders=max_leaders if v else None, setup=setup)
             for i, s in enumerate(seeds) for name in names for v in variants]
 
 
 # ---------------------------------------------------------------------------- the store scan
 
-def _is_done(spec: RunSpec, out: Path, expected: dict) -> bool:
-    """True if the spec's file holds its record; False if absent or unreadable; error if another run."""
+def _is_done(spec: RunSpec, out: Path, expected: dict, legacy_setup=None) -> bool:
+    """True if the spec's file holds its record; False if absent or unreadable; error if another run.
+
+    ``legacy_setup``: the set-up a record without a ``setup`` field (written before set-ups existed)
+    stands for (the problem's default set-up when the grid asks for the default, else no match).
+    """
     path = spec.path(out)
     if not path.is_file():
         return False
@@ -225,7 +241,8 @@ def _is_done(spec: RunSpec, out: Path, expected: dict) -> bool:
         rec = read_record(path, required=(*_MATCH, "F"))
     except ValueError:
         return False                      # unreadable (not written by us): recompute and replace
-    wrong = {k: (rec[k], v) for k, v in expected.items() if rec[k] != v}
+    got = {k: rec.get(k, legacy_setup) if k == "setup" else rec[k] for k in expected}
+    wrong = {k: (got[k], v) for k, v in expected.items() if got[k] != v}
     if wrong:
         what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, (got, want) in wrong.items())
         raise ValueError(f"{path} holds a run with other settings: {what}; use another out directory "
@@ -233,8 +250,9 @@ def _is_done(spec: RunSpec, out: Path, expected: dict) -> bool:
     return True
 
 
-def _expected(spec: RunSpec, n_obj: int, pop_sizes: dict[str, int]) -> dict:
-    return {"problem": spec.problem, "n_obj": n_obj, "algorithm": spec.algorithm, "molsp": spec.molsp,
+def _expected(spec: RunSpec, n_obj: int, pop_sizes: dict[str, int], setup: str | None) -> dict:
+    return {"problem": spec.problem, "setup": setup, "n_obj": n_obj, "algorithm": spec.algorithm,
+            "molsp": spec.molsp,
             "seed": spec.seed, "budget": spec.evals, "pop_size": pop_sizes[spec.algorithm],
             "max_leaders": spec.max_leaders}
 
@@ -247,9 +265,11 @@ def _execute(spec: RunSpec) -> dict:
 
     try:
         result = runner.run(spec.problem, spec.algorithm, seed=spec.seed, evals=spec.evals, n_obj=spec.n_obj,
-                            molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders)
-    except Exception as exc:           # recorded by the driver; KeyboardInterrupt etc. propagate
-        return {"status": "failed", "problem": spec.problem, "n_obj": spec.n_obj, "algorithm": spec.algorithm,
+                            molsp=spec.molsp, pop_size=spec.pop_size, max_leaders=spec.max_leaders,
+                            setup=spec.setup)
+    except Exception as exc:  # noqa: BLE001 - recorded by the driver; KeyboardInterrupt etc. propagate
+        return {"status": "failed", "problem": spec.problem, "setup": spec.setup, "n_obj": spec.n_obj,
+                "algorithm": spec.algorithm,
                 "molsp": spec.molsp, "seed": spec.seed, "run_index": spec.run_index, "budget": spec.evals,
                 "pop_size": spec.pop_size, "max_leaders": spec.max_leaders,
                 "error": f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}".rstrip(": "),
@@ -313,17 +333,49 @@ class _Recorder:
 
 
 def _run_on(executor: Executor, specs: Sequence[RunSpec], recorder: _Recorder) -> None:
-    """Submit every spec, record results as they arrive; on any error cancel the rest, keep what finished."""
+    """Run every spec on ``executor``; resubmit the runs lost to a broken pool if the pool can restart."""
+    todo = list(specs)
+    while todo:
+        lost, broken = _submit_and_record(executor, todo, recorder)
+        if broken is None:
+            return
+        if not isinstance(executor, _RestartingPool):
+            raise broken
+        if not executor.restart():
+            raise BrokenProcessPool(f"a pool process died again after {POOL_RESTARTS} restarts of the pool "
+                                    "(a run may be killing its process)") from broken
+        restart = POOL_RESTARTS - executor.restarts_left
+        print("\n" * (recorder.bar is not None) + f"moo.experiment: a pool process died; resubmitting the "
+              f"{len(lost)} runs lost with it to a fresh pool (restart {restart} of {POOL_RESTARTS})",
+              file=sys.stderr)
+        todo = lost
+
+
+def _submit_and_record(executor: Executor, specs: Sequence[RunSpec],
+                       recorder: _Recorder) -> tuple[list[RunSpec], BrokenProcessPool | None]:
+    """Submit every spec, record results as they arrive; on any error cancel the rest, keep what finished.
+
+    Returns the specs lost to a broken process pool (every run in flight or queued when a pool process
+    died) and the pool's error, or ``([], None)``.
+    """
     futures = {executor.submit(_execute, spec): spec for spec in specs}
+    lost, broken = [], None
     try:
         for fut in as_completed(list(futures)):
-            recorder.add(futures.pop(fut), fut.result())
+            spec = futures.pop(fut)
+            exc = fut.exception()
+            if isinstance(exc, BrokenProcessPool):
+                lost.append(spec)
+                broken = exc
+            else:
+                recorder.add(spec, fut.result())
     finally:
         for fut in futures:
             fut.cancel()
         for fut, spec in futures.items():          # finished while we were stopping: keep them
             if fut.done() and not fut.cancelled() and fut.exception() is None:
                 recorder.keep(spec, fut.result())
+    return lost, broken
 
 
 @dataclass(frozen=True, repr=False)
@@ -388,7 +440,8 @@ class PreparedExperiment:
 
 def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int, out: str | os.PathLike,
             n_obj: int | None = None, base_seed: int = 0, pop_size: int = POP_SIZE,
-            max_leaders: int | None = None, variants: Sequence[bool] = (False, True)) -> PreparedExperiment:
+            max_leaders: int | None = None, variants: Sequence[bool] = (False, True),
+            setup: str | None = None) -> PreparedExperiment:
     """Check the grid of :func:`plan`, create ``out`` and find the runs already recorded there.
 
     Every check happens here, before any run: the arguments of :func:`plan`,
@@ -403,15 +456,18 @@ def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: 
         grid with other settings (the message names the file).
     """
     from moo.problems import make_problem
-    from moo.runner import check_budget
+    from moo.runner import check_budget, setup_name
 
     specs = plan(problem, algorithms, runs=runs, evals=evals, n_obj=n_obj, base_seed=base_seed,
-                 pop_size=pop_size, max_leaders=max_leaders, variants=variants)
-    prob = make_problem(problem, n_obj)
+                 pop_size=pop_size, max_leaders=max_leaders, variants=variants, setup=setup)
+    prob = make_problem(problem, n_obj, setup=setup)
+    name = setup_name(prob)
+    # a record without a set-up was written before set-ups existed, with the problem's default one
+    legacy = name if setup is None else setup_name(make_problem(problem, n_obj))
     pop_sizes = {name: int(check_budget(prob, name, evals=specs[0].evals, pop_size=specs[0].pop_size).pop_size)
                  for name in dict.fromkeys(s.algorithm for s in specs)}
     out = prepare_results_dir(out)
-    todo = tuple(s for s in specs if not _is_done(s, out, _expected(s, prob.n_obj, pop_sizes)))
+    todo = tuple(s for s in specs if not _is_done(s, out, _expected(s, prob.n_obj, pop_sizes, name), legacy))
     retried = sum(s.failed_path(out).is_file() for s in todo)
     return PreparedExperiment(specs=tuple(specs), out=out, todo=todo, retried=retried)
 
@@ -420,7 +476,7 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
                    out: str | os.PathLike, n_obj: int | None = None, base_seed: int = 0, pop_size: int = POP_SIZE,
                    max_leaders: int | None = None, variants: Sequence[bool] = (False, True),
                    workers: int = 1, executor: Executor | None = None, keep_going: bool = False,
-                   progress: bool | None = None) -> ExperimentReport:
+                   progress: bool | None = None, setup: str | None = None) -> ExperimentReport:
     """Run the grid of :func:`plan` into ``out``, skipping runs already recorded.
 
     Parameters are those of :func:`plan`, plus:
@@ -452,13 +508,11 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
     RunFailedError
         A run raised (without ``keep_going``); the records written stay.
     """
-    from moo.executors import open_executor
-
     workers = check_int(workers, "workers", 1)
     if executor is not None and workers != 1:
         raise ValueError("give workers (a local process pool) or executor, not both")
     grid = prepare(problem, algorithms, runs=runs, evals=evals, out=out, n_obj=n_obj, base_seed=base_seed,
-                   pop_size=pop_size, max_leaders=max_leaders, variants=variants)
+                   pop_size=pop_size, max_leaders=max_leaders, variants=variants, setup=setup)
     if executor is not None:
         return grid.run(executor, keep_going=keep_going, progress=progress)
     with open_executor("process", workers=workers if len(grid.todo) > 1 else 1) as pool:

@@ -40,8 +40,16 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from moo.experiment import problem_dir
-from moo.stats import (INDICATORS, LABELS, FriedmanResult, RunIndicators, friedman, registry_order,
-                       run_indicators, true_front)
+from moo.stats import (
+    INDICATORS,
+    LABELS,
+    FriedmanResult,
+    RunIndicators,
+    friedman,
+    registry_order,
+    run_indicators,
+    true_front,
+)
 
 __all__ = ["FORMATS", "check_formats", "hv_history", "indicator_boxplots", "fronts", "cd_diagram", "plot_results"]
 
@@ -102,7 +110,7 @@ def hv_history(records: Sequence[dict], title: str = "") -> Figure:
     top = max(max(rec["hv_history"]["evaluations"]) for rec in records)
     grid = np.linspace(0, top, _GRID_POINTS)
     fig, axes = _panels(len(algs))
-    for ax, alg in zip(axes, algs):
+    for ax, alg in zip(axes, algs, strict=True):
         for molsp, recs in by_alg[alg].items():
             if not recs:
                 continue
@@ -128,7 +136,7 @@ def indicator_boxplots(runs: Sequence[RunIndicators], title: str = "") -> Figure
     algs = _algorithms(r.algorithm for r in runs)
     fig = Figure(figsize=(max(6.0, 1.0 * len(algs) + 1.5), 2.3 * len(INDICATORS) + 0.6), layout="constrained")
     axes = fig.subplots(len(INDICATORS), 1, squeeze=False)[:, 0]
-    for ax, name in zip(axes, INDICATORS):
+    for ax, name in zip(axes, INDICATORS, strict=True):
         for molsp in (False, True):
             data = [np.array([getattr(r, name) for r in runs if r.algorithm == a and r.molsp == molsp]) for a in algs]
             data = [d[np.isfinite(d)] for d in data]
@@ -182,7 +190,7 @@ def fronts(records: Sequence[dict], algorithm: str | None = None, title: str = "
     if M == 2:
         algs = _algorithms(r["algorithm"] for r in records)
         fig, axes = _panels(len(algs), width=3.0, height=2.8)
-        for ax, alg in zip(axes, algs):
+        for ax, alg in zip(axes, algs, strict=True):
             if ref is not None:
                 ax.plot(ref[:, 0], ref[:, 1], ".", color="0.75", ms=1, label="true front")
             for v, rec in runs_of(alg).items():
@@ -234,7 +242,7 @@ def fronts(records: Sequence[dict], algorithm: str | None = None, title: str = "
 def _cliques(ranks: np.ndarray, cd: float) -> list[tuple[int, int]]:
     """Maximal runs ``[i, j]`` (indices into the sorted ranks) whose ranks lie within ``cd``; length >= 2."""
     k = len(ranks)
-    spans = []
+    spans: list[tuple[int, int]] = []
     for i in range(k):
         j = i
         while j + 1 < k and ranks[j + 1] - ranks[i] <= cd:

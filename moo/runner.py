@@ -26,6 +26,9 @@ The record
 
 =================  ==========================================================
 ``problem``        problem name (lower case), ``n_obj`` its objectives
+``setup``          the problem's set-up (``applied``: ``"ours"`` or
+                   ``"authors"``, see :mod:`moo.problems.applied`); null for
+                   problems without one
 ``algorithm``      registry name; ``molsp`` true for the MO-LSP version
 ``max_leaders``    MO-LSP's cap on candidates per generation (null: none)
 ``seed``           the run's seed
@@ -59,8 +62,10 @@ from importlib.metadata import PackageNotFoundError, version
 
 import moocore
 import numpy as np
+from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
 from pymoo.core.population import Population
+from pymoo.core.problem import Problem
 
 from moo._validation import check_int
 from moo.algorithms import make_algorithm
@@ -69,7 +74,7 @@ from moo.indicators import hypervolume
 from moo.molsp import molsp as add_molsp
 from moo.problems import make_problem
 
-__all__ = ["RunResult", "PreparedRun", "prepare", "run", "check_budget"]
+__all__ = ["RunResult", "PreparedRun", "prepare", "run", "check_budget", "setup_name"]
 
 
 def _versions() -> dict[str, str]:
@@ -112,6 +117,7 @@ class RunResult:
     hv_history: np.ndarray
     wall_time: float
     versions: dict[str, str] = field(default_factory=dict)
+    setup: str | None = None
 
     @property
     def hv(self) -> float:
@@ -121,7 +127,7 @@ class RunResult:
     def to_dict(self) -> dict:
         """Plain Python types only (lists for arrays), ready for ``json.dump``."""
         return {
-            "problem": self.problem, "n_obj": self.n_obj, "algorithm": self.algorithm,
+            "problem": self.problem, "n_obj": self.n_obj, "setup": self.setup, "algorithm": self.algorithm,
             "molsp": self.molsp, "max_leaders": self.max_leaders, "seed": self.seed,
             "pop_size": self.pop_size, "budget": self.budget, "n_evals": self.n_evals,
             "n_gen": self.n_gen, "molsp_evals": self.molsp_evals, "hv": self.hv,
@@ -175,8 +181,10 @@ class _HVHistory(Callback):
 
 
 def check_budget(problem, algorithm: str, *, evals: int, pop_size: int = POP_SIZE):
-    """The algorithm ``algorithm`` built for ``problem`` (a pymoo problem); ``ValueError`` if
-    ``evals`` is below the population size it uses."""
+    """The algorithm ``algorithm`` built for ``problem`` (a pymoo problem).
+
+    Raises ``ValueError`` if ``evals`` is below the population size it uses.
+    """
     alg = make_algorithm(algorithm, n_obj=problem.n_obj, pop_size=pop_size)
     if evals < alg.pop_size:
         raise ValueError(f"evals must be at least the population size of {algorithm} ({alg.pop_size}), "
@@ -194,8 +202,9 @@ class PreparedRun:
     evals: int
     molsp: bool
     max_leaders: int | None
-    problem: object
-    algorithm: object
+    problem: Problem
+    algorithm: Algorithm
+    setup: str | None = None
 
     def __repr__(self) -> str:
         tag = "+molsp" if self.molsp else ""
@@ -224,11 +233,17 @@ class PreparedRun:
             n_evals=int(alg.evaluator.n_eval), n_gen=len(history.rows),
             molsp_evals=int(alg.data.get("molsp_n_eval", 0)), F=F, X=X, hv_ref_point=hv_ref,
             molsp_ref_point=molsp_ref, hv_history=np.array(history.rows, dtype=float).reshape(-1, 2),
-            wall_time=wall, versions=_versions())
+            wall_time=wall, versions=_versions(), setup=self.setup)
+
+
+def setup_name(problem) -> str | None:
+    """The name of a built problem's set-up (``problem.setup.name``), None for problems without one."""
+    return getattr(getattr(problem, "setup", None), "name", None)
 
 
 def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,
-            molsp: bool = False, pop_size: int = POP_SIZE, max_leaders: int | None = None) -> PreparedRun:
+            molsp: bool = False, pop_size: int = POP_SIZE, max_leaders: int | None = None,
+            setup: str | None = None) -> PreparedRun:
     """Check the arguments of one run and build its problem and algorithm (once).
 
     Parameters
@@ -251,6 +266,9 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
         used is recorded).
     max_leaders : int, optional
         MO-LSP's cap on candidates per generation (default: none, the paper's).
+    setup : str, optional
+        The problem's set-up (``applied`` only: ``"ours"``, the default, or
+        ``"authors"``); recorded as ``setup``.
 
     Returns
     -------
@@ -272,17 +290,18 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
         max_leaders = check_int(max_leaders, "max_leaders", 1)
         if not molsp:
             raise ValueError("max_leaders needs molsp=True")
-    prob = make_problem(problem, n_obj)
+    prob = make_problem(problem, n_obj, setup=setup)
     alg = check_budget(prob, algorithm, evals=evals, pop_size=pop_size)
     if molsp:
         alg = add_molsp(alg, ref_point=np.asarray(prob.molsp_ref_point, dtype=float), max_leaders=max_leaders)
     return PreparedRun(problem_name=problem.lower(), algorithm_name=algorithm.lower(), seed=seed, evals=evals,
-                       molsp=bool(molsp), max_leaders=max_leaders, problem=prob, algorithm=alg)
+                       molsp=bool(molsp), max_leaders=max_leaders, problem=prob, algorithm=alg,
+                       setup=setup_name(prob))
 
 
 def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,
         molsp: bool = False, pop_size: int = POP_SIZE, max_leaders: int | None = None,
-        progress: Callable[[int, int], None] | None = None) -> RunResult:
+        progress: Callable[[int, int], None] | None = None, setup: str | None = None) -> RunResult:
     """Run one MOEA (optionally with MO-LSP) on one problem to an evaluation budget.
 
     The arguments are those of :func:`prepare` (which checks them), plus
@@ -293,4 +312,4 @@ def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | Non
     RunResult
     """
     return prepare(problem, algorithm, seed=seed, evals=evals, n_obj=n_obj, molsp=molsp, pop_size=pop_size,
-                   max_leaders=max_leaders).run(progress)
+                   max_leaders=max_leaders, setup=setup).run(progress)

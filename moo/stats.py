@@ -456,7 +456,7 @@ def compare(runs: Sequence[RunIndicators], alpha: float = 0.05) -> list[Comparis
         families[(c.problem, c.indicator)].append(i)
     for members in families.values():
         adjusted = holm([rows[i].p_wilcoxon for i in members])
-        for i, p in zip(members, adjusted):
+        for i, p in zip(members, adjusted, strict=True):
             rows[i] = replace(rows[i], p_wilcoxon_holm=float(p), significant_wilcoxon=bool(p < alpha))
     return rows
 
@@ -522,12 +522,12 @@ def analyse(results_dir: str | os.PathLike, alpha: float = 0.05) -> tuple[list[R
 
 def to_csv(rows: Sequence[Comparison] | Sequence[RunIndicators], path: str | os.PathLike | None = None) -> str:
     """The rows as CSV (header from the dataclass fields); written to ``path`` if given."""
-    rows = list(rows)
+    items: list[Comparison | RunIndicators] = list(rows)
     buf = io.StringIO()
-    if rows:
-        writer = csv.DictWriter(buf, fieldnames=[f.name for f in fields(rows[0])], lineterminator="\n")
+    if items:
+        writer = csv.DictWriter(buf, fieldnames=[f.name for f in fields(items[0])], lineterminator="\n")
         writer.writeheader()
-        for r in rows:
+        for r in items:
             writer.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in asdict(r).items()})
     text = buf.getvalue()
     if path is not None:
@@ -550,7 +550,7 @@ def _layout(rows: Sequence[Comparison]):
     table: dict[tuple[str, str], dict[str, Comparison]] = {}
     for c in rows:
         table.setdefault((c.problem, c.algorithm), {})[c.indicator] = c
-    best: dict[tuple[str, str], tuple[str, bool]] = {}
+    best: dict[tuple[str, str], set[tuple[str, bool]]] = {}   # (problem, indicator) -> {(algorithm, molsp)}
     for problem in {p for p, _ in table}:
         for name in INDICATORS:
             cands = [(c.mean_plain, a, False) for (p, a), cs in table.items() if p == problem and name in cs
@@ -565,8 +565,11 @@ def _layout(rows: Sequence[Comparison]):
 
 
 def _marks(c: Comparison, molsp: bool, best: dict) -> tuple[bool, str]:
-    """(bold, superscript marks) of one cell: better of the pair; a = significantly better (Tukey),
-    w = significantly better (Wilcoxon-Holm), * = best."""
+    """(bold, superscript marks) of one cell.
+
+    Bold: better of the pair; a = significantly better (Tukey), w = significantly better
+    (Wilcoxon-Holm), * = best.
+    """
     is_better = c.better == ("molsp" if molsp else "plain")
     marks = []
     if is_better and c.significant:
@@ -729,14 +732,17 @@ def ranks_to_latex(results: Sequence[FriedmanResult]) -> str:
 
 
 def ranks_to_csv(results: Sequence[FriedmanResult], path: str | os.PathLike | None = None) -> str:
-    """One CSV row per (problem, indicator, variant): mean rank, Friedman statistic and p, CD, N,
-    and whether Nemenyi's test separates the variant from the best-ranked one."""
+    """One CSV row per (problem, indicator, variant).
+
+    Columns: mean rank, Friedman statistic and p, CD, N, and whether Nemenyi's test separates
+    the variant from the best-ranked one.
+    """
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(["problem", "indicator", "variant", "mean_rank", "n_blocks", "statistic", "p_friedman",
                      "cd", "alpha", "worse_than_best"])
     for r in results:
-        for v, rank in zip(r.variants, r.mean_ranks):
+        for v, rank in zip(r.variants, r.mean_ranks, strict=True):
             _, _, marks = _rank_cell(r, v)
             writer.writerow([r.problem, r.indicator, v, repr(rank), r.n_blocks, repr(r.statistic),
                              repr(r.p_value), repr(r.cd), repr(r.alpha), marks == "n"])

@@ -20,6 +20,7 @@ shared file system.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
@@ -52,10 +53,8 @@ def write_json_atomic(path: str | os.PathLike, data: dict) -> None:
             os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
-        try:
+        with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
-        except FileNotFoundError:
-            pass
         raise
 
 
@@ -105,9 +104,11 @@ def _probe_directory(directory: Path, name: str) -> None:
 
 
 def check_output_file(path: str | os.PathLike, name: str = "out") -> Path:
-    """A path a file can be written to, checked before any work: not empty, not a directory,
-    its directory existing and writable (tried with a temporary file, so that read-only or
-    virtual file systems such as ``/proc`` are caught). Returns it as a :class:`~pathlib.Path`."""
+    """``path`` as a :class:`~pathlib.Path`, checked before any work to be writable as a file.
+
+    Not empty, not a directory, its directory existing and writable (tried with a temporary
+    file, so that read-only or virtual file systems such as ``/proc`` are caught).
+    """
     if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
         raise ValueError(f"{name} must be a file path, got {path!r}")
     path = Path(path)

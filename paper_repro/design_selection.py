@@ -1,8 +1,8 @@
 """Reproduce the paper's Monte Carlo design selection (Sections 4.4.1 and 4.5.1, Figs. fl-generic / fl-applied).
 
-    python paper_repro/design_selection.py --problem generic|applied [--algorithm nsga2]
-        [--molsp | --no-molsp] [--evals 3000] [--seed 1] [--sims N] [--horizon-steps N]
-        [--pop-size 92] [--out DIR]
+    python paper_repro/design_selection.py --problem generic|applied [--setup ours|authors]
+        [--algorithm nsga2] [--molsp | --no-molsp] [--evals 3000] [--seed 1] [--sims N]
+        [--horizon-steps N] [--pop-size 92] [--out DIR]
 
 1. One MOEA run (:func:`moo.runner.run`, NSGA-II/MO-LSP by default as in the
    paper, population 92, ``--evals`` evaluations) gives a Pareto front.
@@ -16,8 +16,18 @@
    (:func:`moo.problems.selection.select_design`). Generic: ``Delta`` is the plant's
    uncertainty, the error the summed regulation error of the three states.
    Applied: ``Delta`` is the payload overload ``150 (1 + Delta)`` in [0, 300] %,
-   the error the Bryson-weighted squared tracking error summed over time.
-4. The most frequent winner is ``z*``.
+   the error the squared tracking error weighted by the set-up's ``Q``, summed
+   over time.
+4. The most frequent winner is ``z*``; its certified robust-stability margin
+   (:func:`robustctl.robust_stability`) is reported: applied, against the
+   payload polytope (0-300 %) and the appendix's norm-bounded model
+   (:func:`paper_repro.mse_table.margins`); generic, against the problem's
+   true norm-bounded uncertainty ``H Delta [EF_true EG_true]``.
+
+``--setup`` (applied problem only): ``ours`` (default) or ``authors``, the
+loop, initial state and weights of :data:`robustctl.pathfollow.SETUPS`, for
+the MOEA, the candidate designs and the selection alike
+(``make_problem("applied", setup=...)``).
 
 ``--horizon-steps N`` shortens the selection's simulations only (generic:
 regulation horizon N steps instead of 200; applied: the first N samples of
@@ -28,8 +38,9 @@ defaults. The default settings take well under a minute on 2 cores
 compiled kernel, :mod:`robustctl.batchsim`).
 
 Writes ``DIR/selection.json`` (settings, z*, win counts of every design, the
-front's objectives, timings) and ``DIR/selection_histogram.png`` (default
-``DIR``: ``out/selection_<problem>``). For the applied problem it also prints
+winner's margins, the front's objectives, timings) and
+``DIR/selection_histogram.png`` (default ``DIR``: ``out/selection_<problem>``,
+``out/selection_applied_authors`` for the authors' set-up). For the applied problem it also prints
 the command that feeds ``z*`` to the MSE table (``paper_repro/mse_table.py --z``).
 """
 
@@ -46,11 +57,14 @@ import numpy as np
 if __package__ in (None, ""):                      # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from moo.algorithms import ALGORITHMS  # noqa: E402
-from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
-from moo.problems.generic import GenericRLQRProblem  # noqa: E402
-from moo.runner import run as run_moea  # noqa: E402
-from moo.problems.selection import BRYSON_SCALES, DesignSelection, select_design  # noqa: E402
+import robustctl as rc
+from moo.algorithms import ALGORITHMS
+from moo.problems.applied import AppliedRLQRProblem
+from moo.problems.generic import GenericRLQRProblem
+from moo.problems.selection import DesignSelection, error_scales, select_design
+from moo.runner import run as run_moea
+from paper_repro.mse_table import Design, margins
+from robustctl.pathfollow import SETUPS
 
 DEFAULT_SIMS = {"generic": 1000, "applied": 200}
 PAPER = {"generic": "paper: design 49 of 92 won 222/1000; random 1, nominal 0",
@@ -63,14 +77,28 @@ def _algorithm_name(algorithm: str, molsp: bool) -> str:
     return name + ("/MO-LSP" if molsp else "")
 
 
-def _problem(name: str, horizon_steps: int | None):
+def _problem(name: str, horizon_steps: int | None, setup: str | None):
     """The problem the selection simulates on, and the path for the applied one."""
     if name == "generic":
+        if setup is not None:
+            raise ValueError("--setup applies to the applied problem only")
         prob = GenericRLQRProblem() if horizon_steps is None else GenericRLQRProblem(horizon=horizon_steps)
         return prob, None
-    prob = AppliedRLQRProblem()
+    prob = AppliedRLQRProblem(setup=setup or "ours")
     path = prob.path if horizon_steps is None else prob.path.truncated(horizon_steps * prob.path.dt)
     return prob, path
+
+
+def winner_margins(problem, K: np.ndarray) -> dict[str, float | None]:
+    """Certified robust-stability margins of the selected gain ``K`` (module docstring, step 4)."""
+    if not np.all(np.isfinite(K)):
+        return {}
+    if isinstance(problem, AppliedRLQRProblem):
+        found = margins(Design("winner", K, ""))
+    else:
+        unc = rc.NormBounded(problem.H, problem.EF_true, problem.EG_true)
+        found = {"true norm-bounded uncertainty": rc.robust_stability((problem.plant, K), unc)}
+    return {k: (None if isinstance(m, str) else float(m.margin)) for k, m in found.items()}
 
 
 def histogram(sel: DesignSelection, title: str, out: Path) -> None:
@@ -123,6 +151,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--problem", choices=("generic", "applied"), required=True)
+    ap.add_argument("--setup", choices=tuple(SETUPS), default=None,
+                    help="applied problem: the set-up (default ours; robustctl.pathfollow.SETUPS)")
     ap.add_argument("--algorithm", choices=tuple(ALGORITHMS), default="nsga2", help="MOEA (default nsga2)")
     ap.add_argument("--molsp", action=argparse.BooleanOptionalAction, default=True,
                     help="wrap the MOEA with MO-LSP (default on)")
@@ -136,7 +166,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=None, help="output directory (default out/selection_<problem>)")
     args = ap.parse_args(argv)
     sims = DEFAULT_SIMS[args.problem] if args.sims is None else args.sims
-    out = Path("out") / f"selection_{args.problem}" if args.out is None else args.out
+    tag = args.problem if args.setup in (None, "ours") else f"{args.problem}_{args.setup}"
+    out = Path("out") / f"selection_{tag}" if args.out is None else args.out
     for name, value, low in (("--evals", args.evals, 1), ("--sims", sims, 1), ("--pop-size", args.pop_size, 4),
                              ("--seed", args.seed, 0)):
         if value < low:
@@ -144,10 +175,10 @@ def main(argv=None) -> int:
     if args.horizon_steps is not None and args.horizon_steps < 1:
         ap.error(f"--horizon-steps must be >= 1, got {args.horizon_steps}")
     try:
-        problem, path = _problem(args.problem, args.horizon_steps)
+        problem, path = _problem(args.problem, args.horizon_steps, args.setup)
         t0 = time.perf_counter()
         moea = run_moea(args.problem, args.algorithm, seed=args.seed, evals=args.evals, molsp=args.molsp,
-                        pop_size=args.pop_size)
+                        pop_size=args.pop_size, setup=args.setup)
         t_moea = time.perf_counter() - t0
     except (ValueError, TypeError) as exc:
         ap.error(str(exc))
@@ -163,7 +194,9 @@ def main(argv=None) -> int:
     d, res = sel.designs, sel.result
     alg = _algorithm_name(args.algorithm, args.molsp)
     steps = (problem.horizon if args.problem == "generic" else path.T)
-    print(f"{alg} on {args.problem}: {moea.n_evals} evaluations, front of {len(X)} designs ({t_moea:.1f} s)")
+    setup = getattr(getattr(problem, "setup", None), "name", None)
+    print(f"{alg} on {args.problem}" + (f" (set-up {setup})" if setup else "")
+          + f": {moea.n_evals} evaluations, front of {len(X)} designs ({t_moea:.1f} s)")
     print(f"{len(d)} designs x {sims} simulations, {steps} steps each ({t_sel:.1f} s)")
     print("top designs (wins):")
     for i in res.ranking()[:8]:
@@ -178,19 +211,26 @@ def main(argv=None) -> int:
     z = sel.z
     z_txt = " ".join(f"{v:.8g}" for v in z)
     print(f"winner: design {sel.label} ({int(res.counts[sel.best])}/{sims} wins), z* = [{z_txt}]")
+    t0 = time.perf_counter()
+    winner_m = winner_margins(problem, d.K[sel.best])
+    print("winner's certified robust-stability margin (>= 1: certified): "
+          + (", ".join(f"{k} {'n/a' if v is None else f'{v:.3g}'}" for k, v in winner_m.items()) or "n/a (no gain)")
+          + f" ({time.perf_counter() - t0:.1f} s)")
     if args.problem == "applied":
         if np.all(np.isfinite(z)):
-            print(f"feed it to the MSE table:\n  python paper_repro/mse_table.py --z {z_txt}")
+            print(f"feed it to the MSE table:\n  python paper_repro/mse_table.py --setup {setup} --z {z_txt}")
         else:
             print("the winner is the nominal LQR (no z): the MSE table's LQR row already shows it")
 
     out.mkdir(parents=True, exist_ok=True)
-    title = (f"Monte Carlo design selection: {args.problem} problem, {alg}, {moea.n_evals} evaluations, "
+    title = (f"Monte Carlo design selection: {args.problem} problem"
+             + (f" (set-up {setup})" if setup else "") + f", {alg}, {moea.n_evals} evaluations, "
              f"{sims} simulations ($\\Delta \\sim U(-1, 1)$)")
     histogram(sel, title, out / "selection_histogram.png")
     winner_F = F[sel.best].tolist() if d.kinds[sel.best] == "front" else None
     record = {
-        "problem": args.problem, "algorithm": args.algorithm, "molsp": args.molsp, "seed": args.seed,
+        "problem": args.problem, "setup": setup, "algorithm": args.algorithm, "molsp": args.molsp,
+        "seed": args.seed,
         "evals": args.evals, "n_evals": moea.n_evals, "pop_size": moea.pop_size, "sims": sims,
         "horizon_steps": steps,
         "scenario": ("Delta ~ U(-1, 1) held constant, true plant F + H Delta EF_true, G + H Delta EG_true"
@@ -199,10 +239,10 @@ def main(argv=None) -> int:
         "error": ("sum over the three states of the regulation error sum_i sum_k x_j[k]^2 (unit initial states)"
                   if args.problem == "generic" else
                   "sum_k sum_i (e_i[k] / sigma_i)^2, tracking errors of rho, psidot, ydot, theta"),
-        "scales": None if args.problem == "generic" else list(BRYSON_SCALES),
+        "scales": None if args.problem == "generic" else error_scales(problem.setup).tolist(),
         "winner": {"index": sel.best + 1, "label": sel.label, "kind": d.kinds[sel.best],
                    "wins": int(res.counts[sel.best]), "z": [None if not np.isfinite(v) else float(v) for v in z],
-                   "objectives": winner_F},
+                   "objectives": winner_F, "margins": winner_m},
         "designs": [{"index": i + 1, "label": d.labels[i], "kind": d.kinds[i], "wins": int(res.counts[i]),
                      "ok": bool(d.ok[i])} for i in range(len(d))],
         "no_winner": res.n_no_winner,

@@ -3,11 +3,12 @@
     python paper_repro/moea_tables.py --problem generic|applied [--runs 5] [--evals 2000]
                                       [--algorithms all|a,b,...] [--out DIR] [--workers 2] [--seed 0]
                                       [--max-leaders K] [--executor process|dask] [--scheduler ADDRESS]
-                                      [--no-plots]
+                                      [--setup ours|authors] [--no-plots]
 
 Runs the grid problem x algorithms x {plain, MO-LSP} x runs with
 :func:`moo.experiment.run_experiment` into ``DIR`` (default
-``out/moea_<problem>``; resumable: rerunning with the same arguments skips
+``out/moea_<problem>``, or ``out/moea_applied_<setup>`` with ``--setup``,
+whose files are then named ``moea_applied_<setup>*``; resumable: rerunning with the same arguments skips
 finished runs, raising ``--runs`` adds runs), computes the five indicators and
 the ANOVA/Tukey comparisons (:mod:`moo.stats`), and prints
 
@@ -56,14 +57,24 @@ import numpy as np
 if __package__ in (None, ""):                      # run as a script: make the repository importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from moo.algorithms import ALGORITHMS  # noqa: E402
-from moo.executors import open_executor  # noqa: E402
-from moo.experiment import run_experiment  # noqa: E402
-from moo.plots import plot_results  # noqa: E402
-from moo.stats import (INDICATORS, Comparison, analyse, friedman, ranks_to_csv, ranks_to_latex,  # noqa: E402
-                       ranks_to_markdown, to_csv, to_latex, to_markdown)
-from moo.store import load_records  # noqa: E402
-from paper_repro.paper_moea_values import PAPER_LABELS, PAPER_MOEA, paper_cell  # noqa: E402
+from moo.algorithms import ALGORITHMS
+from moo.executors import open_executor
+from moo.experiment import run_experiment
+from moo.plots import plot_results
+from moo.stats import (
+    INDICATORS,
+    Comparison,
+    analyse,
+    friedman,
+    ranks_to_csv,
+    ranks_to_latex,
+    ranks_to_markdown,
+    to_csv,
+    to_latex,
+    to_markdown,
+)
+from moo.store import load_records
+from paper_repro.paper_moea_values import PAPER_LABELS, PAPER_MOEA, paper_cell
 
 _LABELS = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
 
@@ -119,8 +130,8 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
         return ""
     algs = list(dict.fromkeys(c.algorithm for c in cells))
     by = {(c.algorithm, c.indicator): c for c in cells}
-    lines = [f"MO-LSP effect, paper vs ours ({problem}): sign of mean(MO-LSP) - mean(plain), "
-             "sig = significant at 95 % (paper: mark 'a'; ours: Tukey p < 0.05); '=' agree, 'x' differ", "",
+    lines = [(f"MO-LSP effect, paper vs ours ({problem}): sign of mean(MO-LSP) - mean(plain), "
+              "sig = significant at 95 % (paper: mark 'a'; ours: Tukey p < 0.05); '=' agree, 'x' differ"), "",
              "| MOEA | " + " | ".join(_LABELS[n] for n in INDICATORS) + " |",
              "|---|" + "---|" * len(INDICATORS)]
     for alg in algs:
@@ -150,11 +161,10 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
 
 
 def _agreement_csv(cells: Sequence[CellAgreement], path: Path) -> None:
-    rows = ["algorithm,indicator,paper_sign,paper_significant,our_sign,our_significant,our_p_tukey,"
-            "direction_agrees,full_agreement"]
-    for c in cells:
-        rows.append(f"{c.algorithm},{c.indicator},{c.paper_sign},{c.paper_significant},{c.our_sign},"
-                    f"{c.our_significant},{c.our_p_tukey!r},{c.direction_agrees},{c.full_agreement}")
+    rows = [("algorithm,indicator,paper_sign,paper_significant,our_sign,our_significant,our_p_tukey,"
+             "direction_agrees,full_agreement")]
+    rows += [f"{c.algorithm},{c.indicator},{c.paper_sign},{c.paper_significant},{c.our_sign},"
+             f"{c.our_significant},{c.our_p_tukey!r},{c.direction_agrees},{c.full_agreement}" for c in cells]
     path.write_text("\n".join(rows) + "\n", encoding="utf-8")
 
 
@@ -173,6 +183,8 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--executor", choices=("process", "dask"), default="process",
                     help="'process' (default) or 'dask' (a local cluster, or the one at --scheduler)")
     ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (with --executor dask)")
+    ap.add_argument("--setup", choices=("ours", "authors"), default=None,
+                    help="applied MOP set-up (robustctl.pathfollow.PathFollowingSetup; default: the MOP's own)")
     ap.add_argument("--no-plots", action="store_true", help="do not draw the figures")
     return ap
 
@@ -186,12 +198,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     unknown = [a for a in names if a not in ALGORITHMS]
     if unknown:
         ap.error(f"unknown algorithm(s) {', '.join(unknown)}; valid: {', '.join(ALGORITHMS)}")
-    out = args.out if args.out is not None else Path("out") / f"moea_{args.problem}"
+    if args.setup is not None and args.problem != "applied":
+        ap.error("--setup applies to --problem applied only")
+    stem = f"moea_{args.problem}" + ("" if args.setup is None else f"_{args.setup}")
+    out = args.out if args.out is not None else Path("out") / stem
     workers = 2 if args.workers is None and args.scheduler is None else args.workers
     try:
         with open_executor(args.executor, workers=workers, scheduler=args.scheduler) as ex:
             report = run_experiment(args.problem, names, runs=args.runs, evals=args.evals, out=out,
-                                    base_seed=args.seed, max_leaders=args.max_leaders, executor=ex)
+                                    base_seed=args.seed, max_leaders=args.max_leaders, executor=ex,
+                                    setup=args.setup)
     except (ValueError, TypeError) as exc:
         ap.error(str(exc).splitlines()[0])
     print(f"{report!r}\n")
@@ -209,7 +225,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(ours)
     print(versus)
     print(ranks_md)
-    stem = f"moea_{args.problem}"
     (out / f"{stem}.md").write_text(ours + "\n" + versus + "\n" + ranks_md, encoding="utf-8")
     (out / f"{stem}.tex").write_text(to_latex(table) + "\n" + ranks_to_latex(ranks), encoding="utf-8")
     to_csv(table, out / f"{stem}_stats.csv")

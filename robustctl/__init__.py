@@ -1,27 +1,41 @@
-"""robustctl: robust state-feedback design (LQR, RLQR, LMI H-infinity).
+"""robustctl: robust state-feedback design (LQR, RLQR, LMI H-infinity and H2) and robust analysis.
 
 >>> import robustctl as rc
->>> plant = rc.Plant.from_continuous(A, B, dt=0.1)          # doctest: +SKIP
->>> ctrl = rc.design("rlqr", plant, EF, EG, mu=1e8)          # doctest: +SKIP
->>> ctrl.K, ctrl.is_stabilizing()                            # doctest: +SKIP
+>>> from robustctl.models.truck import truck_plant
+>>> plant = truck_plant(0.0)            # the paper's truck, zero-order hold at dt = 0.1 s
+>>> plant
+Plant(n=4, m=1, dt=0.1)
+>>> EF, EG = [[0.0, 0.0, 0.0, 0.05]], [[0.05]]
+>>> ctrl = rc.design("rlqr", plant, EF, EG, mu=1e8)
+>>> ctrl.K.round(3), ctrl.is_stabilizing()
+(array([[-0.001, -0.007, -0.001, -1.015]]), True)
+>>> rc.robust_stability(ctrl, rc.NormBounded(plant.G, EF, EG)).certified
+True
 
 Sign convention everywhere: ``u = K x``.
 """
 
+from .analysis import (
+    CostBound,
+    HinfBound,
+    RobustStability,
+    WorstCase,
+    guaranteed_cost,
+    robust_hinf_bound,
+    robust_stability,
+    worst_case,
+)
 from .controller import Controller
 from .design import design
 from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, RankConditionError, RobustCtlError
-from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .h2 import H2Controller, h2
-from .regions import ConicSector, Disk, HalfPlane
+from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .lqr import lqr
 from .plant import Plant
+from .regions import ConicSector, Disk, HalfPlane
 from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
 from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
-from .analysis import (CostBound, HinfBound, RobustStability, WorstCase, guaranteed_cost, robust_hinf_bound,
-                       robust_stability, worst_case)
-
 
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",

@@ -24,14 +24,18 @@ from __future__ import annotations
 
 import functools
 import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .errors import ConvergenceError, InfeasibleError
 
-__all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "SOLVER_TOL"]
+if TYPE_CHECKING:  # cvxpy itself is imported on first use
+    import cvxpy as cp
+
+__all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "value", "totals", "SOLVER_TOL"]
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
@@ -50,13 +54,14 @@ _CERT_TOL = 1e-7
 class LMI:
     """A named block ``M >= margin * I``.
 
-    ``M`` is a square cvxpy expression; ``margin`` a float or a scalar cvxpy
-    expression (e.g. a variable that the objective maximises).
+    ``M`` is a square cvxpy expression (or, for :func:`certificate`, a
+    constant array); ``margin`` a float or a scalar cvxpy expression (e.g. a
+    variable that the objective maximises).
     """
 
     name: str
-    M: object
-    margin: object = 0.0
+    M: cp.Expression | np.ndarray
+    margin: float | cp.Expression = 0.0
 
 
 @dataclass(frozen=True)
@@ -83,6 +88,12 @@ class SolveReport:
                 f"{prefix}certificate": dict(self.certificate)}
 
 
+def totals(solves: Sequence[Mapping]) -> dict:
+    """``solve_time`` (s) and ``iterations`` summed over solves (each a ``SolveReport.as_dict()``)."""
+    return {"solve_time": float(sum(s["solve_time"] for s in solves)),
+            "iterations": int(sum(s["iterations"] or 0 for s in solves))}
+
+
 def certificate(lmis: Sequence[LMI]) -> dict[str, float]:
     """Smallest eigenvalue of each (symmetrised) block at the current values, by name.
 
@@ -91,6 +102,14 @@ def certificate(lmis: Sequence[LMI]) -> dict[str, float]:
     ValueError on a block that is not symmetric.
     """
     return _evaluate(lmis, "the point has")[0]
+
+
+def value(var: cp.Variable) -> np.ndarray:
+    """The value of ``var`` after :func:`solve_sdp`; ConvergenceError if the solver left it unset."""
+    val = var.value
+    if val is None:
+        raise ConvergenceError(f"the solver returned no value for the variable {var.name()!r}")
+    return np.asarray(val, dtype=float)
 
 
 def _evaluate(lmis: Sequence[LMI], who: str) -> tuple[dict[str, float], dict[str, float]]:

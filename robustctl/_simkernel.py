@@ -102,9 +102,9 @@ def closed_loop(KT, F, G, xr, uff, w, e0, lim, bound, dead, keep, sq, sqx, div_s
     W = min(B, MAX_BLOCK)
     NW = n * W
     NP = (n + 3) // 4 * 4 * W                   # x, xn padded to whole chunks of 4 rows, pad rows zero
-    x = np.zeros(NP); xn = np.zeros(NP); e = np.empty(NW); ef = np.empty(NW)
-    acc = np.empty(NW); accx = np.empty(NW)
-    u = np.empty(p * W); kb = np.empty(p * NW)
+    x, xn = np.zeros(NP), np.zeros(NP)
+    e, ef, acc, accx = np.empty(NW), np.empty(NW), np.empty(NW), np.empty(NW)
+    u, kb = np.empty(p * W), np.empty(p * NW)
     alive = np.empty(W, dtype=np.bool_)
     div = np.empty(W, dtype=np.int64)
     nsat = np.empty(W, dtype=np.int64)

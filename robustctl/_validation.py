@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import numbers
 from collections.abc import Collection, Sequence
+from typing import NoReturn
 
 import numpy as np
 
 __all__ = ["as_float_array", "as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
-           "check_int", "check_bool", "check_choice", "check_performance"]
+           "check_real", "check_positive_vector", "check_int", "check_bool", "check_choice", "as_rng",
+           "check_performance"]
 
 #: Symmetry accepted by :func:`check_spd` (relative to the largest entry, at least 1).
 SYMMETRY_TOL = 1e-10
@@ -40,16 +42,20 @@ def _has_bool(seq) -> bool:
     return False
 
 
-def as_float_array(value, name: str) -> np.ndarray:
+def as_float_array(value, name: str, *, want: str | None = None) -> np.ndarray:
     """``value`` as a real float64 array of any shape (finite or not).
 
     Raises ``TypeError`` naming ``name`` for booleans, strings, complex
     numbers, ``None`` and other non-numbers, and ``ValueError`` for nested
-    sequences of unequal lengths.
+    sequences of unequal lengths. ``want`` (e.g. ``"a positive number"``)
+    phrases the ``TypeError`` as ``"<name> must be <want>, got ..."``.
     """
+    def refuse(what: str, default: str) -> NoReturn:
+        raise TypeError(f"{name} must be {want}, got {what}" if want else default)
+
     if value is None or isinstance(value, (str, bytes, *_BOOL)):
         what = "a boolean" if isinstance(value, _BOOL) else type(value).__name__
-        raise TypeError(f"{name} must be an array of numbers (or one number), got {what}")
+        refuse(what, f"{name} must be an array of numbers (or one number), got {what}")
     if isinstance(value, (list, tuple)):
         try:
             arr = np.array(value)
@@ -57,7 +63,7 @@ def as_float_array(value, name: str) -> np.ndarray:
             raise ValueError(f"{name} must be a rectangular array: its nested sequences have different "
                              "lengths") from None
         if arr.dtype.kind in "iuf" and _has_bool(value):
-            raise TypeError(f"{name} must contain real numbers, got booleans")
+            refuse("booleans", f"{name} must contain real numbers, got booleans")
     else:
         arr = np.asarray(value)
     kind = arr.dtype.kind
@@ -66,11 +72,12 @@ def as_float_array(value, name: str) -> np.ndarray:
         if all(isinstance(x, numbers.Real) and not isinstance(x, _BOOL) for x in items):
             return arr.astype(np.float64)
         bad = next(x for x in items if not (isinstance(x, numbers.Real) and not isinstance(x, _BOOL)))
-        raise TypeError(f"{name} must contain real numbers, got an entry of type {type(bad).__name__}")
+        what = f"an entry of type {type(bad).__name__}"
+        refuse(what, f"{name} must contain real numbers, got {what}")
     if kind not in "iuf":
         what = {"b": "booleans", "c": "complex entries", "U": "strings", "S": "strings"}.get(
             kind, f"entries of dtype {arr.dtype}")
-        raise TypeError(f"{name} must contain real numbers, got {what}")
+        refuse(what, f"{name} must contain real numbers, got {what}")
     return np.array(arr, dtype=np.float64)  # a copy: callers may write into it
 
 
@@ -122,7 +129,7 @@ def as_batch(value, name: str, shape: Sequence[int | None], what: Sequence[str] 
     if arr.ndim != len(shape):
         raise ValueError(f"{name} must be a {len(shape)}-D array of shape "
                          f"{tuple('B' if s is None else s for s in shape)}, got shape {arr.shape}")
-    for axis, (want, got) in enumerate(zip(shape, arr.shape)):
+    for axis, (want, got) in enumerate(zip(shape, arr.shape, strict=True)):
         if want is not None and want != got:
             label = f" ({what[axis]})" if axis < len(what) and what[axis] else ""
             raise ValueError(f"{name} must have size {want} along axis {axis}{label}, "
@@ -152,12 +159,17 @@ def check_spd(arr: np.ndarray, name: str, *, semidefinite: bool = False) -> np.n
     return sym
 
 
+def _scalar(value, name: str, want: str) -> float:
+    """A real scalar (Python or numpy number, 0-d array) as a float, NaN and inf kept."""
+    arr = as_float_array(value, name, want=want)
+    if arr.shape != ():
+        raise TypeError(f"{name} must be {want}, got an array of shape {arr.shape}")
+    return float(arr)
+
+
 def check_positive_scalar(value, name: str, *, allow_inf: bool = False) -> float:
     """A real scalar > 0 (``inf`` only if ``allow_inf``); booleans and strings are refused."""
-    arr = as_float_array(value, name)
-    if arr.shape != ():
-        raise TypeError(f"{name} must be a real scalar, got an array of shape {arr.shape}")
-    x = float(arr)
+    x = _scalar(value, name, "a real number > 0")
     if np.isnan(x):
         raise ValueError(f"{name} must be a number, got NaN")
     if np.isinf(x) and not (allow_inf and x > 0):
@@ -165,6 +177,36 @@ def check_positive_scalar(value, name: str, *, allow_inf: bool = False) -> float
     if x <= 0:
         raise ValueError(f"{name} must be > 0, got {x}")
     return x
+
+
+def check_real(value, name: str, *, minimum: float | None = None) -> float:
+    """A finite real scalar, ``>= minimum`` if given; booleans, strings and complex numbers are refused."""
+    x = _scalar(value, name, "a real number")
+    if not np.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {x}")
+    if minimum is not None and x < minimum:
+        raise ValueError(f"{name} must be >= {minimum:g}, got {x:g}")
+    return x
+
+
+def check_positive_vector(value, name: str, size: int, *, what: str = "") -> np.ndarray:
+    """``size`` finite numbers > 0 as a float array ``(size,)``; one number stands for all of them.
+
+    ``what`` says what ``size`` counts (e.g. ``"the number of inputs"``).
+    """
+    want = "a positive number" + ("" if size == 1 else f" or {size} positive numbers")
+    arr = as_float_array(value, name, want=want)
+    if arr.ndim == 0:
+        arr = np.full(size, float(arr))
+    if arr.shape != (size,):
+        label = f" ({what})" if what else ""
+        raise ValueError(f"{name} must be a scalar or have {size} {'entry' if size == 1 else 'entries'}{label}, "
+                         f"got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite, got {arr.tolist()}")
+    if np.any(arr <= 0):
+        raise ValueError(f"{name} must be > 0 for every entry, got {arr.tolist()}")
+    return arr
 
 
 def check_int(value, name: str, minimum: int = 1) -> int:
@@ -181,8 +223,18 @@ def check_int(value, name: str, minimum: int = 1) -> int:
 def check_bool(value, name: str) -> bool:
     """``True`` or ``False`` (numpy booleans too); anything else, e.g. ``"no"`` or ``0``, is refused."""
     if not isinstance(value, _BOOL):
-        raise TypeError(f"{name} must be True or False, got {value!r}")
+        raise TypeError(f"{name} must be a bool (True or False), got {value!r}")
     return bool(value)
+
+
+def as_rng(seed, name: str = "seed") -> np.random.Generator:
+    """``np.random.default_rng(seed)`` (``None``, an int >= 0, a SeedSequence, a Generator, ...); booleans refused."""
+    if isinstance(seed, _BOOL):
+        raise TypeError(f"{name} must be None, an integer >= 0, a SeedSequence or a Generator, got a boolean")
+    try:
+        return np.random.default_rng(seed)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{name} must be None, an integer >= 0, a SeedSequence or a Generator ({exc})") from None
 
 
 def check_choice(value, name: str, choices: Collection[str]) -> str:
@@ -192,7 +244,7 @@ def check_choice(value, name: str, choices: Collection[str]) -> str:
     return value
 
 
-def check_performance(n: int, m: int, Bw, Cz, Dzu, Dzw):
+def check_performance(n: int, m: int, Bw, Cz, Dzu, Dzw) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Disturbance and performance channels of ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u``.
 
     Returns float arrays ``(Bw, Cz, Dzu, Dzw)``; ``Dzw=None`` is zero; a 1-D ``Bw`` is one column.

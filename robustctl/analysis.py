@@ -55,7 +55,12 @@ Numerics
   Lyapunov solution ``P_L = L L'`` of the nominal loop (weight: the
   problem's state weight plus ``1e-3`` of its norm times ``I``) becomes
   ``I``, with ``H`` and ``E`` scaled to comparable norms (the margin problem:
-  unit norms). Results are mapped back; margins and bounds are unchanged.
+  unit norms), ``Bw`` to unit norm and the guaranteed-cost objective to
+  unit size. Results are mapped back; margins and bounds are unchanged.
+  Every bound is then independent of the units of the weights, of ``w``,
+  ``z`` and ``x0`` (scaling ``Q, R`` by ``a^2`` scales the cost by ``a^2``;
+  unscaled, the authors' truck weights ``R = 33535`` made the
+  guaranteed-cost LMI fail).
 * The margin minimisation is non-strict (it computes the infimum); the
   returned ``P`` comes from its optimum ``P*`` as ``P* + eps P_L``, which
   is strictly feasible at any radius below the margin for small ``eps``
@@ -91,21 +96,22 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 
 from __future__ import annotations
 
-import numbers
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
 
 from . import _cvx
-from ._validation import as_batch, as_matrix, check_performance, check_spd
+from ._validation import as_batch, as_matrix, as_rng, check_int, check_performance, check_spd
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
-from .plant import Plant, _frozen
-from .uncertainty import NormBounded
+from .plant import Plant, _frozen, check_vertices
+from .stability import is_stable, spectral_abscissa, spectral_radius
+from .uncertainty import NormBounded, check_norm_bounded
 
 __all__ = ["RobustStability", "CostBound", "HinfBound", "WorstCase",
            "robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case"]
@@ -243,7 +249,10 @@ class WorstCase:
         Spectral radius (discrete) or spectral abscissa (largest real part,
         continuous) of ``A + H Delta E``.
     destabilizing : bool
-        ``radius >= 1`` (discrete) or ``radius >= 0`` (continuous).
+        The loop at ``Delta`` is not stable in the sense of
+        :mod:`robustctl.stability`: ``radius >= 1 - STABILITY_MARGIN``
+        (discrete) or ``radius >= -STABILITY_MARGIN`` (continuous), as
+        ``not Controller.is_stabilizing``.
     nominal_radius : float
         The same for ``Delta = 0``.
     evaluations : int
@@ -274,37 +283,10 @@ def _loop(controller) -> tuple[Plant, np.ndarray]:
     raise TypeError(f"controller must be a robustctl.Controller or a (Plant, K) pair, got {type(controller).__name__}")
 
 
-def _uncertainty(uncertainty, plant: Plant) -> NormBounded:
-    if not isinstance(uncertainty, NormBounded):
-        raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
-    uncertainty.check_plant(plant)
-    return uncertainty
-
-
-def _vertices(plant: Plant, vertices) -> list[Plant]:
-    if isinstance(vertices, Plant) or not isinstance(vertices, Sequence) or len(vertices) == 0:
-        raise TypeError("vertices must be a non-empty list of robustctl.Plant")
-    for i, v in enumerate(vertices):
-        if not isinstance(v, Plant):
-            raise TypeError(f"vertices[{i}] must be a robustctl.Plant, got {type(v).__name__}")
-        if (v.n, v.m) != (plant.n, plant.m):
-            raise ValueError(f"vertices[{i}] must have n={plant.n} states and m={plant.m} inputs like the "
-                             f"controller's plant, got n={v.n}, m={v.m}")
-        if v.dt != plant.dt:
-            raise ValueError(f"vertices[{i}] must have the sampling time of the controller's plant "
-                             f"(dt={plant.dt}), got dt={v.dt}")
-    return [plant, *vertices]
-
-
 # ---------------------------------------------------------------- linear algebra
 def _radius(A: np.ndarray, discrete: bool) -> float:
     """Spectral radius (discrete) or spectral abscissa (continuous)."""
-    lam = np.linalg.eigvals(A)
-    return float(np.max(np.abs(lam)) if discrete else np.max(lam.real))
-
-
-def _stable(A: np.ndarray, discrete: bool) -> bool:
-    return _radius(A, discrete) < (1.0 if discrete else 0.0)
+    return float(spectral_radius(A) if discrete else spectral_abscissa(A))
 
 
 def _lyapunov_factor(A: np.ndarray, Q: np.ndarray, discrete: bool) -> np.ndarray:
@@ -373,9 +355,8 @@ class _Coordinates:
 
 
 def _solve_info(reports) -> dict:
-    return {"solve_time": float(sum(r.solve_time for r in reports)),
-            "iterations": int(sum(r.iterations or 0 for r in reports)),
-            "solves": tuple(r.as_dict() for r in reports)}
+    solves = tuple(r.as_dict() for r in reports)
+    return {**_cvx.totals(solves), "solves": solves}
 
 
 # ---------------------------------------------------------------- robust stability
@@ -396,7 +377,7 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     H, E = unc.H, unc.EF + unc.EG @ K
     n, p = H.shape
     nominal = _radius(A, discrete)
-    if not _stable(A, discrete):
+    if not is_stable(A, discrete=discrete):
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
                                MappingProxyType({"nominal_radius": nominal}))
     e = float(np.linalg.norm(E, 2))
@@ -412,7 +393,7 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     lmis = [_cvx.LMI("lyapunov", _block(Ah, Hh, P, N, discrete)), _cvx.LMI("P", P)]
     rep = _cvx.solve_sdp(cp.Minimize(mu), lmis, infeasible_msg="the bounded-real LMI of the uncertainty loop is "
                                                                "infeasible")
-    mu_opt = max(float(mu.value), 0.0)
+    mu_opt = max(float(_cvx.value(mu)), 0.0)
     no_reach = not (np.any(H) and np.any(E))
     margin = np.inf if no_reach or mu_opt == 0.0 else 1.0 / (np.sqrt(mu_opt) * hh * eh)
     radius = 1.0 if margin > 1.0 else margin / (1.0 + _BACKOFF)
@@ -421,16 +402,15 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     # strictly feasible for small eps > 0 at any radius below the margin; the
     # LMI gains delta = 1 / (radius hh eh)^2 - mu_opt in its q block. The
     # plant's coordinates with multiplier 1 need P = eh^2 L (P^* + eps I) L'.
-    P_opt = 0.5 * (P.value + P.value.T)
+    P_val = _cvx.value(P)
+    P_opt = 0.5 * (P_val + P_val.T)
     delta = 1.0 / (radius * hh * eh) ** 2 - mu_opt
-    best = None
+    candidates = []
     for eps in max(delta, 1e-12) * 10.0 ** -np.arange(7.0):
         P_c = eh**2 * T.P(P_opt + eps * np.eye(n))
         blocks = _stability_blocks(A, H, E, P_c, radius, discrete)
-        score = _relative_min_eig(blocks)
-        if best is None or score > best[0]:
-            best = (score, P_c, blocks)
-    score, P_c, blocks = best
+        candidates.append((_relative_min_eig(blocks), P_c, blocks))
+    score, P_c, blocks = max(candidates, key=lambda c: c[0])  # the first of the best scores
     cert = {k: _min_eig(M) for k, M in blocks.items()}
     info = {"nominal_radius": nominal, "mu": mu_opt, **_solve_info([rep])}
     return RobustStability(bool(radius == 1.0 and score > _STRICT), float(margin), float(radius), _frozen(P_c),
@@ -445,7 +425,7 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
     D = [p.F + p.G @ K - A0 for p in plants]
     n = A0.shape[0]
     nominal = _radius(A0, discrete)
-    if not _stable(A0, discrete):
+    if not is_stable(A0, discrete=discrete):
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "polytope",
                                MappingProxyType({"nominal_radius": nominal}))
     T = _Coordinates(_lyapunov_factor(A0, np.eye(n), discrete))
@@ -455,7 +435,7 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
 
     def feasible(r: float):
         """``P^`` with every scaled vertex's Lyapunov block >= t I, P^ >= t I, P^ <= I and t > 0, or None."""
-        if any(not _stable(A0 + r * Di, discrete) for Di in D):
+        if any(not is_stable(A0 + r * Di, discrete=discrete) for Di in D):
             return None  # a vertex of the scaled polytope is unstable: no solve needed
         P, t = cp.Variable((n, n), symmetric=True, name="P"), cp.Variable(name="t")
         lmis = [_cvx.LMI(f"vertex[{i}]", _block(Ah0 + r * Di, empty, P, np.zeros((n, n)), discrete), t)
@@ -466,7 +446,8 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
         except (InfeasibleError, ConvergenceError):
             return None
         reports.append(rep)
-        return 0.5 * (P.value + P.value.T) if t.value > _POLY_T else None
+        P_val = _cvx.value(P)
+        return 0.5 * (P_val + P_val.T) if float(_cvx.value(t)) > _POLY_T else None
 
     if not any(np.any(Di) for Di in D):
         margin, (lo, P_lo) = np.inf, (1.0, np.eye(n))
@@ -541,15 +522,36 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
 
     Examples
     --------
-    >>> res = rc.robust_stability(ctrl, rc.NormBounded(H, EF, EG))     # doctest: +SKIP
-    >>> res.certified, res.margin                                      # doctest: +SKIP
+    An LQR of the paper's truck against ``dG = G Delta 0.1``,
+    ``dF = G Delta [0.1, 0, 0, 0]``; the margin is the reciprocal of the peak
+    of ``|E (z I - A)^-1 H|`` on the unit circle (here on a fine grid), and
+    the same gain is quadratically stable over the 0-300 % payload polytope:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.models.truck import truck_plant
+    >>> plant = truck_plant(0.0)
+    >>> ctrl = rc.lqr(plant)
+    >>> unc = rc.NormBounded(plant.G, [[0.1, 0.0, 0.0, 0.0]], [[0.1]])
+    >>> res = rc.robust_stability(ctrl, unc)
+    >>> res.certified, round(res.margin, 4)
+    (True, 4.0359)
+    >>> A, H, E = ctrl.closed_loop(), unc.H, unc.EF + unc.EG @ ctrl.K
+    >>> peak = max(abs(E @ np.linalg.solve(z * np.eye(4) - A, H)).item()
+    ...            for z in np.exp(1j * np.linspace(0.0, np.pi, 20001)))
+    >>> bool(abs(res.margin * peak - 1.0) < 1e-4)
+    True
+    >>> rc.robust_stability(ctrl, vertices=[truck_plant(300.0)]).certified
+    True
     """
     plant, K = _loop(controller)
     if (uncertainty is None) == (vertices is None):
         raise ValueError("give exactly one of uncertainty (a NormBounded) and vertices (a list of Plant)")
     if vertices is not None:
-        return _polytope_stability(_vertices(plant, vertices), K)
-    return _norm_bounded_stability(plant, K, _uncertainty(uncertainty, plant))
+        # a polytope needs a vertex besides the nominal plant
+        return _polytope_stability(check_vertices(plant, vertices, reference="the controller's plant",
+                                                  non_empty=True), K)
+    return _norm_bounded_stability(plant, K, check_norm_bounded(uncertainty, plant))
 
 
 # ---------------------------------------------------------------- performance bounds
@@ -558,10 +560,10 @@ def _robust_loop(controller, uncertainty, what: str):
     import control
 
     plant, K = _loop(controller)
-    unc = _uncertainty(uncertainty, plant)
+    unc = check_norm_bounded(uncertainty, plant)
     discrete = plant.is_discrete
     A, H, E = plant.F + plant.G @ K, unc.H, unc.EF + unc.EG @ K
-    if not _stable(A, discrete):
+    if not is_stable(A, discrete=discrete):
         kind = "spectral radius" if discrete else "spectral abscissa"
         raise InfeasibleError(f"no {what}: the nominal closed loop F + G K is unstable ({kind} "
                               f"{_radius(A, discrete):.6g})")
@@ -587,7 +589,7 @@ def _balanced(Hh: np.ndarray, Eh: np.ndarray) -> tuple[np.ndarray, np.ndarray, f
 
 def _multiplier(lam, p: int, c: float) -> float:
     """The multiplier in the plant's scaling: ``lam^ (|E^ x^|^2 - |q^|^2) = lam^ (|E x|^2 - |q|^2) / c^2``."""
-    return float(lam.value) / c**2 if p else 0.0
+    return float(_cvx.value(lam)) / c**2 if p else 0.0
 
 
 def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertainty: NormBounded, Q: ArrayLike,
@@ -643,14 +645,16 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     lmis = [_cvx.LMI("cost", _block(Ah, Hh, P, N, plant.is_discrete)), _cvx.LMI("P", P)]
     if x0 is None:
         s = cp.Variable(name="s")
-        # lambda_max(L P^ L') <= s  <=>  s (L L')^-1 - P^ >= 0
-        lmis.append(_cvx.LMI("P_upper", s * T.Q(np.eye(n)) - P))
+        # lambda_max(L P^ L') <= s / c  <=>  s (L L')^-1 / c - P^ >= 0, c = ||(L L')^-1|| (s of unit size)
+        M = T.Q(np.eye(n))
+        lmis.append(_cvx.LMI("P_upper", s * (M / np.linalg.norm(M, 2)) - P))
         objective = cp.Minimize(s)
     else:
         xh = T.L.T @ x0
+        xh = xh / (np.linalg.norm(xh) or 1.0)   # x0' P x0 = |L' x0|^2 xh' P^ xh: the direction only
         objective = cp.Minimize(xh @ P @ xh)
     rep = _cvx.solve_sdp(objective, lmis, infeasible_msg="the guaranteed-cost LMI is infeasible")
-    P_orig = T.P(P.value)
+    P_orig = T.P(_cvx.value(P))
     bound = float(x0 @ P_orig @ x0) if x0 is not None else float(np.linalg.eigvalsh(P_orig)[-1])
     return CostBound(bound, _frozen(P_orig), _multiplier(lam, p, c), None if x0 is None else _frozen(x0),
                      MappingProxyType(dict(rep.certificate)), MappingProxyType(_solve_info([rep])))
@@ -703,8 +707,8 @@ def robust_hinf_bound(controller: Controller | tuple[Plant, ArrayLike], uncertai
          - mu * _diag(np.zeros((n + p, n + p)), np.eye(q)))
     lmis = [_cvx.LMI("hinf", _block(Ah, np.hstack([Hh, Bh]), P, N, plant.is_discrete)), _cvx.LMI("P", P)]
     rep = _cvx.solve_sdp(cp.Minimize(mu), lmis, infeasible_msg="the robust H-infinity LMI is infeasible")
-    gamma = b * float(np.sqrt(max(float(mu.value), 0.0)))
-    return HinfBound(gamma, _frozen(T.P(P.value)), _multiplier(lam, p, c),
+    gamma = b * float(np.sqrt(max(float(_cvx.value(mu)), 0.0)))
+    return HinfBound(gamma, _frozen(T.P(_cvx.value(P))), _multiplier(lam, p, c),
                      MappingProxyType(dict(rep.certificate)), MappingProxyType(_solve_info([rep])))
 
 
@@ -806,10 +810,12 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     import control
 
     plant, K = _loop(controller)
-    unc = _uncertainty(uncertainty, plant)
-    if isinstance(n_starts, bool) or not isinstance(n_starts, numbers.Integral) or n_starts < 0:
-        raise ValueError(f"n_starts must be an integer >= 0, got {n_starts!r}")
-    rng = np.random.default_rng(seed)
+    unc = check_norm_bounded(uncertainty, plant)
+    try:
+        n_starts = check_int(n_starts, "n_starts", minimum=0)
+    except TypeError as exc:  # worst_case has raised ValueError for every bad n_starts: keep that type
+        raise ValueError(str(exc)) from None
+    rng = as_rng(seed)
     discrete = plant.is_discrete
     A, H, E = plant.F + plant.G @ K, unc.H, unc.EF + unc.EG @ K
     p, l = unc.p, unc.l
@@ -817,14 +823,14 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     nominal, g0 = obj.value_grad(np.zeros((p, l)))
     starts = []
     if np.any(g0):
-        U, s, Vt = np.linalg.svd(g0)
+        U, _, Vt = np.linalg.svd(g0)
         starts += [_polar(g0), np.outer(U[:, 0], Vt[0])]
-    if _stable(A, discrete) and np.any(H) and np.any(E):
+    if is_stable(A, discrete=discrete) and np.any(H) and np.any(E):
         sys = control.ss(A, H, E, np.zeros((l, p)), plant.dt if discrete else 0)
         _, w = control.linfnorm(sys)
         z = np.exp(1j * w * plant.dt) if discrete else 1j * w
         Tz = E @ np.linalg.solve(z * np.eye(plant.n) - A, H)
-        U, s, Vh = np.linalg.svd(Tz)
+        U, _s, Vh = np.linalg.svd(Tz)
         Dc = np.outer(Vh[0].conj(), U[:, 0].conj()).real  # Re(v u^H)
         if np.any(Dc):
             starts.append(Dc / np.linalg.norm(Dc, 2))
@@ -835,5 +841,6 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
         f, D = _ascend(obj, S)
         if f > best_f:
             best_f, best_D = f, D
-    radius = _radius(A + H @ best_D @ E, discrete)
-    return WorstCase(_frozen(best_D), radius, bool(radius >= (1.0 if discrete else 0.0)), nominal, obj.count)
+    worst = A + H @ best_D @ E
+    return WorstCase(_frozen(best_D), _radius(worst, discrete), not is_stable(worst, discrete=discrete), nominal,
+                     obj.count)

@@ -48,8 +48,9 @@ error from a reference trajectory).
 from __future__ import annotations
 
 import copy
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal, Sequence
+from typing import Literal
 
 import numpy as np
 
@@ -109,10 +110,12 @@ class SimulationResult:
 
     @property
     def B(self) -> int:
+        """Number of gains (designs)."""
         return self.diverged.shape[0]
 
     @property
     def S(self) -> int:
+        """Number of scenarios."""
         return self.diverged.shape[1]
 
     @property
@@ -193,7 +196,7 @@ def _plant_array(M, name: str, rows: int, cols: int | None, T: int) -> np.ndarra
         raise ValueError(f"{name} must have shape ({rows}, {cols or 'p'}), (S, {rows}, {cols or 'p'}) "
                          f"or (S, T, {rows}, {cols or 'p'}), got shape {arr.shape}")
     lead = (None,) * (arr.ndim - 2)
-    arr = as_batch(arr, name, lead + (rows, cols), ("",) * len(lead) + ("the number of states, from F", ""))
+    arr = as_batch(arr, name, (*lead, rows, cols), ("",) * len(lead) + ("the number of states, from F", ""))
     arr = arr[None, None] if arr.ndim == 2 else (arr[:, None] if arr.ndim == 3 else arr)
     if arr.shape[1] not in (1, T):
         raise ValueError(f"{name} has {arr.shape[1]} time steps, expected 1 or T={T} (from x_ref)")
@@ -314,7 +317,7 @@ class LinearSimulator:
                                   "w": self._w, "x0": self._e0})
         self.n, self.p, self.T = n, p, T
         self._M = None if input_map is None else _input_map(input_map, p)
-        self.m = p if input_map is None else self._M.shape[1]
+        self.m = p if self._M is None else self._M.shape[1]
         self._lim = _limits(u_limit, p)
         self._has_limit = u_limit is not None
         self._bound = check_positive_scalar(bound, "bound", allow_inf=True)
@@ -328,7 +331,7 @@ class LinearSimulator:
         self._state_names = names
         self._dt = dt
 
-    def with_input_map(self, input_map) -> "LinearSimulator":
+    def with_input_map(self, input_map) -> LinearSimulator:
         """The same simulator with another input map ``M`` (p, m') (no other argument is checked again)."""
         M = _input_map(input_map, self.p)
         other = copy.copy(self)
@@ -418,11 +421,11 @@ def _run_numpy(sim: LinearSimulator, Keff: np.ndarray, dead: np.ndarray, keep: b
     """The reference implementation: one array recursion over T steps on (S, n, B) states."""
     B, S, T, n, p = Keff.shape[0], sim.S, sim.T, sim.n, sim.p
     bound = sim._bound
-    Fa = np.broadcast_to(sim._F, (S,) + sim._F.shape[1:])
-    Ga = np.broadcast_to(sim._G, (S,) + sim._G.shape[1:])
+    Fa = np.broadcast_to(sim._F, (S, *sim._F.shape[1:]))
+    Ga = np.broadcast_to(sim._G, (S, *sim._G.shape[1:]))
     xr = np.broadcast_to(sim._xr, (S, T, n))
-    uff = np.broadcast_to(sim._uff, (S,) + sim._uff.shape[1:])
-    wa = np.broadcast_to(sim._w, (S,) + sim._w.shape[1:])
+    uff = np.broadcast_to(sim._uff, (S, *sim._uff.shape[1:]))
+    wa = np.broadcast_to(sim._w, (S, *sim._w.shape[1:]))
     e0 = np.broadcast_to(sim._e0, (S, n))
     lo, hi = -sim._lim[None, :, None], sim._lim[None, :, None]
     # State layout (S, n, B): one batched matmul per step. A frozen (diverged) run
@@ -436,8 +439,8 @@ def _run_numpy(sim: LinearSimulator, Keff: np.ndarray, dead: np.ndarray, keep: b
     sq = np.zeros((S, n, B))
     sqx = np.zeros((S, n, B))
     sat_steps = np.zeros((S, B), dtype=np.int64)
-    E_all = np.empty((T, S, n, B)) if keep else None
-    U_all = np.empty((T, S, p, B)) if keep else None
+    T_keep = T if keep else 0                                    # the trajectories, only if asked for
+    E_all, U_all = np.empty((T_keep, S, n, B)), np.empty((T_keep, S, p, B))
     any_dead = bool(dead.any())
     alive3 = alive[:, None, :]                                   # view: follows alive
     for k in range(T):

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from ._validation import as_float_array, as_matrix
-from .plant import Plant, _frozen
+from .plant import Plant, _frozen, check_plant
 from .stability import is_stable
 
 __all__ = ["Controller"]
@@ -40,8 +41,7 @@ class Controller:
     info: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self):
-        if not isinstance(self.plant, Plant):
-            raise TypeError(f"plant must be a robustctl.Plant, got {type(self.plant).__name__}")
+        check_plant(self.plant)
         K = as_matrix(self.K, "K", rows=self.plant.m, cols=self.plant.n,
                       rows_what="the number of inputs", cols_what="the number of states")
         object.__setattr__(self, "K", _frozen(K))
@@ -63,11 +63,14 @@ class Controller:
         return p.F + p.G @ self.K
 
     def closed_loop_poles(self, plant: Plant | None = None) -> np.ndarray:
+        """Eigenvalues of :meth:`closed_loop`."""
         return np.linalg.eigvals(self.closed_loop(plant))
 
     def is_stabilizing(self, plant: Plant | None = None) -> bool:
-        """``F + G K`` is stable: spectral radius below ``1 - 1e-9`` (discrete) or every real part below
-        ``-1e-9`` (continuous), the margin of :mod:`robustctl.stability`."""
+        """Whether ``F + G K`` is stable, with the margin of :mod:`robustctl.stability`.
+
+        Spectral radius below ``1 - 1e-9`` (discrete) or every real part below ``-1e-9`` (continuous).
+        """
         p = self._plant(plant)
         return is_stable(self.closed_loop(p), discrete=p.is_discrete)
 
@@ -89,8 +92,7 @@ class Controller:
     def _plant(self, plant: Plant | None) -> Plant:
         if plant is None:
             return self.plant
-        if not isinstance(plant, Plant):
-            raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+        check_plant(plant)
         if (plant.n, plant.m) != (self.plant.n, self.plant.m):
             raise ValueError(f"plant must have n={self.plant.n} states and m={self.plant.m} inputs, "
                              f"got n={plant.n}, m={plant.m}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 from importlib import import_module
 
 from .controller import Controller
-from .plant import Plant
+from .plant import Plant, check_plant
 
 __all__ = ["design", "METHODS"]
 
@@ -25,12 +25,21 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     remaining arguments are those of the named function (:func:`robustctl.lqr`,
     :func:`robustctl.rlqr`, :func:`robustctl.hinf`), which documents them.
 
-    >>> ctrl = design("rlqr", plant, EF, EG, mu, Q=Q, R=R)   # doctest: +SKIP
+    >>> import numpy as np
+    >>> from robustctl import design, lqr
+    >>> from robustctl.models.truck import truck_plant
+    >>> plant = truck_plant(0.0)
+    >>> ctrl = design("lqr", plant, Q=np.eye(4), R=[[1.0]])
+    >>> ctrl.method, bool(np.array_equal(ctrl.K, lqr(plant, Q=np.eye(4), R=[[1.0]]).K))
+    ('lqr', True)
+    >>> design("lqg", plant)
+    Traceback (most recent call last):
+        ...
+    ValueError: method must name a design: unknown design method 'lqg'; valid: h2, hinf, lqr, rlqr
     """
     if not isinstance(method, str) or method.lower() not in METHODS:
         raise ValueError(f"method must name a design: unknown design method {method!r}; "
                          f"valid: {', '.join(sorted(METHODS))}")
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+    check_plant(plant)
     module, func = METHODS[method.lower()].split(":")
     return getattr(import_module(module), func)(plant, *args, **kwargs)

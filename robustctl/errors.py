@@ -29,10 +29,10 @@ class InfeasibleError(RobustCtlError, ValueError):
 class NotStabilizableError(ConvergenceError, InfeasibleError):
     """The plant is not stabilisable: some unstable mode cannot be moved by the input (PBH test).
 
-    Raised by ``lqr`` and ``rlqr`` before they start
+    Raised by ``lqr``, ``rlqr``, ``hinf`` and ``h2`` before they start
     (:func:`robustctl.stability.check_stabilizable`), since no gain ``u = K x``
     stabilises such a plant. It is both a :class:`ConvergenceError` (what
     ``lqr`` raised when its Riccati solver failed on such plants) and an
-    :class:`InfeasibleError` (what ``hinf`` raises, with the same message), so
-    handlers written for either keep working.
+    :class:`InfeasibleError` (what the LMI syntheses raise when no gain
+    exists), so handlers written for either keep working.
     """

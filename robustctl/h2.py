@@ -30,8 +30,10 @@ the stabilising Riccati solution: the tests check the LMI optimum against
 scipy's DARE / CARE.
 
 Numerics: the data go through the coordinates of :mod:`robustctl.hinf`
-(balancing, ``||Bw|| = 1``, ``z`` compressed to a factor with the same
-Gram matrix, which is all the H2 norm depends on). The minimisation uses
+(``w`` and ``z`` scaled to unit size, since ``||T_zw||_2`` is homogeneous
+in both and the gain does not depend on them; balancing, ``||Bw|| = 1``,
+``z`` compressed to a factor with the same Gram matrix, which is all the H2
+norm depends on). The minimisation uses
 non-strict LMIs (the infimum); unless ``backoff=0`` the gain comes from a
 second problem at ``h2_bound = (1 + backoff) h2_opt`` that maximises the
 smallest eigenvalue of every block (a strictly feasible, well-centred point),
@@ -42,24 +44,23 @@ reported (``info["h2_norms"]``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
 
 from . import _cvx
-from ._validation import check_performance
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .hinf import _tolerances as tol
-from .hinf._coordinates import Coordinates, normalised, recentred
+from .hinf._coordinates import Coordinates, channel_scales, normalised, recentred
 from .hinf._lmis import Point, region_blocks, variables
-from .hinf._problem import check_backoff, check_poles_reachable, check_stabilisable, check_vertices
+from .hinf._problem import validate
 from .hinf._synthesis import check_closed_loop
 from .plant import Plant
-from .regions import Region, as_regions, describe_regions
+from .regions import Region, describe_regions
 
 __all__ = ["h2", "H2Controller"]
 
@@ -120,47 +121,48 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     H2Controller
         ``K``, ``h2_bound``, ``h2_opt`` and ``info`` with ``h2_norms`` (the
         H2 norm of the closed loop at every vertex, from its Gramian),
-        ``certificate``, ``margin``, ``solves``, ``X``, ``poles``, ``status``,
-        ``solve_time``, ``iterations``, ``backoff``.
+        ``certificate``, ``margin``, ``solves``, ``X`` (the Lyapunov matrix,
+        ``X >= `` the closed-loop controllability Gramian at every vertex),
+        ``poles``, ``status``, ``solve_time``, ``iterations``, ``backoff``.
 
     Raises
     ------
     InfeasibleError
-        A vertex is not stabilisable, the pole regions cannot be reached
+        A vertex is not stabilisable (:class:`~robustctl.errors.NotStabilizableError`,
+        an ``InfeasibleError``), the pole regions cannot be reached
         (with the reason), or no common Lyapunov matrix exists.
     ValueError, TypeError
         Bad arguments (named in the message).
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    plants = check_vertices(plant, vertices)
-    Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
+    # the validation stage of the H-infinity synthesis, without its H-infinity-only options
+    problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=None, u_max=None,
+                       w_energy=None, backoff=backoff, extended=False, solver=solver, poles=poles)
+    plants, regions, solver, backoff = problem.plants, problem.regions, problem.solver, problem.backoff
+    Bw, Cz, Dzu, Dzw = problem.Bw, problem.Cz, problem.Dzu, problem.Dzw
     if not plant.is_discrete and np.any(Dzw):
         raise ValueError("Dzw must be zero for a continuous-time plant: a feedthrough from white noise w to z "
                          "makes the H2 norm infinite")
-    backoff = check_backoff(backoff)
-    solver = _cvx.check_solver(solver)
-    regions = as_regions(poles)
-    check_stabilisable(plants)
-    check_poles_reachable(plants, regions)
 
-    data = normalised([p.F for p in plants], [p.G for p in plants], Bw, Cz, Dzu, Dzw)
+    w_scale, z_unit = channel_scales(Bw, Cz, Dzu, Dzw)
+    data = normalised([p.F for p in plants], [p.G for p in plants], Bw, Cz, Dzu, Dzw, w_scale, z_unit=z_unit)
     what = _infeasibility(plants, regions)
     const = float(np.sum(data.Dzw**2))          # trace(Dzw' Dzw), invariant under the compression
     point, cost, rep = _minimise(data, plant.is_discrete, regions, solver, what)
-    h2_opt = float(np.sqrt(max(cost, 0.0) + const))
+    scaled_opt = float(np.sqrt(max(cost, 0.0) + const))     # ||T_zw||_2 of the scaled channels
     solves = [rep.as_dict()]
     if backoff == 0:
         cert, margin = dict(rep.certificate), 0.0
     else:
         home = recentred(data, point.X, tol.RECENTRE_REG)
         data = data if home is None else home[0]
-        point, margin, rep, backoff, centring = _centre(data, plant.is_discrete, regions, solver, h2_opt, const,
-                                                        backoff)
+        point, margin, rep, backoff, centring = _centre(data, plant.is_discrete, regions, solver, scaled_opt,
+                                                        const, backoff)
         cert = dict(rep.certificate)
         solves += centring
     K, X = data.to_original(point.gain(), point.X)
+    X = X / w_scale**2                           # the Gramian bound of the caller's w
     check_closed_loop(K, plants, regions)
+    h2_opt = scaled_opt / data.level_scale
     h2_bound = (1.0 + backoff) * h2_opt
     norms = np.array([_h2_norm(p, K, Bw, Cz, Dzu, Dzw) for p in plants])
     if np.any(norms > h2_bound * (1.0 + tol.U_BOUND_CHECK)):
@@ -169,8 +171,7 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     info = {
         "h2_bound": h2_bound, "h2_opt": h2_opt, "h2_norms": norms, "backoff": backoff, "margin": margin,
         "certificate": cert, "solves": solves, "X": 0.5 * (X + X.T), "poles": regions, "vertices": len(plants),
-        "status": solves[-1]["status"], "solve_time": float(sum(s["solve_time"] for s in solves)),
-        "iterations": int(sum(s["iterations"] or 0 for s in solves)), "solver": solver,
+        "status": solves[-1]["status"], **_cvx.totals(solves), "solver": solver,
     }
     return H2Controller(K=K, method="h2", plant=plant, info=info, h2_bound=h2_bound, h2_opt=h2_opt)
 
@@ -193,7 +194,7 @@ def h2_blocks(data: Coordinates, V: Point, W, discrete: bool, margin=0.0, z_scal
     X, Y = V.X, V.Y
     BB = data.Bw @ data.Bw.T
     out = []
-    for i, (F, G) in enumerate(zip(data.F, data.G)):
+    for i, (F, G) in enumerate(zip(data.F, data.G, strict=True)):
         AX = F @ X + G @ Y
         M = cp.bmat([[X - BB, AX], [AX.T, X]]) if discrete else -(AX + AX.T) - BB
         out.append(_cvx.LMI(f"gramian[{i}]", M, margin))
@@ -213,17 +214,18 @@ def _minimise(data: Coordinates, discrete: bool, regions, solver: str, what: str
     lmis = h2_blocks(data, V, W, discrete) + region_blocks(regions, data, V)
     rep = _cvx.solve_sdp(cp.Minimize(cp.trace(W)), lmis, solver=solver, tol=tol.LEVEL_TOL,
                          infeasible_msg=f"no H2 state feedback: {what}")
-    return V.values(), float(np.trace(W.value)), rep
+    return V.values(), float(np.trace(_cvx.value(W))), rep
 
 
 def _centre(data: Coordinates, discrete: bool, regions, solver: str, h2_opt: float, const: float,
             backoff: float):
     """A well-centred strictly feasible point at ``(1 + backoff) h2_opt``, the backoff raised if needed.
 
-    Maximises the common margin ``t <= 1`` of every block with ``z`` scaled
-    so that the bound on ``trace(W)`` is 1 (``data``: coordinates where the
-    optimal ``X`` is ~ I, so one margin suits every block). Returns
-    ``(point, t, report, backoff used, solves)``.
+    ``h2_opt`` and ``const`` in ``data``'s units. Maximises the common
+    margin ``t <= 1`` of every block with ``z`` scaled so that the bound on
+    ``trace(W)`` is 1 (``data``: coordinates where the optimal ``X`` is ~ I,
+    so one margin suits every block). Returns ``(point, t, report, backoff
+    used, solves)``.
     """
     import cvxpy as cp
 
@@ -245,7 +247,7 @@ def _centre(data: Coordinates, discrete: bool, regions, solver: str, h2_opt: flo
             continue
         solves.append({**rep.as_dict(), "centring": "margin"})
         if all(v > 0 for v in rep.certificate.values()):
-            return V.values(), float(t.value), rep, used, solves
+            return V.values(), float(_cvx.value(t)), rep, used, solves
         failure = ConvergenceError(f"{msg} (smallest eigenvalues {dict(rep.certificate)})")
     raise failure or ConvergenceError("no centring attempt")
 

@@ -39,8 +39,20 @@ Notes
 ``scipy.linalg.solve_discrete_are`` may return a wrong matrix for an
 indefinite ``R`` without raising; every solution is therefore accepted only
 after its relative residual, symmetry, sign and the closed-loop spectrum are
-checked. The continuous case builds the Hamiltonian and its ordered Schur form
-directly (imaginary-axis eigenvalues mean ``gamma`` is too small).
+checked (the closed loop of the saddle point must be stable with the margin
+of :mod:`robustctl.stability`, like every stability test of the library:
+this module shares that definition, not the LMI code). The continuous case builds the Hamiltonian
+and its ordered Schur form directly (imaginary-axis eigenvalues mean ``gamma`` is too small).
+
+The equations are solved in unit-sized channels, ``w~ = ||Bw|| w`` and
+``z~ = z / ||[Cz Dzu Dzw~]||`` (the level is homogeneous in both scalings
+and the gain does not depend on them); ``gamma`` and ``P`` are reported in
+the caller's units. scipy's solver is not scale invariant: on the truck
+with the authors' weights (``R = 33535``, so ``gamma^2 ~ 1e8`` in the
+indefinite weight) its genuine solutions had relative residuals of 1e-10
+to 3e-10 at every level between the optimum and 3.2 times it, so the
+residual check rejected them and the bisection ended at 3.2 times the
+optimum; with unit-sized channels the residuals are ~1e-14.
 """
 
 from __future__ import annotations
@@ -53,7 +65,8 @@ from numpy.typing import ArrayLike
 
 from ._validation import check_performance, check_positive_scalar
 from .errors import InfeasibleError
-from .plant import Plant
+from .plant import Plant, check_plant
+from .stability import is_stable
 
 __all__ = ["RiccatiHinf", "hinf_riccati", "riccati_level"]
 
@@ -62,6 +75,9 @@ __all__ = ["RiccatiHinf", "hinf_riccati", "riccati_level"]
 # residual 1e-9..1e-7 whose gain misses the level (seen on a random n = 20
 # plant: gamma 8e-6 too low with 1e-7 here).
 _RES_TOL = 1e-10
+
+# (F, G, Bw, Cz, Dzu, Dzw)
+_Data = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,11 +105,17 @@ class RiccatiHinf:
     iterations: int
 
 
-def _data(plant, Bw, Cz, Dzu, Dzw):
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+def _data(plant, Bw, Cz, Dzu, Dzw) -> tuple[_Data, float, float]:
+    """``(F, G, Bw~, Cz~, Dzu~, Dzw~), b, c``: ``w~ = b w`` and ``z~ = z / c`` of unit size (1 for zero matrices).
+
+    A level of the scaled data is ``gamma / (b c)``, its Riccati solution ``P / c^2``; the gain is the same.
+    """
+    check_plant(plant)
     Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
-    return plant.F, plant.G, Bw, Cz, Dzu, Dzw
+    b = float(np.linalg.norm(Bw, 2)) or 1.0
+    Bw, Dzw = Bw / b, Dzw / b
+    c = float(np.linalg.norm(np.hstack([Cz, Dzu, Dzw]), 2)) or 1.0
+    return (plant.F, plant.G, Bw, Cz / c, Dzu / c, Dzw / c), b, c
 
 
 def _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma):
@@ -106,7 +128,7 @@ def _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma):
 
 
 def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
-    n, m = G.shape
+    _n, m = G.shape
     B, Q, R, S = _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma)
     try:
         with np.errstate(all="ignore"):
@@ -122,12 +144,12 @@ def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
     except np.linalg.LinAlgError:
         return None
     res = F.T @ P @ F + Q + (F.T @ P @ B + S) @ L - P
-    scale = max(1.0, np.linalg.norm(P), np.linalg.norm(Q))
+    scale = max(1.0, float(np.linalg.norm(P)), float(np.linalg.norm(Q)))
     if not np.linalg.norm(res) <= _RES_TOL * scale:
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * scale:
         return None
-    if np.max(np.abs(np.linalg.eigvals(F + B @ L))) >= 1.0:
+    if not is_stable(F + B @ L, discrete=True):
         return None
     Hww = H[m:, m:]
     if np.linalg.eigvalsh(0.5 * (Hww + Hww.T)).max() >= 0.0:
@@ -147,10 +169,10 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     A = F - B @ Rinv @ S.T
     Ham = np.block([[A, -B @ Rinv @ B.T], [-(Q - S @ Rinv @ S.T), -A.T]])
     eig = np.linalg.eigvals(Ham)
-    scale = max(1.0, np.linalg.norm(Ham, 1))
+    scale = max(1.0, float(np.linalg.norm(Ham, 1)))
     if np.min(np.abs(eig.real)) <= 1e-10 * scale:
         return None  # eigenvalue on the imaginary axis: gamma too small
-    T, U, sdim = scipy.linalg.schur(Ham, output="real", sort="lhp")
+    _T, U, sdim = scipy.linalg.schur(Ham, output="real", sort="lhp")
     if sdim != n:
         return None
     U1, U2 = U[:n, :n], U[n:, :n]
@@ -160,12 +182,12 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     P = 0.5 * (P + P.T)
     L = -Rinv @ (B.T @ P + S.T)
     res = F.T @ P + P @ F + Q + (P @ B + S) @ L
-    pscale = max(1.0, np.linalg.norm(P), np.linalg.norm(Q))
-    if not np.linalg.norm(res) <= 1e-6 * pscale * max(1.0, np.linalg.norm(F)):
+    pscale = max(1.0, float(np.linalg.norm(P)), float(np.linalg.norm(Q)))
+    if not np.linalg.norm(res) <= 1e-6 * pscale * max(1.0, float(np.linalg.norm(F))):
         return None
     if np.linalg.eigvalsh(P).min() < -1e-9 * pscale:
         return None
-    if np.max(np.linalg.eigvals(F + B @ L).real) >= 0.0:
+    if not is_stable(F + B @ L, discrete=False):
         return None
     return L[:m], P
 
@@ -176,10 +198,11 @@ def riccati_level(plant: Plant, gamma: float, *, Bw: ArrayLike, Cz: ArrayLike, D
 
     See the module docstring for the equations and the checks applied.
     """
-    F, G, Bw, Cz, Dzu, Dzw = _data(plant, Bw, Cz, Dzu, Dzw)
+    data, b, c = _data(plant, Bw, Cz, Dzu, Dzw)
     gamma = check_positive_scalar(gamma, "gamma")
     level = _level_discrete if plant.is_discrete else _level_continuous
-    return level(F, G, Bw, Cz, Dzu, Dzw, gamma)
+    sol = level(*data, gamma / (b * c))
+    return None if sol is None else (sol[0], c**2 * sol[1])
 
 
 def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: ArrayLike | None = None,
@@ -196,7 +219,11 @@ def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, 
     rtol : float
         Stop when ``gamma_high / gamma_low - 1 < rtol``.
     gamma_max : float
-        Give up (``InfeasibleError``) if no level below this is feasible.
+        Give up (``InfeasibleError``) if no level up to ``gamma_max`` in the
+        unit-sized channels of the module notes is feasible, i.e. up to
+        ``gamma_max ||Bw|| ||[Cz Dzu Dzw / ||Bw||]||`` in the caller's units
+        (relative, so that the answer does not depend on the units of ``w``
+        and ``z``).
 
     Returns
     -------
@@ -204,35 +231,40 @@ def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, 
 
     Notes
     -----
-    The bracket starts at ``[||Dzw||, 1]`` and the upper end is doubled until
-    feasible. The bisection is geometric (on ``log gamma``). Near the optimum
-    the Riccati solution may become ill conditioned; a level whose solution
+    The bracket starts at ``[||Dzw~||, 1]`` in the unit-sized channels of
+    the module notes (``[||Dzw||, ||Bw|| ||[Cz Dzu Dzw / ||Bw||]||]`` in the
+    caller's units) and the upper end is doubled until feasible. The
+    bisection is geometric (on ``log gamma``). Near the optimum the Riccati
+    solution may become ill conditioned; a level whose solution
     fails the residual checks is treated as infeasible, so the returned
     ``gamma`` is an upper bound of the optimum, tight to ``rtol`` unless the
     checks fail early (compare ``gamma`` with ``gamma_low``).
     """
-    F, G, Bw, Cz, Dzu, Dzw = _data(plant, Bw, Cz, Dzu, Dzw)
+    data, b, c = _data(plant, Bw, Cz, Dzu, Dzw)
     rtol = check_positive_scalar(rtol, "rtol")
+    gamma_max = check_positive_scalar(gamma_max, "gamma_max")
     level = _level_discrete if plant.is_discrete else _level_continuous
-    lo = float(np.linalg.norm(Dzw, 2))
+    lo = float(np.linalg.norm(data[-1], 2))      # the scaled data from here on
     hi = max(1.0, 2.0 * lo)
     its = 0
     while True:
         its += 1
-        sol = level(F, G, Bw, Cz, Dzu, Dzw, hi)
+        sol = level(*data, hi)
         if sol is not None:
             break
         lo, hi = hi, 2.0 * hi
         if hi > gamma_max:
-            raise InfeasibleError(f"no stabilising game-Riccati solution for gamma up to {gamma_max:g} "
-                                  "(is (F, G) stabilisable?)")
+            raise InfeasibleError(f"no stabilising game-Riccati solution for gamma up to {gamma_max * b * c:g} "
+                                  f"(gamma_max = {gamma_max:g} times the size of the channels; is (F, G) "
+                                  "stabilisable?)")
     best = sol
     while hi - lo > rtol * hi:
         mid = np.sqrt(lo * hi) if lo > 0 else 0.5 * hi
         its += 1
-        sol = level(F, G, Bw, Cz, Dzu, Dzw, mid)
+        sol = level(*data, mid)
         if sol is None:
             lo = mid
         else:
             hi, best = mid, sol
-    return RiccatiHinf(gamma=float(hi), gamma_low=float(lo), K=best[0], P=best[1], iterations=its)
+    return RiccatiHinf(gamma=float(hi * b * c), gamma_low=float(lo * b * c), K=best[0], P=c**2 * best[1],
+                       iterations=its)

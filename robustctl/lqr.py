@@ -18,7 +18,7 @@ import scipy.linalg
 from ._validation import as_matrix, check_spd
 from .controller import Controller
 from .errors import ConvergenceError
-from .plant import Plant
+from .plant import Plant, check_plant
 from .stability import check_stabilizable
 
 __all__ = ["lqr", "dare"]
@@ -38,7 +38,7 @@ def _weights(plant: Plant, Q, R) -> tuple[np.ndarray, np.ndarray]:
 def _residual(F, G, Q, R, P) -> float:
     GP = G.T @ P
     res = F.T @ P @ F - F.T @ P @ G @ np.linalg.solve(R + GP @ G, GP @ F) + Q - P
-    return float(np.linalg.norm(res) / max(1.0, np.linalg.norm(P)))
+    return float(np.linalg.norm(res)) / max(1.0, float(np.linalg.norm(P)))
 
 
 def dare(F, G, Q=None, R=None) -> tuple[np.ndarray, str]:
@@ -62,7 +62,8 @@ def _dare(F, G, Q, R) -> tuple[np.ndarray, str]:
                 P = np.asarray(control.dare(F, G, Q, R, method="slycot")[0])
             else:
                 P = scipy.linalg.solve_discrete_are(F, G, Q, R)
-        except Exception as exc:  # slycot missing or failed, or scipy failed: try the next
+        except (ImportError, RuntimeError, ValueError, ArithmeticError) as exc:
+            # slycot missing (ImportError) or failed (SlycotError is a RuntimeError), or scipy failed: try the next
             reasons.append(f"{backend}: {exc}")
             continue
         P = 0.5 * (P + P.T)
@@ -95,14 +96,11 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     ------
     NotStabilizableError
         ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`);
-        ``rlqr`` raises the same, ``hinf`` an ``InfeasibleError`` (which this error also is).
+        ``rlqr``, ``hinf`` and ``h2`` raise the same (it is also an ``InfeasibleError``).
     ConvergenceError
         No backend solves the Riccati equation (e.g. ``(F, Q)`` not detectable).
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    if not plant.is_discrete:
-        raise ValueError("plant must be discrete-time (dt > 0) for lqr; discretise it first")
+    check_plant(plant, discrete_for="lqr")
     Q, R = _weights(plant, Q, R)
     check_stabilizable(plant)
     P, backend = _dare(plant.F, plant.G, Q, R)

@@ -22,8 +22,8 @@ reproduction.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import numpy as np
 
@@ -53,6 +53,7 @@ class Straight:
         check_positive_scalar(self.length, "Straight.length")
 
     def curvature(self, s: np.ndarray) -> np.ndarray:
+        """Curvature [1/m] at arc lengths ``s`` [m] from the element's start: zero."""
         return np.zeros_like(s)
 
 
@@ -83,9 +84,11 @@ class Curve:
 
     @property
     def length(self) -> float:
+        """Arc length [m]: ``|angle| radius + transition``."""
         return abs(np.radians(self.angle)) * self.radius + self.transition
 
     def curvature(self, s: np.ndarray) -> np.ndarray:
+        """Curvature [1/m] at arc lengths ``s`` [m] from the element's start (the arc between two clothoid ramps)."""
         k = np.sign(self.angle) / self.radius
         L, Lt = self.length, self.transition
         if Lt == 0:
@@ -112,6 +115,7 @@ class LaneChange:
             raise ValueError(f"LaneChange.offset must be finite and non-zero, got {self.offset}")
 
     def curvature(self, s: np.ndarray) -> np.ndarray:
+        """Curvature [1/m] at arc lengths ``s`` [m] from its start: ``offset (2 pi / L^2) sin(2 pi s / L)``."""
         L = self.length
         return self.offset * 2 * np.pi / L**2 * np.sin(2 * np.pi * s / L)
 
@@ -163,6 +167,7 @@ class ReferencePath:
 
     @property
     def duration(self) -> float:
+        """Length of the run ``T dt`` [s]."""
         return self.T * self.dt
 
     # -- constructors -------------------------------------------------------
@@ -170,7 +175,7 @@ class ReferencePath:
     def from_curvature(cls, kappa: Callable[[np.ndarray], np.ndarray] | Sequence[float] | np.ndarray,
                        *, duration: float | None = None, speed: float = DEFAULT_SPEED,
                        dt: float = 0.1, start: tuple[float, float, float] = (0.0, 0.0, 0.0),
-                       name: str = "") -> "ReferencePath":
+                       name: str = "") -> ReferencePath:
         """Path from a curvature profile.
 
         Parameters
@@ -189,7 +194,7 @@ class ReferencePath:
         """
         speed = check_positive_scalar(speed, "speed")
         dt = check_positive_scalar(dt, "dt")
-        start = as_batch(start, "start", (3,), ("X0, Y0, heading0",))
+        pose0 = as_batch(start, "start", (3,), ("X0, Y0, heading0",))
         if callable(kappa):
             if duration is None:
                 raise ValueError("duration is required when kappa is a function of arc length")
@@ -202,21 +207,21 @@ class ReferencePath:
                                  f"got {k_fine.shape}")
             if not np.all(np.isfinite(k_fine)):
                 raise ValueError("kappa(s) must be finite")
-            h_fine = start[2] + np.concatenate([[0.0], np.cumsum(0.5 * (k_fine[1:] + k_fine[:-1]) * ds)])
+            h_fine = pose0[2] + np.concatenate([[0.0], np.cumsum(0.5 * (k_fine[1:] + k_fine[:-1]) * ds)])
         else:
             k = as_batch(kappa, "kappa", (None,))
             if k.size == 0:
                 raise ValueError("kappa must have at least one sample (a path shorter than one step)")
             T = k.size if duration is None else _n_samples(duration, dt)
-            if T > k.size:
+            if k.size < T:
                 raise ValueError(f"duration {duration} s needs {T} curvature samples, kappa has {k.size}")
             k = k[:T]
             ds = speed * dt / _FINE
             k_fine = np.repeat(k, _FINE)
-            h_fine = start[2] + np.concatenate([[0.0], np.cumsum(k_fine * ds)])
+            h_fine = pose0[2] + np.concatenate([[0.0], np.cumsum(k_fine * ds)])
         c, sn = np.cos(h_fine), np.sin(h_fine)
-        X = start[0] + np.concatenate([[0.0], np.cumsum(0.5 * (c[1:] + c[:-1]) * ds)])
-        Y = start[1] + np.concatenate([[0.0], np.cumsum(0.5 * (sn[1:] + sn[:-1]) * ds)])
+        X = pose0[0] + np.concatenate([[0.0], np.cumsum(0.5 * (c[1:] + c[:-1]) * ds)])
+        Y = pose0[1] + np.concatenate([[0.0], np.cumsum(0.5 * (sn[1:] + sn[:-1]) * ds)])
         idx = np.arange(T + 1) * _FINE
         kappa_mean = np.diff(h_fine[idx]) / (speed * dt)
         return cls(_frozen(kappa_mean), _frozen(X[idx[:-1]]), _frozen(Y[idx[:-1]]),
@@ -226,7 +231,7 @@ class ReferencePath:
     def from_segments(cls, segments: Sequence[Segment], *, duration: float | None = None,
                       speed: float = DEFAULT_SPEED, dt: float = 0.1,
                       start: tuple[float, float, float] = (0.0, 0.0, 0.0),
-                      name: str = "") -> "ReferencePath":
+                      name: str = "") -> ReferencePath:
         """Path from a sequence of road elements (:class:`Straight`, :class:`Curve`, :class:`LaneChange`).
 
         ``duration`` defaults to the time to drive all elements (rounded down to
@@ -248,7 +253,7 @@ class ReferencePath:
 
         def kappa(s):
             out = np.zeros_like(s)
-            for seg, a, b in zip(segments, starts, ends):
+            for seg, a, b in zip(segments, starts, ends, strict=True):
                 inside = (s >= a) & (s < b)
                 out[inside] = seg.curvature(s[inside] - a)
             return out
@@ -257,7 +262,7 @@ class ReferencePath:
 
     @classmethod
     def from_waypoints(cls, X, Y, *, speed: float = DEFAULT_SPEED, dt: float = 0.1,
-                       duration: float | None = None, name: str = "") -> "ReferencePath":
+                       duration: float | None = None, name: str = "") -> ReferencePath:
         """Path through waypoints, by a cubic spline in the chord-length parameter.
 
         The curvature ``(x' y'' - y' x'') / (x'^2 + y'^2)^(3/2)`` of an
@@ -297,12 +302,12 @@ class ReferencePath:
                                   speed=speed, dt=dt, start=start, name=name)
 
     @classmethod
-    def straight(cls, duration: float, *, speed: float = DEFAULT_SPEED, dt: float = 0.1) -> "ReferencePath":
+    def straight(cls, duration: float, *, speed: float = DEFAULT_SPEED, dt: float = 0.1) -> ReferencePath:
         """A straight along the X axis lasting ``duration`` seconds."""
-        return cls.from_curvature(lambda s: np.zeros_like(s), duration=duration, speed=speed, dt=dt,
+        return cls.from_curvature(np.zeros_like, duration=duration, speed=speed, dt=dt,
                                   name="straight")
 
-    def truncated(self, duration: float) -> "ReferencePath":
+    def truncated(self, duration: float) -> ReferencePath:
         """The first ``duration`` seconds of the path (at least one sample)."""
         T = _n_samples(duration, self.dt)
         T = min(T, self.T)

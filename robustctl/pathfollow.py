@@ -9,28 +9,62 @@ Along a :class:`robustctl.path.ReferencePath`::
     x[k+1]   = F x[k] + G alpha[k] + Gk kappa[k]
 
 with ``F, G, Gk`` the ZOH model of the true vehicle
-(:func:`robustctl.models.truck.discretise`), ``kappa`` the path curvature,
-``x_ref``, ``alpha_ff`` the nominal model's steady cornering along the path
-(:func:`robustctl.models.truck.reference_states`; ``x_ref = [beta_1 v, v, 0,
--beta_1] kappa`` with ``beta_1`` the nominal sideslip per unit curvature) and
+(:func:`robustctl.models.truck.discretise`), ``kappa`` the path curvature and
 ``M`` the map from the controller's inputs to the steering angle (``[[1]]``
 for a plain gain, ``[[1, 1]]`` for the doubled steering column
 ``alpha = u1 + u2`` of the applied RLQR designs,
-:data:`robustctl.models.truck.DOUBLED_INPUT_MAP`). The steady-state steering
-feedforward is the same for every controller; with it, the nominal plant
-follows a constant-curvature path with zero error, and errors come from
-transients, the initial offset and payload mismatch.
+:data:`robustctl.models.truck.DOUBLED_INPUT_MAP`).
+
+Set-ups
+-------
+The paper states neither its reference, its initial state nor its weights.
+A :class:`PathFollowingSetup` fixes them, together with the design weights
+``Q``, ``R`` that the controllers of a study share; :data:`SETUPS` holds two:
+
+``"ours"`` (the default; the engineering set-up)
+    ``x_ref`` and ``alpha_ff`` are the nominal model's steady cornering along
+    the path (:func:`robustctl.models.truck.reference_states`; ``x_ref =
+    [beta_1 v, v, 0, -beta_1] kappa``), with the steady-state steering as
+    feedforward: the nominal plant follows a constant-curvature path with
+    zero error, and errors come from transients, the initial offset and the
+    payload mismatch; every state is a *tracking* error. Bryson's weights
+    (:func:`robustctl.models.truck.lqr_weights`) and a 1 m initial offset.
+``"authors"`` (the set-up of the authors' published code)
+    Barbosa et al. (2019), GitHub ``barbosafilipe/robust_lqr``:
+    ``u = K (x - x_ref)`` with no steering feedforward and ``x_ref = [0, 0,
+    rho_ref, theta_ref]`` (``standard_formulation/main.m``: the lateral
+    velocity and the yaw rate are regulated to zero, the paper's
+    "regulation errors" f2-f4), the reference ``rho_ref, theta_ref`` of the
+    nominal truck driven open loop by a smooth steering command
+    (``standard_formulation/parameters.m``; here the path's steady-cornering
+    steering, :func:`robustctl.models.truck.open_loop_reference`), the
+    initial state ``[0, 0, 0.3, -0.1]`` and the weights ``Q = diag(1, 1,
+    25000, 100)``, ``R = 67070 I2`` on the doubled column (``parameters.m``,
+    ``alternative_formulation/model.m``;
+    :func:`robustctl.models.truck.authors_weights`).
+
+Not taken from the code: its sampling time (0.01 s; the paper's 0.1 s is
+kept), its Tustin discretisation (ZOH kept), its per-column saturation at
+0.22 rad (the paper's 0.45 rad on the steering angle is kept), its
+30 s manoeuvre on a straight road (the path is a parameter; the default
+route is ours) and its RLQR gains recomputed online from ``P = I`` (the
+controllers here are steady-state gains; its gains settle within seconds).
 
 :class:`PathFollowing` discretises the scenarios and builds the reference
 once (an optimiser's problem keeps one); :func:`simulate` is the one-call form.
 The simulation itself, the divergence rule and the backends are those of
-:mod:`robustctl.batchsim`.
+:mod:`robustctl.batchsim`. A law that also feeds back the previous steering
+angle (``K_input``, e.g. :mod:`robustctl.hinf_game`'s delayed
+full-information law) runs on the plant augmented by that angle as a state.
 
 References
 ----------
 Morais et al. (2022), Section 4.5.2 (the four objectives f1..f4 and the
 payload cases). K. J. Astrom & R. M. Murray, *Feedback Systems*, 2nd ed.,
 Princeton 2021, Sec. 8.5 (feedforward plus feedback on the tracking error).
+F. M. Barbosa et al., "Robust path-following control for articulated
+heavy-duty vehicles", *Control Engineering Practice* 85 (2019) 246-256, and
+its code, https://github.com/barbosafilipe/robust_lqr (the authors' set-up).
 """
 
 from __future__ import annotations
@@ -41,15 +75,96 @@ from typing import Literal
 
 import numpy as np
 
-from .batchsim import DEFAULT_BOUND, LinearSimulator, SimulationResult
+from ._validation import as_batch, as_float_array, check_bool, check_choice, check_positive_scalar
+from .batchsim import DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
 from .models import truck as _truck
-from .path import ReferencePath
+from .path import LaneChange, ReferencePath, Straight
 
-__all__ = ["PathFollowing", "PathFollowingResult", "simulate", "DEFAULT_INITIAL_ERROR"]
+__all__ = ["PathFollowing", "PathFollowingResult", "PathFollowingSetup", "SETUPS", "get_setup", "simulate",
+           "DEFAULT_INITIAL_ERROR", "code_manoeuvre"]
 
-#: Initial path-following error of :func:`simulate`: the truck starts 1 m to the
+#: Initial path-following error of the ``"ours"`` set-up: the truck starts 1 m to the
 #: left of the path, parallel to it, at steady speed ([ydot, psidot, rho, theta]).
 DEFAULT_INITIAL_ERROR = (0.0, 0.0, 1.0, 0.0)
+
+
+@dataclass(frozen=True)
+class PathFollowingSetup:
+    """How a path-following study is posed: reference, loop, initial state and design weights.
+
+    Attributes
+    ----------
+    name : str
+    reference : {"steady", "open_loop"}
+        ``"steady"``: ``x_ref`` is the nominal model's steady cornering along
+        the path, every state tracked
+        (:func:`robustctl.models.truck.reference_states`). ``"open_loop"``:
+        ``x_ref = [0, 0, rho_ol, theta_ol]`` from the nominal truck driven open
+        loop by the path's steady-cornering steering
+        (:func:`robustctl.models.truck.open_loop_reference`); the lateral
+        velocity and the yaw rate are regulated to zero.
+    feedforward : bool
+        Add the steady-cornering steering ``alpha_per_kappa kappa`` (the
+        reference's steering command) to the feedback.
+    x0 : tuple of 4 floats
+        Initial error ``x[0] - x_ref[0]`` (``x_ref[0] = 0`` at the start of a
+        straight).
+    Q_diag : tuple of 4 floats
+        State weight ``Q = diag(Q_diag)`` of every design of the study.
+    r : float
+        Steering weight on the plain truck; the doubled steering column uses
+        ``R = 2 r I2`` (the cheapest split of a steering angle costs the same,
+        see :func:`robustctl.models.truck.lqr_weights`).
+    source : str
+        Where the choices come from.
+    """
+
+    name: str
+    reference: Literal["steady", "open_loop"]
+    feedforward: bool
+    x0: tuple[float, float, float, float]
+    Q_diag: tuple[float, float, float, float]
+    r: float
+    source: str = ""
+
+    def __post_init__(self):
+        check_choice(self.reference, "reference", ("steady", "open_loop"))
+        check_bool(self.feedforward, "feedforward")
+        as_batch(self.x0, "x0", (4,))
+        if np.any(as_batch(self.Q_diag, "Q_diag", (4,)) < 0):
+            raise ValueError(f"Q_diag must be >= 0, got {self.Q_diag}")
+        check_positive_scalar(self.r, "r")
+
+    def weights(self, *, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """``Q`` (4, 4) and ``R``: ``[[r]]``, or ``2 r I2`` on the doubled steering column."""
+        Q = np.diag(np.asarray(self.Q_diag, dtype=float))
+        return Q, (2.0 * self.r * np.eye(2) if doubled else np.array([[float(self.r)]]))
+
+
+_Q_OURS, _R_OURS = _truck.lqr_weights()
+#: The two set-ups (module docstring): ``"ours"`` (default) and ``"authors"``.
+SETUPS = {
+    "ours": PathFollowingSetup(
+        "ours", "steady", True, DEFAULT_INITIAL_ERROR, tuple(np.diag(_Q_OURS).tolist()), float(_R_OURS[0, 0]),
+        "steady-cornering tracking with feedforward, Bryson's weights (robustctl.models.truck.lqr_weights), "
+        "1 m initial offset"),
+    "authors": PathFollowingSetup(
+        "authors", "open_loop", False, _truck.AUTHORS_X0, _truck.AUTHORS_Q_DIAG, _truck.AUTHORS_R_DOUBLED / 2.0,
+        "Barbosa et al. (2019)'s code, github.com/barbosafilipe/robust_lqr: standard_formulation/main.m "
+        "(loop), parameters.m (reference, x0, Q, R), alternative_formulation/model.m (x0, Q, R)"),
+}
+
+
+def get_setup(setup: str | PathFollowingSetup) -> PathFollowingSetup:
+    """A :class:`PathFollowingSetup` by name (a key of :data:`SETUPS`), or ``setup`` itself."""
+    if isinstance(setup, PathFollowingSetup):
+        return setup
+    if not isinstance(setup, str):
+        raise TypeError(f"setup must be a name ({', '.join(SETUPS)}) or a PathFollowingSetup, "
+                        f"got {type(setup).__name__}")
+    if setup not in SETUPS:
+        raise ValueError(f"unknown setup {setup!r}; valid: {', '.join(SETUPS)}")
+    return SETUPS[setup]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -77,10 +192,26 @@ class PathFollowingResult(SimulationResult):
     path: ReferencePath | None = None
     overloads: tuple | None = None
 
+    def _path(self) -> ReferencePath:
+        if self.path is None:
+            raise ValueError("this result has no path (path=None): the poses need the reference path")
+        return self.path
+
+    def reference_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global position ``(X, Y)`` of the reference, each (T,) or (S, T).
+
+        The path displaced by ``rho_ref`` along its left normal (the path itself for the ``"steady"`` reference).
+        """
+        path = self._path()
+        h = path.heading[: self.T]
+        rho = self.x_ref[..., 2]
+        return path.X[: self.T] - rho * np.sin(h), path.Y[: self.T] + rho * np.cos(h)
+
     @property
     def steering(self) -> np.ndarray:
         """Applied steering angle, shape (B, S, T)."""
         self._need_trajectories()
+        assert self.inputs is not None                 # kept with the errors
         return self.inputs[..., 0]
 
     def pose(self, method: Literal["path", "integrated"] = "path") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -103,15 +234,16 @@ class PathFollowingResult(SimulationResult):
         self._need_trajectories()
         x = self.states
         rho, theta = x[..., 2], x[..., 3]
-        h = self.path.heading[: self.T]
-        X0 = self.path.X[0] - rho[..., 0] * np.sin(h[0])
-        Y0 = self.path.Y[0] + rho[..., 0] * np.cos(h[0])
+        path = self._path()
+        h = path.heading[: self.T]
+        X0 = path.X[0] - rho[..., 0] * np.sin(h[0])
+        Y0 = path.Y[0] + rho[..., 0] * np.cos(h[0])
         if method == "path":
-            return (self.path.X[: self.T] - rho * np.sin(h), self.path.Y[: self.T] + rho * np.cos(h),
+            return (path.X[: self.T] - rho * np.sin(h), path.Y[: self.T] + rho * np.cos(h),
                     h + theta)
         if method != "integrated":
             raise ValueError(f"method must be 'path' or 'integrated', got {method!r}")
-        dt, v = self.path.dt, self.path.speed
+        dt, v = path.dt, path.speed
 
         def integrate(rate, start):
             steps = 0.5 * (rate[..., 1:] + rate[..., :-1]) * dt
@@ -134,7 +266,7 @@ def _scenarios(overloads, T: int) -> tuple:
     items = list(overloads)
     if not items:
         raise ValueError("overloads must not be empty")
-    out = []
+    out: list[float | np.ndarray] = []
     for i, ov in enumerate(items):
         if np.ndim(ov) == 0:
             out.append(float(_truck.check_overload(ov, f"overloads[{i}]")))
@@ -147,6 +279,29 @@ def _scenarios(overloads, T: int) -> tuple:
     return tuple(out)
 
 
+def code_manoeuvre(*, params: _truck.TruckParameters | None = None) -> ReferencePath:
+    """The reference manoeuvre of the authors' code, as a path: 30 s with two sine lane changes.
+
+    ``standard_formulation/parameters.m`` of Barbosa et al. (2019)'s code
+    (GitHub ``barbosafilipe/robust_lqr``) drives the nominal vehicle open
+    loop for 30 s on a straight road with the steering command ``0.01
+    sin(0.4 pi t)`` rad for 5 s from ``t = 10 s`` (a lane change to the left)
+    and its negative from ``t = 20 s`` (back). This is the path whose
+    steady-cornering steering (``alpha_per_kappa kappa``,
+    :func:`robustctl.models.truck.steady_state_cornering`, nominal payload)
+    is that command: straights and two :class:`~robustctl.path.LaneChange`
+    elements of ``5 v`` metres and offset ``0.01 L^2 / (2 pi alpha_per_kappa)``
+    (``L = 5 v``), so the ``"open_loop"`` reference of :data:`SETUPS` along it
+    is the code's ``x_ref`` (at our 0.1 s sampling, ZOH model).
+    """
+    p = _truck._params(params)
+    _, a_per_kappa = _truck.steady_state_cornering(0.0, params=p)
+    L = 5.0 * p.v
+    offset = 0.01 * L**2 / (2.0 * np.pi * a_per_kappa)
+    return ReferencePath.from_segments([Straight(2 * L), LaneChange(offset, L), Straight(L), LaneChange(-offset, L)],
+                                       duration=30.0, speed=p.v, dt=p.dt, name="code manoeuvre")
+
+
 class PathFollowing:
     """The truck along ``path`` at S payload scenarios, ready to simulate gains (checked once).
 
@@ -157,15 +312,17 @@ class PathFollowing:
     overloads : float, or sequence of S floats / (T,) arrays
         Payload overload of each scenario in percent (>= 0); an array gives a
         time-varying payload (e.g. unloading at a stop), sample by sample.
+    setup : str or PathFollowingSetup
+        Reference, loop and initial state (module docstring; default ``"ours"``).
     params : TruckParameters, optional
     nominal_overload : float
         Overload of the model the reference and feedforward are computed on.
     steer_limit : float or None
         Steering saturation [rad] (0.45 in the paper); None for none.
-    feedforward : bool
-        Add the nominal steady-state steering ``alpha_ff`` (default True).
-    x0 : (4,) or (S, 4) array_like
-        Initial error ``x[0] - x_ref[0]`` (default: 1 m left of the path).
+    feedforward : bool, optional
+        Add the reference's steering command (default: the set-up's).
+    x0 : (4,) or (S, 4) array_like, optional
+        Initial error ``x[0] - x_ref[0]`` (default: the set-up's).
     bound : float
         Divergence bound (see :mod:`robustctl.batchsim`).
     input_map : (1, m) array_like, optional
@@ -176,11 +333,12 @@ class PathFollowing:
         ``DeprecationWarning`` (the earlier, implicit behaviour).
     """
 
-    def __init__(self, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParameters | None = None,
-                 nominal_overload: float = 0.0, steer_limit: float | None = _truck.STEER_LIMIT,
-                 feedforward: bool = True, x0=DEFAULT_INITIAL_ERROR, bound: float = DEFAULT_BOUND,
-                 input_map=None):
+    def __init__(self, path: ReferencePath, overloads=0.0, *, setup: str | PathFollowingSetup = "ours",
+                 params: _truck.TruckParameters | None = None, nominal_overload: float = 0.0,
+                 steer_limit: float | None = _truck.STEER_LIMIT, feedforward: bool | None = None, x0=None,
+                 bound: float = DEFAULT_BOUND, input_map=None):
         p = _truck._params(params)
+        self.setup = get_setup(setup)
         if not isinstance(path, ReferencePath):
             raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
         if abs(path.speed - p.v) > 1e-9 * p.v or abs(path.dt - p.dt) > 1e-12:
@@ -198,26 +356,53 @@ class PathFollowing:
             idx = np.stack([np.searchsorted(values, np.broadcast_to(s, (T,))) for s in scen])  # (S, T)
             F, G = Fu[idx], Gu[idx]                                             # (S, T, 4, 4) ...
             w = Gku[idx] * path.kappa[None, :, None]
-        x_ref, a_ff = _truck.reference_states(path.kappa, nominal_overload, params=p)
-        if not isinstance(feedforward, (bool, np.bool_)):
-            raise TypeError(f"feedforward must be a bool, got {type(feedforward).__name__}")
+        if self.setup.reference == "steady":
+            x_ref, a_ff = _truck.reference_states(path.kappa, nominal_overload, params=p)
+        else:
+            x_ref, a_ff = _truck.open_loop_reference(path.kappa, nominal_overload, params=p)
+            x_ref[:, :2] = 0.0                        # lateral velocity and yaw rate regulated to zero
+        feedforward = self.setup.feedforward if feedforward is None else check_bool(feedforward, "feedforward")
+        u_ff = a_ff if feedforward else np.zeros_like(a_ff)
+        x0 = self.setup.x0 if x0 is None else x0
         self._given_map = input_map is not None
         self._linear = LinearSimulator(
-            F, G, x_ref, u_ff=(a_ff if feedforward else np.zeros_like(a_ff))[:, None], w=w, x0=x0,
-            u_limit=steer_limit, input_map=input_map, bound=bound, objectives=_truck.OBJECTIVE_STATES,
-            state_names=_truck.STATE_NAMES, dt=p.dt)
+            F, G, x_ref, u_ff=u_ff[:, None], w=w, x0=x0, u_limit=steer_limit, input_map=input_map, bound=bound,
+            objectives=_truck.OBJECTIVE_STATES, state_names=_truck.STATE_NAMES, dt=p.dt)
+        self._memory: LinearSimulator | None = None    # the plant augmented by the previous steering angle
+        self._memory_args = dict(F=F, G=G, x_ref=x_ref, u_ff=u_ff, w=w, x0=np.asarray(x0, dtype=float),
+                                 steer_limit=steer_limit, bound=bound, dt=p.dt)
         self.path = path
         self.overloads = scen
 
     @property
     def S(self) -> int:
+        """Number of payload scenarios."""
         return self._linear.S
 
     @property
     def T(self) -> int:
+        """Number of samples along the path."""
         return self._linear.T
 
-    def run(self, K, *, keep_trajectories: bool = True, nan_gains: Literal["raise", "flag"] = "raise",
+    def _memory_simulator(self) -> LinearSimulator:
+        """``[x; alpha_prev]``: ``F_a = [[F, 0], [0, 0]]``, ``G_a = [G; 1]`` (built on first use)."""
+        if self._memory is None:
+            a = self._memory_args
+            F, G = a["F"], a["G"]
+            Fa = np.zeros((*F.shape[:-2], 5, 5))
+            Fa[..., :4, :4] = F
+            Ga = np.concatenate([G, np.ones((*G.shape[:-2], 1, 1))], axis=-2)
+
+            def pad(v):                              # the memory state's entry: zero reference, disturbance, start
+                return np.concatenate([v, np.zeros((*v.shape[:-1], 1))], axis=-1)
+
+            self._memory = LinearSimulator(
+                Fa, Ga, pad(a["x_ref"]), u_ff=a["u_ff"][:, None], w=pad(a["w"]), x0=pad(a["x0"]),
+                u_limit=a["steer_limit"], bound=a["bound"], objectives=_truck.OBJECTIVE_STATES,
+                state_names=(*_truck.STATE_NAMES, "alpha_prev"), dt=a["dt"])
+        return self._memory
+
+    def run(self, K, *, K_input=None, keep_trajectories: bool = True, nan_gains: Literal["raise", "flag"] = "raise",
             backend: Literal["numba", "numpy"] = "numba") -> PathFollowingResult:
         """Simulate B gains on every scenario.
 
@@ -225,6 +410,10 @@ class PathFollowing:
         ----------
         K : (m, 4) or (B, m, 4) array_like
             Gains with ``u = K e`` (``m`` = the input map's columns).
+        K_input : (m, 1) or (B, m, 1) array_like, optional
+            Gain on the previous applied (saturated) steering angle, for laws
+            with input memory: ``u[k] = K e[k] + K_input alpha[k-1]``,
+            ``alpha[-1] = 0`` (one-row gains, no input map).
         keep_trajectories : bool
             False keeps only the MSE sums (for optimisers).
         nan_gains : {"raise", "flag"}
@@ -240,7 +429,10 @@ class PathFollowing:
             ``errors`` (B, S, T, 4), ``steering`` (B, S, T), ``mse()`` (B, S, 4)
             in the paper's order f1..f4; ``pose()`` for plotting.
         """
+        if K_input is not None:
+            return self._run_with_memory(K, K_input, keep_trajectories, nan_gains, backend)
         sim = self._linear
+        shape: tuple[int, ...]
         try:
             shape = np.shape(K) if not isinstance(K, (str, bytes)) else ()
         except ValueError:                          # ragged nested lists: check_gains names K
@@ -255,23 +447,47 @@ class PathFollowing:
         res = sim.run(K, keep_trajectories=keep_trajectories, nan_gains=nan_gains, backend=backend)
         return PathFollowingResult(**vars(res), path=self.path, overloads=self.overloads)
 
+    def _run_with_memory(self, K, K_input, keep, nan_gains, backend) -> PathFollowingResult:
+        if self._given_map:
+            raise ValueError("K_input needs one-row gains on the steering angle (no input_map)")
+        Kb, bad = check_gains(K, 4, nan_gains)
+        Ku = as_float_array(K_input, "K_input")
+        Ku = Ku[None] if Ku.ndim == 2 else Ku
+        if Kb.shape[1] != 1 or Ku.ndim != 3 or Ku.shape[1:] != (1, 1) or Ku.shape[0] not in (1, Kb.shape[0]):
+            raise ValueError(f"K_input must have shape (1, 1) or (B, 1, 1) for K of shape (B, 1, 4), "
+                             f"got K {np.shape(K)} and K_input {np.shape(K_input)}")
+        bad_u = ~np.isfinite(Ku).all(axis=(1, 2))
+        if bad_u.any() and nan_gains == "raise":
+            raise ValueError("K_input must have finite entries (found NaN or inf); "
+                             "nan_gains='flag' reports such gains as diverged instead")
+        Ka = np.concatenate([Kb, np.broadcast_to(Ku, (Kb.shape[0], 1, 1))], axis=2)
+        Ka[bad | bad_u] = np.nan                    # flagged by the simulator (nan_gains="flag" here)
+        res = self._memory_simulator().run(Ka, keep_trajectories=keep, nan_gains=nan_gains, backend=backend)
+        fields = vars(res).copy()
+        for name in ("errors", "sq_error_sum", "sq_state_sum", "x_ref"):
+            if fields[name] is not None:
+                fields[name] = fields[name][..., :4]
+        fields["state_names"] = _truck.STATE_NAMES
+        return PathFollowingResult(**fields, path=self.path, overloads=self.overloads)
+
     def __repr__(self) -> str:
-        return (f"PathFollowing(path={self.path.name!r}, S={self.S}, T={self.T}, "
+        return (f"PathFollowing(path={self.path.name!r}, setup={self.setup.name!r}, S={self.S}, T={self.T}, "
                 f"input_map={'given' if self._given_map else 'default'})")
 
 
-def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParameters | None = None,
-             nominal_overload: float = 0.0, steer_limit: float | None = _truck.STEER_LIMIT,
-             feedforward: bool = True, x0=DEFAULT_INITIAL_ERROR, bound: float = DEFAULT_BOUND,
-             keep_trajectories: bool = True, nan_gains: Literal["raise", "flag"] = "raise",
-             input_map=None, backend: Literal["numba", "numpy"] = "numba") -> PathFollowingResult:
+def simulate(K, path: ReferencePath, overloads=0.0, *, setup: str | PathFollowingSetup = "ours",
+             params: _truck.TruckParameters | None = None, nominal_overload: float = 0.0,
+             steer_limit: float | None = _truck.STEER_LIMIT, feedforward: bool | None = None, x0=None,
+             bound: float = DEFAULT_BOUND, keep_trajectories: bool = True,
+             nan_gains: Literal["raise", "flag"] = "raise", input_map=None, K_input=None,
+             backend: Literal["numba", "numpy"] = "numba") -> PathFollowingResult:
     """Truck path following: B gains x S payload scenarios over ``path``, in one call.
 
     ``PathFollowing(path, overloads, ...).run(K, ...)``; see :class:`PathFollowing`
-    (scenarios, input map) and :meth:`PathFollowing.run` (gains, result).
-    A gain of several rows needs ``input_map`` (e.g. ``[[1, 1]]`` for the
-    doubled steering column); without it the rows are summed with a
-    ``DeprecationWarning``.
+    (scenarios, set-up, input map) and :meth:`PathFollowing.run` (gains,
+    ``K_input``, result). A gain of several rows needs ``input_map`` (e.g.
+    ``[[1, 1]]`` for the doubled steering column); without it the rows are
+    summed with a ``DeprecationWarning``.
 
     Returns
     -------
@@ -280,7 +496,7 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, params: _truck.TruckParam
         in the paper's order f1..f4 = MSE of rho, psidot, ydot, theta;
         ``pose()`` for plotting.
     """
-    sim = PathFollowing(path, overloads, params=params, nominal_overload=nominal_overload,
+    sim = PathFollowing(path, overloads, setup=setup, params=params, nominal_overload=nominal_overload,
                         steer_limit=steer_limit, feedforward=feedforward, x0=x0, bound=bound,
                         input_map=input_map)
-    return sim.run(K, keep_trajectories=keep_trajectories, nan_gains=nan_gains, backend=backend)
+    return sim.run(K, K_input=K_input, keep_trajectories=keep_trajectories, nan_gains=nan_gains, backend=backend)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -10,7 +11,7 @@ import numpy as np
 from ._validation import as_matrix, check_choice, check_positive_scalar, check_square
 from .stability import unstabilizable_modes
 
-__all__ = ["Plant"]
+__all__ = ["Plant", "check_plant", "check_vertices"]
 
 _METHODS = ("zoh", "tustin", "euler")
 
@@ -25,6 +26,16 @@ def _frozen_complex(arr: np.ndarray) -> np.ndarray:
     arr = np.array(arr, dtype=complex)
     arr.flags.writeable = False
     return arr
+
+
+def _singular(M: np.ndarray, scale: float) -> bool:
+    """Whether ``M`` is singular up to the rounding of forming it from terms of norm ``scale``.
+
+    Smallest singular value at most ``n eps scale`` (or ``M`` not finite).
+    """
+    if not np.all(np.isfinite(M)):
+        return True
+    return bool(np.linalg.svd(M, compute_uv=False)[-1] <= M.shape[0] * np.finfo(float).eps * scale)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -68,6 +79,7 @@ class Plant:
 
     @property
     def is_discrete(self) -> bool:
+        """Whether the plant is discrete-time (``dt`` given)."""
         return self.dt is not None
 
     @cached_property
@@ -85,12 +97,14 @@ class Plant:
 
     # -- constructors ------------------------------------------------------
     @classmethod
-    def from_continuous(cls, A, B, dt: float | None, method: str = "zoh") -> "Plant":
+    def from_continuous(cls, A, B, dt: float | None, method: str = "zoh") -> Plant:
         """Discretise ``dx/dt = A x + B u`` with sampling time ``dt``.
 
         ``method`` is ``"zoh"`` (exact for piecewise-constant inputs, via
         python-control's ``c2d``), ``"tustin"`` (bilinear; needs ``I - A dt/2``
-        invertible, i.e. no eigenvalue of ``A`` at ``2/dt``) or ``"euler"``
+        invertible, i.e. no eigenvalue of ``A`` at ``2/dt``, up to the
+        rounding of forming it: smallest singular value above
+        ``n eps (1 + ||A|| dt/2)``) or ``"euler"``
         (forward Euler, ``F = I + A dt``, ``G = B dt``). ``dt=None`` keeps the
         plant in continuous time. ``ValueError`` naming ``A`` if ``A dt`` is
         too large for the discrete plant to be finite.
@@ -106,7 +120,8 @@ class Plant:
             if method == "euler":
                 F, G = np.eye(n) + A * dt, B * dt
             else:
-                if method == "tustin" and not np.linalg.cond(np.eye(n) - A * (dt / 2)) < 1 / np.finfo(float).eps:
+                half = A * (dt / 2)
+                if method == "tustin" and _singular(np.eye(n) - half, 1.0 + float(np.linalg.norm(half, 2))):
                     raise ValueError(f"method='tustin' needs I - A dt/2 invertible, but A has an eigenvalue at "
                                      f"2/dt = {2 / dt:g} (dt={dt:g}); use method='zoh' or another dt")
                 import control
@@ -119,7 +134,7 @@ class Plant:
         return cls(F, G, dt)
 
     @classmethod
-    def from_statespace(cls, sys) -> "Plant":
+    def from_statespace(cls, sys) -> Plant:
         """Build a plant from a python-control ``StateSpace`` (its C and D are ignored)."""
         import control
 
@@ -141,3 +156,42 @@ class Plant:
     def __repr__(self) -> str:
         time = "continuous" if self.dt is None else f"dt={self.dt:g}"
         return f"Plant(n={self.n}, m={self.m}, {time})"
+
+
+def check_plant(value, name: str = "plant", *, discrete_for: str | None = None) -> Plant:
+    """``value`` if it is a :class:`~robustctl.Plant`, else ``TypeError`` naming ``name``.
+
+    With ``discrete_for`` (a design's name), a continuous-time plant is refused
+    with a ``ValueError`` that says so.
+    """
+    if not isinstance(value, Plant):
+        raise TypeError(f"{name} must be a robustctl.Plant, got {type(value).__name__}")
+    if discrete_for is not None and not value.is_discrete:
+        raise ValueError(f"{name} must be discrete-time (dt > 0) for {discrete_for}; discretise it first")
+    return value
+
+
+def check_vertices(plant: Plant, vertices, *, reference: str = "plant", non_empty: bool = False) -> list[Plant]:
+    """``[plant, *vertices]``, each vertex checked to be a :class:`~robustctl.Plant` of ``plant``'s size and ``dt``.
+
+    The vertices of a polytope ``conv{plant, *vertices}`` (e.g. the ``vertices``
+    of :func:`robustctl.hinf` and :func:`robustctl.robust_stability`).
+    ``vertices=None`` (and, unless ``non_empty``, an empty list) is the plant
+    alone. ``reference`` names ``plant`` in the messages. ``TypeError`` for
+    anything but a list (or tuple) of plants, ``ValueError`` naming
+    ``vertices[i]`` for a size or sampling time that differs from ``plant``'s.
+    """
+    if vertices is None and not non_empty:
+        return [plant]
+    if isinstance(vertices, Plant) or not isinstance(vertices, Sequence) or isinstance(vertices, (str, bytes)) \
+            or (non_empty and len(vertices) == 0):
+        raise TypeError(f"vertices must be a {'non-empty ' if non_empty else ''}list of robustctl.Plant")
+    for i, v in enumerate(vertices):
+        check_plant(v, f"vertices[{i}]")
+        if (v.n, v.m) != (plant.n, plant.m):
+            raise ValueError(f"vertices[{i}] must have n={plant.n} states and m={plant.m} inputs like {reference}, "
+                             f"got n={v.n}, m={v.m}")
+        if v.dt != plant.dt:
+            raise ValueError(f"vertices[{i}] must have the sampling time of {reference} (dt={plant.dt}), "
+                             f"got dt={v.dt}")
+    return [plant, *vertices]

@@ -25,24 +25,14 @@ placement constraints: an LMI approach", IEEE Trans. Automatic Control
 from __future__ import annotations
 
 import math
-import numbers
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
-from ._validation import check_positive_scalar
+from ._validation import check_positive_scalar, check_real
 
 __all__ = ["Region", "Disk", "HalfPlane", "ConicSector", "as_regions", "describe_regions", "region_lmi"]
-
-
-def _real(value, name: str) -> float:
-    """A finite real number (``bool`` refused); positive ones go through ``check_positive_scalar``."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite, got {value}")
-    return float(value)
 
 
 class Region:
@@ -50,10 +40,12 @@ class Region:
 
     @property
     def L(self) -> np.ndarray:  # pragma: no cover - every region defines it
+        """The symmetric characteristic matrix ``L``."""
         raise NotImplementedError
 
     @property
     def M(self) -> np.ndarray:  # pragma: no cover
+        """The characteristic matrix ``M``."""
         raise NotImplementedError
 
     def real_interval(self) -> tuple[float, float]:  # pragma: no cover
@@ -78,18 +70,21 @@ class Disk(Region):
     radius: float = 1.0
 
     def __post_init__(self):
-        object.__setattr__(self, "center", _real(self.center, "center"))
+        object.__setattr__(self, "center", check_real(self.center, "center"))
         object.__setattr__(self, "radius", check_positive_scalar(self.radius, "radius"))
 
     @property
     def L(self) -> np.ndarray:
+        """The characteristic matrix ``L`` (class docstring)."""
         return np.array([[-self.radius, -self.center], [-self.center, -self.radius]])
 
     @property
     def M(self) -> np.ndarray:
+        """The characteristic matrix ``M`` (class docstring)."""
         return np.array([[0.0, 1.0], [0.0, 0.0]])
 
     def real_interval(self) -> tuple[float, float]:
+        """The open interval of real points in the region."""
         return self.center - self.radius, self.center + self.radius
 
 
@@ -104,7 +99,7 @@ class HalfPlane(Region):
     side: str = "left"
 
     def __post_init__(self):
-        object.__setattr__(self, "boundary", _real(self.boundary, "boundary"))
+        object.__setattr__(self, "boundary", check_real(self.boundary, "boundary"))
         if self.side not in ("left", "right"):
             raise ValueError(f"side must be 'left' or 'right', got {self.side!r}")
 
@@ -114,13 +109,16 @@ class HalfPlane(Region):
 
     @property
     def L(self) -> np.ndarray:
+        """The characteristic matrix ``L`` (class docstring)."""
         return np.array([[-2.0 * self._sign * self.boundary]])
 
     @property
     def M(self) -> np.ndarray:
+        """The characteristic matrix ``M`` (class docstring)."""
         return np.array([[self._sign]])
 
     def real_interval(self) -> tuple[float, float]:
+        """The open interval of real points in the region."""
         return (-math.inf, self.boundary) if self.side == "left" else (self.boundary, math.inf)
 
 
@@ -138,22 +136,25 @@ class ConicSector(Region):
     angle: float = math.pi / 4
 
     def __post_init__(self):
-        object.__setattr__(self, "apex", _real(self.apex, "apex"))
-        angle = _real(self.angle, "angle")
+        object.__setattr__(self, "apex", check_real(self.apex, "apex"))
+        angle = check_real(self.angle, "angle")
         if not 0.0 < angle < math.pi / 2:
             raise ValueError(f"angle must be in (0, pi/2) radians (the half-angle of the sector), got {angle}")
         object.__setattr__(self, "angle", angle)
 
     @property
     def L(self) -> np.ndarray:
+        """The characteristic matrix ``L`` (class docstring)."""
         return -2.0 * self.apex * math.sin(self.angle) * np.eye(2)
 
     @property
     def M(self) -> np.ndarray:
+        """The characteristic matrix ``M`` (class docstring)."""
         s, c = math.sin(self.angle), math.cos(self.angle)
         return np.array([[s, c], [-c, s]])
 
     def real_interval(self) -> tuple[float, float]:
+        """The open interval of real points in the region."""
         return -math.inf, self.apex
 
 

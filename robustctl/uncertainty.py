@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_batch, as_float_array, as_matrix
-from .plant import Plant, _frozen
+from .plant import Plant, _frozen, check_plant
 
-__all__ = ["NormBounded"]
+__all__ = ["NormBounded", "check_norm_bounded"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -43,10 +43,12 @@ class NormBounded:
 
     @property
     def n(self) -> int:
+        """Columns of EF (the number of states)."""
         return self.EF.shape[1]
 
     @property
     def m(self) -> int:
+        """Columns of EG (the number of inputs)."""
         return self.EG.shape[1]
 
     @property
@@ -61,8 +63,7 @@ class NormBounded:
 
     def check_plant(self, plant: Plant) -> None:
         """Raise ``TypeError`` if ``plant`` is not a :class:`Plant`, ``ValueError`` if the sizes do not match it."""
-        if not isinstance(plant, Plant):
-            raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
+        check_plant(plant)
         if (plant.n, plant.m) != (self.n, self.m):
             raise ValueError(f"uncertainty is for n={self.n} states and m={self.m} inputs, "
                              f"plant has n={plant.n}, m={plant.m}")
@@ -101,3 +102,14 @@ class NormBounded:
 
     def __repr__(self) -> str:
         return f"NormBounded(n={self.n}, m={self.m}, p={self.p}, l={self.l})"
+
+
+def check_norm_bounded(value, plant: Plant, name: str = "uncertainty") -> NormBounded:
+    """``value`` if it is a :class:`~robustctl.NormBounded` of ``plant``'s size.
+
+    Otherwise a ``TypeError`` or ``ValueError`` naming ``name``.
+    """
+    if not isinstance(value, NormBounded):
+        raise TypeError(f"{name} must be a robustctl.NormBounded, got {type(value).__name__}")
+    value.check_plant(plant)
+    return value

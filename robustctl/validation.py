@@ -6,8 +6,22 @@ real numbers: booleans, strings, complex values and ``None`` are refused, and
 so are nested lists of unequal lengths. See each function's docstring.
 """
 
-from ._validation import (as_batch, as_float_array, as_matrix, check_bool, check_choice, check_int,
-                          check_positive_scalar, check_spd, check_square)
+from ._validation import (
+    as_batch,
+    as_float_array,
+    as_matrix,
+    as_rng,
+    check_bool,
+    check_choice,
+    check_int,
+    check_positive_scalar,
+    check_positive_vector,
+    check_real,
+    check_spd,
+    check_square,
+)
+from .plant import check_plant, check_vertices
 
 __all__ = ["as_float_array", "as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
-           "check_int", "check_bool", "check_choice"]
+           "check_real", "check_positive_vector", "check_int", "check_bool", "check_choice", "as_rng",
+           "check_plant", "check_vertices"]

@@ -213,7 +213,7 @@ def test_polytope_certificate_holds_inside_the_hull(discrete):
     loops = [p.F + p.G @ K for p in [plant, *vertices]]
     for _ in range(100):
         w = rng.dirichlet(np.ones(4))
-        A = sum(wi * Ai for wi, Ai in zip(w, loops))
+        A = sum(wi * Ai for wi, Ai in zip(w, loops, strict=True))
         V = A.T @ P @ A - P if discrete else A.T @ P + P @ A
         assert np.linalg.eigvalsh(V).max() < 0
     # beyond the margin some vertex ray is (eventually) unstable or no common P exists: never above the ray roots
@@ -331,12 +331,44 @@ def test_guaranteed_cost_bounds_every_sampled_perturbation(seed, n, discrete):
 
 def test_guaranteed_cost_is_infeasible_without_robust_stability():
     plant, K, unc = random_case(1, 4, True, 3.0)
-    with pytest.raises(InfeasibleError, match="not quadratically stable.*margin"):
+    with pytest.raises(InfeasibleError, match=r"not quadratically stable.*margin"):
         rc.guaranteed_cost((plant, K), unc, np.eye(4), np.eye(2))
     unstable = rc.Plant(np.diag([1.1, 0.5]), [[1.0], [0.0]], 0.1)
     with pytest.raises(InfeasibleError, match="nominal closed loop F \\+ G K is unstable"):
         rc.guaranteed_cost((unstable, [[0.0, 0.0]]), rc.NormBounded(np.ones((2, 1)), [[1.0, 0.0]], [[0.0]]),
                            np.eye(2), [[1.0]])
+
+
+def test_bounds_do_not_depend_on_the_units_of_the_weights_and_channels():
+    """Q, R times a^2 and x0 times b scale the cost by (a b)^2; z times a and w times b scale gamma by a b.
+
+    With the weights of the authors' code (R = 33535) the guaranteed-cost LMI without x0 was infeasible,
+    with Q, R times 1e3 the solver stopped (user_limit) and with x0 times 1e-6 the bound came out 4x too high.
+    References: the LQ cost (scipy's Lyapunov solver) and linfnorm at every constant Delta of a grid.
+    """
+    plant = truck.truck_plant(0.0)
+    Q, R = truck.authors_weights()
+    ctrl = rc.lqr(plant, Q=Q, R=R)
+    unc = rc.NormBounded(plant.G, [[0.1, 0.0, 0.0, 0.0]], [[0.1]])
+    x0 = np.array([0.1, 0.0, 0.05, 0.01])
+    Bw, Cz = np.ones((4, 1)), np.vstack([np.sqrt(Q), np.zeros((1, 4))])
+    Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+    given, worst_unit = rc.guaranteed_cost(ctrl, unc, Q, R, x0), rc.guaranteed_cost(ctrl, unc, Q, R)
+    hinf = rc.robust_hinf_bound(ctrl, unc, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    A, H, E = loop(plant, ctrl.K, unc)
+    QK, C = Q + ctrl.K.T @ R @ ctrl.K, Cz + Dzu @ ctrl.K
+    for d in np.linspace(-1.0, 1.0, 21):
+        AD = A + d * H @ E
+        assert lq_cost(AD, QK, x0, True) <= given.bound * (1 + 1e-7)
+        assert np.linalg.eigvalsh(scipy.linalg.solve_discrete_lyapunov(AD.T, QK)).max() <= worst_unit.bound * (1 + 1e-7)
+        assert hinf_norm(AD, Bw, C, np.zeros((5, 1)), plant) <= hinf.gamma * (1 + 1e-6)
+    for a, b in [(1e-6, 1.0), (1e-3, 1e3), (1e3, 1e-3), (1e6, 1e6), (1.0, 1e-6), (1e-6, 1e6)]:
+        res = rc.guaranteed_cost(ctrl, unc, a**2 * Q, a**2 * R, b * x0)
+        assert res.bound / (a * b) ** 2 == pytest.approx(given.bound, rel=1e-6), (a, b)
+        res = rc.guaranteed_cost(ctrl, unc, a**2 * Q, a**2 * R)
+        assert res.bound / a**2 == pytest.approx(worst_unit.bound, rel=1e-6), (a, b)
+        res = rc.robust_hinf_bound(ctrl, unc, Bw=b * Bw, Cz=a * Cz, Dzu=a * Dzu)
+        assert res.gamma / (a * b) == pytest.approx(hinf.gamma, rel=1e-6), (a, b)
 
 
 # ---------------------------------------------------------------- robust H-infinity bound
@@ -437,7 +469,7 @@ def test_results_are_frozen_and_readable():
     assert "RobustStability(certified=True" in repr(res)
     with pytest.raises(dataclasses.FrozenInstanceError):
         res.margin = 2.0
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="read-only"):
         res.P[0, 0] = 1.0
     assert "CostBound(bound=" in repr(rc.guaranteed_cost((plant, K), unc, np.eye(3), np.eye(2)))
     assert "HinfBound(gamma=" in repr(rc.robust_hinf_bound((plant, K), unc, Bw=np.eye(3), Cz=np.eye(3),
@@ -449,11 +481,11 @@ def test_results_are_frozen_and_readable():
 
 def test_bad_input_names_the_argument():
     plant, K, unc = random_case(0, 3, True, 0.05)
-    with pytest.raises(TypeError, match="controller must be a robustctl.Controller or a \\(Plant, K\\) pair"):
+    with pytest.raises(TypeError, match=r"controller must be a robustctl\.Controller or a \(Plant, K\) pair"):
         rc.robust_stability(K, unc)
     with pytest.raises(ValueError, match="K must have 2 rows \\(the number of inputs\\), got shape \\(3, 3\\)"):
         rc.robust_stability((plant, np.eye(3)), unc)
-    with pytest.raises(TypeError, match="uncertainty must be a robustctl.NormBounded"):
+    with pytest.raises(TypeError, match=r"uncertainty must be a robustctl\.NormBounded"):
         rc.robust_stability((plant, K), "big")
     with pytest.raises(ValueError, match="uncertainty is for n=4 states"):
         rc.robust_stability((plant, K), rc.NormBounded(np.ones((4, 1)), np.ones((1, 4)), np.ones((1, 2))))
@@ -463,7 +495,7 @@ def test_bad_input_names_the_argument():
         rc.robust_stability((plant, K), unc, vertices=[plant])
     with pytest.raises(TypeError, match="vertices must be a non-empty list"):
         rc.robust_stability((plant, K), vertices=plant)
-    with pytest.raises(TypeError, match="vertices\\[0\\] must be a robustctl.Plant"):
+    with pytest.raises(TypeError, match=r"vertices\[0\] must be a robustctl\.Plant"):
         rc.robust_stability((plant, K), vertices=[np.eye(3)])
     with pytest.raises(ValueError, match="vertices\\[0\\] must have the sampling time"):
         rc.robust_stability((plant, K), vertices=[rc.Plant(plant.F, plant.G, 0.2)])
@@ -484,5 +516,5 @@ def test_bad_input_names_the_argument():
     for bad in (-1, 2.5, True):
         with pytest.raises(ValueError, match="n_starts must be an integer >= 0"):
             rc.worst_case((plant, K), unc, n_starts=bad)
-    with pytest.raises(TypeError, match="uncertainty must be a robustctl.NormBounded"):
+    with pytest.raises(TypeError, match=r"uncertainty must be a robustctl\.NormBounded"):
         rc.worst_case((plant, K), None)

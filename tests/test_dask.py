@@ -72,7 +72,7 @@ def test_local_cluster_gives_the_serial_records_and_a_rerun_computes_nothing(tmp
 
 
 def test_worker_killed_mid_grid_loses_nothing(tmp_path, serial, cluster):
-    lc, client = cluster
+    _lc, client = cluster
     client.wait_for_workers(2, timeout=60)
     pids = client.run(os.getpid)
     done = {}
@@ -104,11 +104,9 @@ def dask_processes(tmp_path):
         deadline = time.monotonic() + 60
         while not sched_file.exists() and time.monotonic() < deadline:
             time.sleep(0.05)
-        for _ in range(2):
-            procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file",
-                                           str(sched_file), "--nthreads", "1", "--no-dashboard", "--host",
-                                           "127.0.0.1"], cwd=REPO, env=env, stdout=subprocess.DEVNULL,
-                                          stderr=subprocess.DEVNULL))
+        procs += [subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
+                                    "--nthreads", "1", "--no-dashboard", "--host", "127.0.0.1"], cwd=REPO, env=env,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for _ in range(2)]
         with distributed.Client(scheduler_file=str(sched_file), timeout=60) as client:
             client.wait_for_workers(2, timeout=60)
             address = client.scheduler.address
@@ -128,10 +126,10 @@ def test_cli_on_dask_scheduler_and_two_workers(tmp_path, serial, dask_processes,
     out = tmp_path / "res"
     cmd = [sys.executable, "-m", "moo", "experiment", *CLI_GRID, "--out", str(out), "--executor", "dask",
            "--scheduler", dask_processes]
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO, timeout=180)
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO, timeout=180, check=False)
     assert proc.returncode == 0, proc.stderr
     assert _content(out) == serial
-    from moo.__main__ import main                                # the rerun in-process (no second start-up)
+    from moo.__main__ import main  # the rerun in-process (no second start-up)
 
     assert main(cmd[3:]) == 0
     err = capsys.readouterr().err

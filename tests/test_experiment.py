@@ -4,8 +4,15 @@ from __future__ import annotations
 
 import csv
 import json
+import multiprocessing
+import os
+import signal
 import subprocess
 import sys
+import threading
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -99,7 +106,8 @@ def fake_run(monkeypatch):
     calls = []
     state = {"fail_after": None}
 
-    def run(problem, algorithm, *, seed, evals, n_obj=None, molsp=False, pop_size=92, max_leaders=None):
+    def run(problem, algorithm, *, seed, evals, n_obj=None, molsp=False, pop_size=92, max_leaders=None,
+            setup=None):  # runner.run's signature
         if state["fail_after"] is not None and len(calls) >= state["fail_after"]:
             raise KeyboardInterrupt
         calls.append((algorithm, molsp, seed))
@@ -128,9 +136,9 @@ def test_resume_after_interrupt_computes_only_missing_runs(tmp_path, fake_run):
 
 
 def test_resume_rejects_other_settings_and_redoes_corrupt_files(tmp_path, fake_run):
-    calls, _ = fake_run
+    _calls, _ = fake_run
     run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path, progress=False)
-    with pytest.raises(ValueError, match="other settings.*budget"):
+    with pytest.raises(ValueError, match=r"other settings.*budget"):
         run_experiment("zdt1", "nsga2", runs=1, evals=400, out=tmp_path, progress=False)
     spec = plan("zdt1", "nsga2", runs=1, evals=300)[0]
     spec.path(tmp_path).write_text('{"problem": "zdt1", "F": [[1')         # truncated by hand
@@ -237,7 +245,7 @@ def test_cli_out_is_a_file(tmp_path, capsys):
 def test_python_dash_m_exit_code_and_one_line(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "moo", "experiment", "--problem", "zdt1", "--runs", "-1",
                            "--evals", "300", "--out", str(tmp_path / "r")], capture_output=True, text=True,
-                          cwd=Path(__file__).resolve().parents[1])
+                          cwd=Path(__file__).resolve().parents[1], check=False)
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.strip().splitlines() == ["python -m moo: error: --runs must be >= 1, got -1"]
 
@@ -277,7 +285,7 @@ def failing_run(fake_run, monkeypatch):
 
 
 def test_keep_going_records_the_failure_and_finishes_the_grid(tmp_path, failing_run):
-    calls, bad_seed = failing_run
+    _calls, bad_seed = failing_run
     report = run_experiment("zdt1", "nsga2", runs=3, evals=300, out=tmp_path, keep_going=True, progress=False)
     assert (report.completed, len(report.failed)) == (5, 1) and len(load_records(tmp_path)) == 5
     failed = json.loads(report.failed[0].read_text())
@@ -305,7 +313,7 @@ def test_without_keep_going_the_first_failure_stops_the_grid(tmp_path, failing_r
 def test_retried_failure_is_replaced_by_the_record(tmp_path, failing_run, fake_run, monkeypatch):
     run_experiment("zdt1", "nsga2", runs=2, evals=300, out=tmp_path, keep_going=True, progress=False)
     assert len(list(tmp_path.rglob("*.failed.json"))) == 1
-    calls, _ = fake_run
+    _calls, _ = fake_run
     monkeypatch.setattr(moo.runner, "run", lambda problem, algorithm, **kw: _FakeResult(
         problem, algorithm, kw["seed"], kw["evals"], kw.get("n_obj"), kw["molsp"], kw["max_leaders"],
         kw["pop_size"]))
@@ -327,8 +335,6 @@ def test_cli_failures_exit_1_with_one_line(tmp_path, failing_run, capsys):
 
 
 def test_any_executor_thread_pool_gives_the_serial_records(tmp_path):
-    from concurrent.futures import ThreadPoolExecutor
-
     kw = dict(runs=2, evals=60, pop_size=20, progress=False)
     run_experiment("zdt1", "nsga2", out=tmp_path / "serial", **kw)
     with ThreadPoolExecutor(2) as pool:
@@ -339,14 +345,11 @@ def test_any_executor_thread_pool_gives_the_serial_records(tmp_path):
            [[r[k] for k in key] for r in load_records(tmp_path / "threads")]
     with pytest.raises(ValueError, match="not both"):
         run_experiment("zdt1", "nsga2", out=tmp_path / "x", executor=pool, workers=2, **kw)
-    with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
+    with pytest.raises(TypeError, match=r"executor must be a concurrent\.futures\.Executor"):
         run_experiment("zdt1", "nsga2", out=tmp_path / "x", executor="dask", **kw)
 
 
 def test_executor_stops_at_a_failure_and_keeps_what_finished(tmp_path, failing_run, monkeypatch):
-    import time
-    from concurrent.futures import ThreadPoolExecutor
-
     from moo.experiment import RunFailedError
 
     calls, _ = failing_run
@@ -362,6 +365,62 @@ def test_executor_stops_at_a_failure_and_keeps_what_finished(tmp_path, failing_r
     with ThreadPoolExecutor(1) as pool, pytest.raises(RunFailedError):
         run_experiment("zdt1", "nsga2", runs=4, evals=300, out=tmp_path / "b", executor=pool, progress=False)
     assert len(load_records(tmp_path / "b")) == 7
+
+
+def test_killed_pool_process_is_replaced_and_its_runs_recomputed(tmp_path, capsys):
+    """SIGKILL of a pool process mid-grid: a fresh pool reruns what the broken one lost; nothing is missing."""
+    kw = dict(runs=2, evals=4000, pop_size=20, progress=False)
+    run_experiment("zdt1", "nsga2", out=tmp_path / "serial", **kw)
+    done = {}
+    driver = threading.Thread(target=lambda: done.setdefault(
+        "report", run_experiment("zdt1", "nsga2", out=tmp_path / "pool", workers=2, **kw)))
+    driver.start()
+    deadline = time.monotonic() + 120
+    while not any((tmp_path / "pool").rglob("seed_*.json")) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    victims = multiprocessing.active_children()              # the pool's two spawned processes
+    assert len(victims) == 2, "the pool's processes were not found when the first record arrived"
+    os.kill(victims[0].pid, signal.SIGKILL)                  # mid-grid: 3 of the 4 runs are not recorded yet
+    driver.join(timeout=180)
+    assert not driver.is_alive()
+    assert done["report"].completed == 4
+    err = capsys.readouterr().err
+    assert "a pool process died; resubmitting the " in err and "(restart 1 of 3)" in err
+    key = ("molsp", "seed", "F", "X", "hv_history", "n_evals")
+    assert [[r[k] for k in key] for r in load_records(tmp_path / "serial")] == \
+           [[r[k] for k in key] for r in load_records(tmp_path / "pool")]
+
+
+def test_pool_restarts_are_bounded_and_other_executors_stop(tmp_path, capsys):
+    from moo.executors import POOL_RESTARTS, _RestartingPool
+
+    def broken(*args, **kwargs) -> Future:
+        fut: Future = Future()
+        fut.set_exception(BrokenProcessPool("a process in the pool was terminated abruptly"))
+        return fut
+
+    class DiesEveryTime(_RestartingPool):
+        """Every run loses its process (a thread pool stands in for the processes)."""
+
+        pools = 0
+
+        def _new(self):
+            DiesEveryTime.pools += 1
+            return ThreadPoolExecutor(1)
+
+        submit = staticmethod(broken)
+
+    class CannotRestart(ThreadPoolExecutor):
+        submit = staticmethod(broken)
+
+    kw = dict(runs=1, evals=300, pop_size=20, progress=False)
+    with pytest.raises(BrokenProcessPool, match=f"died again after {POOL_RESTARTS} restarts of the pool"):
+        run_experiment("zdt1", "nsga2", out=tmp_path / "a", executor=DiesEveryTime(2), **kw)
+    assert DiesEveryTime.pools == 1 + POOL_RESTARTS and not load_records(tmp_path / "a")
+    assert capsys.readouterr().err.count("resubmitting the 2 runs lost with it") == POOL_RESTARTS
+    with CannotRestart(1) as pool, pytest.raises(BrokenProcessPool, match="terminated abruptly"):
+        run_experiment("zdt1", "nsga2", out=tmp_path / "b", executor=pool, **kw)
+    assert "resubmitting" not in capsys.readouterr().err
 
 
 # ----------------------------------------------------------------------------- CLI: --out, corrupt records, help
@@ -392,7 +451,7 @@ def test_cli_stats_and_plot_name_a_corrupt_record(tmp_path, fake_run, capsys):
 
 
 def test_cli_deprecated_molsp_max_leaders_alias(tmp_path, fake_run, capsys):
-    calls, _ = fake_run
+    _calls, _ = fake_run
     args = ["experiment", "--problem", "zdt1", "--algorithms", "nsga2", "--runs", "1", "--evals", "300"]
     assert main([*args, "--molsp-max-leaders", "3", "--out", str(tmp_path / "a")]) == 0
     assert "--molsp-max-leaders is deprecated, use --max-leaders" in capsys.readouterr().err

@@ -16,12 +16,11 @@ import control
 import numpy as np
 import pytest
 import scipy.linalg
+from test_hinf import MSD_BW, MSD_CZ, MSD_DZU, msd, random_case
+from test_regions import closed_form
 
 import robustctl as rc
 from robustctl import Disk, HalfPlane, InfeasibleError, Plant
-
-from test_hinf import MSD_BW, MSD_CZ, MSD_DZU, msd, random_case
-from test_regions import closed_form
 
 
 def h2_norm(plant, K, Bw, Cz, Dzu, Dzw=None) -> float:
@@ -99,7 +98,7 @@ def test_unreachable_regions_and_bad_input():
         rc.h2(cont, **kw, Dzw=np.ones((3, 2)))
     with pytest.raises(ValueError, match="backoff must be"):
         rc.h2(plant, **kw, backoff=-1)
-    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+    with pytest.raises(TypeError, match=r"plant must be a robustctl\.Plant"):
         rc.h2(np.eye(2), **kw)
     with pytest.raises(ValueError, match=r"Bw must have 2 rows"):
         rc.h2(plant, **{**kw, "Bw": np.ones((3, 1))})
@@ -128,7 +127,7 @@ def test_internal_norm_check(monkeypatch):
     h2_module = importlib.import_module("robustctl.h2")
     monkeypatch.setattr(h2_module, "_h2_norm", lambda *a: 1e9)
     plant, Bw, Cz, Dzu, _ = random_case(0, 3, 1, 1, discrete=True)
-    with pytest.raises(rc.ConvergenceError, match="closed-loop H2 norms .* exceed the guaranteed"):
+    with pytest.raises(rc.ConvergenceError, match=r"closed-loop H2 norms .* exceed the guaranteed"):
         rc.h2(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
 
 

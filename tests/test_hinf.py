@@ -348,11 +348,12 @@ def check_input_bound_sweep(plant, Bw, Cz, Dzu, u_maxes, **kw):
         try:
             ctrl = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, u_max=u_max, **kw)
         except (InfeasibleError, rc.ConvergenceError) as exc:
-            assert np.any(u_max < peak), f"u_max={u_max:g} is inactive (peak {peak}) but: {exc}"
-            assert "u_max" in str(exc) or "backoff" in str(exc)
+            # either outcome is valid: a clear error for an active bound, or a design meeting it
+            assert np.any(u_max < peak), f"u_max={u_max:g} is inactive (peak {peak}) but: {exc}"  # noqa: PT017
+            assert "u_max" in str(exc) or "backoff" in str(exc)  # noqa: PT017
             continue
         assert np.all(ctrl.info["u_bound"] <= u_max * (1 + 1e-9))
-        for p in [plant] + list(kw.get("vertices", [])):
+        for p in [plant, *list(kw.get("vertices", []))]:
             assert np.all(worst_case_input(p, ctrl.K, Bw, 1.0) <= u_max * (1 + 1e-9))
         assert ctrl.gamma_opt >= free.gamma_opt * (1 - RTOL)
         if np.all(u_max >= peak):

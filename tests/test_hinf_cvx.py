@@ -5,14 +5,13 @@ from __future__ import annotations
 import pathlib
 import re
 
+import cvxpy as cp
 import numpy as np
 import pytest
 
-import cvxpy as cp  # noqa: E402  (a dependency: never skip)
-
-from robustctl import _cvx  # noqa: E402
-from robustctl import errors as rc_errors  # noqa: E402
-from robustctl.errors import InfeasibleError  # noqa: E402
+from robustctl import _cvx
+from robustctl import errors as rc_errors
+from robustctl.errors import InfeasibleError
 
 
 def test_margin_and_certificate_are_reported():
@@ -102,7 +101,7 @@ def test_a_solver_crash_is_a_convergence_error(monkeypatch):
 
     monkeypatch.setattr(cp.Problem, "solve", crash)
     X = cp.Variable((2, 2), symmetric=True)
-    with pytest.raises(rc_errors.ConvergenceError, match="crashed internally.*index out of bounds"):
+    with pytest.raises(rc_errors.ConvergenceError, match=r"crashed internally.*index out of bounds"):
         _cvx.solve_sdp(cp.Minimize(cp.trace(X)), [_cvx.LMI("X", X)])
 
     def interrupt(self, *args, **kwargs):

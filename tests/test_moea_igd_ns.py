@@ -43,7 +43,7 @@ PROBLEM2 = Problem(n_var=1, n_obj=2)
 def _igd_ns_loop(Q, A):
     """The definition: sum over A of the nearest distance + distances of non-contributing solutions."""
     def d(x, y):
-        return math.sqrt(sum((a - b) ** 2 for a, b in zip(x, y)))
+        return math.sqrt(sum((a - b) ** 2 for a, b in zip(x, y, strict=True)))
     total, contributing = 0.0, set()
     for y in A:
         dists = [d(x, y) for x in Q]
@@ -232,7 +232,7 @@ def test_archive_on_runs_wrapped_with_molsp():
     res = minimize(problem, molsp(make_moea_igd_ns(n_obj=3), ref_point=np.full(3, 2.0)), ("n_eval", 1500), seed=2)
     A = res.algorithm.survival.archive.get("F")
     # the archive holds mutually non-dominated points only
-    assert not np.any([np.any(np.all(A <= a, axis=1) & np.any(A < a, axis=1)) for a in A])
+    assert not np.any([np.any(np.all(a >= A, axis=1) & np.any(a > A, axis=1)) for a in A])
 
 
 # ----------------------------------------------------------------------------- bad input

@@ -32,7 +32,7 @@ def test_tables_complete():
 @pytest.mark.parametrize("problem, label", [("generic", "result_1"), ("applied", "result_2")])
 def test_transcription_matches_tex(problem, label):
     tex = TEX.read_text()
-    start = tex.index(r"\label{tab:%s}" % label)
+    start = tex.index(rf"\label{{tab:{label}}}")
     body = tex[start:tex.index(r"\end{table*}", start)]
     body = "\n".join(line.split("%")[0] for line in body.splitlines())       # drop LaTeX comments
     pairs = re.findall(r"([0-9.]+E[+-]\d+)\s*\$\\pm\$\s*([0-9.]+E[+-]\d+)(\}?)((?:\$\^\{[^}]*\}\$)?)", body)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import itertools
 import pickle
 
 import numpy as np
@@ -17,8 +18,7 @@ from pymoo.util.ref_dirs import get_reference_directions
 from scipy import stats
 
 from moo.algorithms import ALGORITHMS, make_algorithm
-from moo.molsp import (MOLSP, build_mutants, candidates, leader_scores, molsp, mutation_steps, propose,
-                       repair_bounds)
+from moo.molsp import MOLSP, build_mutants, candidates, leader_scores, molsp, mutation_steps, propose, repair_bounds
 from moo.problems import make_problem
 from moo.runner import run
 
@@ -169,19 +169,19 @@ def test_survival_contract_and_evaluation_count():
         per_gen.setdefault(gen, []).append(size)
         assert n_survive == 12 and same_rng
     rows = ledger.rows
-    for gen, (n_eval, off, mut) in enumerate(rows[1:], start=2):
+    for gen, (_n_eval, off, mut) in enumerate(rows[1:], start=2):
         sizes = per_gen[gen]
         assert sizes[0] == 12 + off
         if mut:
             assert sizes == [12 + off, 12 + mut]
     # every evaluation is accounted for: initial population + offspring + mutants
     assert rows[0][0] == 12
-    for (prev, _, _), (now, off, mut) in zip(rows, rows[1:]):
+    for (prev, _, _), (now, off, mut) in itertools.pairwise(rows):
         assert now - prev == off + mut
     assert a.evaluator.n_eval == 12 + sum(o + m for _, o, m in rows[1:])
     assert a.data["molsp_n_eval"] == sum(m for _, _, m in rows[1:]) > 0
     # budget: MO-LSP never passes it; the run stops as the host does (overshoot < one offspring batch)
-    for n_eval, off, mut in rows[1:]:
+    for n_eval, _off, mut in rows[1:]:
         if mut:
             assert n_eval <= 500
     assert 500 <= a.evaluator.n_eval < 500 + 12
@@ -263,12 +263,12 @@ def test_wrapper_argument_errors():
 
 
 def test_same_seed_same_result_and_global_state_untouched():
-    np.random.seed(123)
-    before = np.random.get_state()[1].copy()
+    np.random.seed(123)  # noqa: NPY002 - the legacy global state is what must stay untouched
+    before = np.random.get_state()[1].copy()  # noqa: NPY002
     a = run("zdt2", "nsga2", seed=5, evals=600, molsp=True, pop_size=20)
     b = run("zdt2", "nsga2", seed=5, evals=600, molsp=True, pop_size=20)
     c = run("zdt2", "nsga2", seed=6, evals=600, molsp=True, pop_size=20)
-    assert np.array_equal(np.random.get_state()[1], before)
+    assert np.array_equal(np.random.get_state()[1], before)  # noqa: NPY002
     assert np.array_equal(a.F, b.F) and np.array_equal(a.X, b.X)
     assert not np.array_equal(a.F, c.F)
 

@@ -52,7 +52,7 @@ def test_from_statespace_roundtrip():
 
 def test_plant_is_immutable():
     p = rc.Plant(np.eye(2), np.ones((2, 1)), 0.1)
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="read-only"):
         p.F[0, 0] = 5.0
 
 
@@ -77,7 +77,7 @@ def test_plant_bad_types_and_methods():
         rc.Plant("abc", np.ones((2, 1)), 0.1)
     with pytest.raises(ValueError, match="method must be one of"):
         rc.Plant.from_continuous(A, B, dt=0.1, method="foh2")
-    with pytest.raises(TypeError, match="sys must be a control.StateSpace"):
+    with pytest.raises(TypeError, match=r"sys must be a control\.StateSpace"):
         rc.Plant.from_statespace(np.eye(2))
 
 
@@ -132,7 +132,7 @@ def test_design_dispatch_errors():
     plant = rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1)
     with pytest.raises(ValueError, match="unknown design method 'pid'; valid: h2, hinf, lqr, rlqr"):
         rc.design("pid", plant)
-    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+    with pytest.raises(TypeError, match=r"plant must be a robustctl\.Plant"):
         rc.design("lqr", np.eye(2))
     assert rc.design("LQR", plant).method == "lqr"
 
@@ -143,7 +143,7 @@ def test_closed_loop_statespace_is_python_controls_feedback_with_minus_K():
     c = rc.lqr(plant)
     cl = c.to_statespace()
     ref = control.feedback(plant.to_statespace(), -c.K)    # python-control feeds back with a minus sign
-    for ours, theirs in zip((cl.A, cl.B, cl.C, cl.D), (ref.A, ref.B, ref.C, ref.D)):
+    for ours, theirs in zip((cl.A, cl.B, cl.C, cl.D), (ref.A, ref.B, ref.C, ref.D), strict=True):
         np.testing.assert_allclose(ours, theirs, atol=1e-14)
     assert cl.dt == 0.1
     x0 = rng.standard_normal(3)
@@ -173,13 +173,13 @@ def test_from_continuous_errors_name_A():
 def test_controller_rejects_non_numeric_and_non_finite_states():
     plant = rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1)
     c = rc.Controller(np.array([[-0.1, -0.2]]), "x", plant)
-    with pytest.raises(TypeError, match="^x must be an array of numbers"):
+    with pytest.raises(TypeError, match=r"^x must be an array of numbers"):
         c("x")
-    with pytest.raises(ValueError, match="^x must have finite entries"):
+    with pytest.raises(ValueError, match=r"^x must have finite entries"):
         c([np.nan, 1.0])
-    with pytest.raises(TypeError, match="^x must contain real numbers, got booleans"):
+    with pytest.raises(TypeError, match=r"^x must contain real numbers, got booleans"):
         c([True, False])
-    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+    with pytest.raises(TypeError, match=r"plant must be a robustctl\.Plant"):
         rc.Controller(np.zeros((1, 2)), "x", np.eye(2))
 
 
@@ -191,7 +191,30 @@ def test_perturb_rejects_booleans_strings_and_non_plants():
                             (1j, TypeError, "^Delta must contain real numbers, got complex")):
         with pytest.raises(err, match=match):
             unc.perturb(plant, bad)
-    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+    with pytest.raises(TypeError, match=r"plant must be a robustctl\.Plant"):
         unc.perturb(np.eye(2), 0.5)
-    with pytest.raises(ValueError, match="^H must be a rectangular array"):
+    with pytest.raises(ValueError, match=r"^H must be a rectangular array"):
         rc.NormBounded([[1.0], [2.0, 3.0]], [[0.1, 0.2]], [[0.3]])
+
+
+def test_one_vertex_check_serves_hinf_h2_and_the_analysis():
+    from robustctl.validation import check_vertices
+
+    plant = rc.Plant(0.5 * np.eye(2), np.ones((2, 1)), 0.1)
+    other = rc.Plant(0.4 * np.eye(2), np.ones((2, 1)), 0.1)
+    assert check_vertices(plant, None) == [plant] and check_vertices(plant, []) == [plant]
+    assert check_vertices(plant, (other,)) == [plant, other]
+    for bad, err, match in (("ab", TypeError, "^vertices must be a list of robustctl.Plant"),
+                            (plant, TypeError, "^vertices must be a list"),
+                            ([other, 1.0], TypeError, r"^vertices\[1\] must be a robustctl.Plant, got float"),
+                            ([rc.Plant(np.eye(3), np.ones((3, 1)), 0.1)], ValueError,
+                             r"^vertices\[0\] must have n=2 states and m=1 inputs like plant, got n=3, m=1"),
+                            ([rc.Plant(np.eye(2), np.ones((2, 1)), None)], ValueError,
+                             r"^vertices\[0\] must have the sampling time of plant \(dt=0.1\), got dt=None")):
+        with pytest.raises(err, match=match):
+            check_vertices(plant, bad)
+    for empty in (None, []):
+        with pytest.raises(TypeError, match=r"^vertices must be a non-empty list"):
+            check_vertices(plant, empty, non_empty=True)
+    with pytest.raises(ValueError, match="like the controller's plant"):
+        rc.robust_stability((plant, np.zeros((1, 2))), vertices=[rc.Plant(np.eye(3), np.ones((3, 1)), 0.1)])

@@ -40,13 +40,14 @@ GENERIC_Z = np.array([
 RANDOM_Z = np.random.default_rng(0).uniform(0.0, 200.0, (10, 5))
 
 
-def _generic_reference(z, *, deltas, x0s, horizon, Q=np.eye(3), R=np.eye(1), aggregate="mean",
-                       penalty=1e6):
+def _generic_reference(z, *, deltas, x0s, horizon, Q=None, R=None, aggregate="mean", penalty=1e6):
     """One individual at a time: design with robustctl.design, simulate with plain loops.
 
     Applies the documented penalty rule: not computable -> 2 penalty; unstable for
     some delta (spectral radius rho >= 1) -> penalty * min(rho, 2); else min(error, penalty).
     """
+    Q = np.eye(3) if Q is None else Q
+    R = np.eye(1) if R is None else R
     out = []
     for zi in np.atleast_2d(z):
         try:
@@ -274,12 +275,26 @@ def _zoh_truck(overload):
     return Phi[:4, :4], Phi[:4, 4], Phi[:4, 5]
 
 
-def _applied_reference(z, problem, *, aggregate="mean"):
-    """One individual, one payload, one time step at a time (no batching anywhere)."""
+def _applied_reference(z, problem, *, aggregate="mean", setup="ours"):
+    """One individual, one payload, one time step at a time (no batching anywhere).
+
+    ``setup="authors"``: the open-loop reference (the nominal ZOH truck driven by the steady-cornering
+    steering, step by step), velocities regulated to zero, no feedforward, start at [0, 0, 0.3, -0.1].
+    """
     pen = problem.penalty
     kappa = problem.path.kappa
     T = kappa.size
     x_ref, alpha_ff = truck.reference_states(kappa, 0.0)
+    x0 = np.array([0.0, 0.0, 1.0, 0.0])                        # start 1 m left of the path
+    if setup == "authors":
+        F0, G0, Gk0 = _zoh_truck(0.0)
+        u_ref = alpha_ff.copy()                                 # the steady-cornering steering command
+        x_ref = np.zeros((T, 4))
+        for k in range(T - 1):
+            x_ref[k + 1] = F0 @ x_ref[k] + G0 * u_ref[k] + Gk0 * kappa[k]
+        x_ref[:, :2] = 0.0
+        alpha_ff = np.zeros(T)
+        x0 = np.array([0.0, 0.0, 0.3, -0.1])
     plants = [_zoh_truck(ov) for ov in problem.overloads]
     out = []
     for zi in np.atleast_2d(z):
@@ -296,7 +311,7 @@ def _applied_reference(z, problem, *, aggregate="mean"):
             continue
         per_payload = []
         for Fd, Gd, Gk in plants:
-            x = x_ref[0] + np.array([0.0, 0.0, 1.0, 0.0])     # start 1 m left of the path
+            x = x_ref[0] + x0
             sq = np.zeros(4)
             for k in range(T):
                 e = x - x_ref[k]
@@ -350,7 +365,7 @@ def test_applied_paper_optimum_is_finite_and_sensible():
     # stable at every payload of the paper's comparison, 0 to 300 % overload
     K = p.gains(p.paper_optimum[None]).K[0]
     F_s, G_s, _ = truck.discretise([0.0, 100.0, 200.0, 300.0])
-    for Fd, Gd in zip(F_s, G_s):
+    for Fd, Gd in zip(F_s, G_s, strict=True):
         assert np.max(np.abs(np.linalg.eigvals(Fd + Gd @ K.sum(axis=0, keepdims=True)))) < 1.0
     # the truck ends up on the path: RMS lateral error well below the 1 m start offset
     assert np.sqrt(f[0]) < 0.5
@@ -487,3 +502,39 @@ def test_applied_experiment_is_the_same_with_workers(tmp_path):
     serial, parallel = load_records(tmp_path / "serial"), load_records(tmp_path / "parallel")
     assert len(serial) == 4
     assert [(r["molsp"], r["seed"], r["F"]) for r in serial] == [(r["molsp"], r["seed"], r["F"]) for r in parallel]
+
+
+# ------------------------------------------------------------ applied, the authors' set-up --
+@pytest.fixture(scope="module")
+def applied_authors():
+    return AppliedRLQRProblem(setup="authors", path=default_route(duration=SHORT_PATH_S))
+
+
+def test_applied_authors_setup_matches_reference(applied_authors):
+    p = applied_authors
+    Q, R = truck.authors_weights(doubled=True)
+    np.testing.assert_array_equal(p.Q, Q)
+    np.testing.assert_array_equal(p.R, R)
+    z = APPLIED_Z[:4]
+    np.testing.assert_allclose(p.evaluate(z), _applied_reference(z, p, setup="authors"), rtol=1e-8)
+    assert p.setup.name == "authors" and "authors" in repr(p)
+
+
+def test_applied_authors_reference_points():
+    p = AppliedRLQRProblem(setup="authors", path=default_route(duration=10.0))
+    np.testing.assert_allclose(p.hv_ref_point, np.square([0.25, 0.035, 0.35, 0.0125]))
+    np.testing.assert_allclose(p.molsp_ref_point, np.square([1.0, 0.04, 0.4, 0.02]))
+    ours = AppliedRLQRProblem(path=default_route(duration=10.0))
+    np.testing.assert_allclose(ours.hv_ref_point, np.square([0.25, 0.0125, 0.15, 0.01]))
+    assert ours.setup.name == "ours"
+
+
+def test_make_problem_passes_the_setup_to_applied_only():
+    from moo.problems import make_problem
+
+    assert make_problem("applied", setup="authors").setup.name == "authors"
+    assert make_problem("applied").setup.name == "ours"
+    with pytest.raises(ValueError, match="setup applies to the 'applied' problem only"):
+        make_problem("zdt1", setup="authors")
+    with pytest.raises(ValueError, match="unknown setup"):
+        make_problem("applied", setup="theirs")

@@ -12,12 +12,11 @@ import math
 
 import numpy as np
 import pytest
+from test_hinf import MSD_BW, MSD_CZ, MSD_DZU, RTOL, cl_norm, msd, random_case
 
 import robustctl as rc
 from robustctl import ConicSector, Disk, HalfPlane, InfeasibleError, Plant
 from robustctl.regions import as_regions, region_lmi
-
-from test_hinf import RTOL, cl_norm, msd, MSD_BW, MSD_CZ, MSD_DZU, random_case
 
 POINTS = np.array([0.0, 0.5, -0.5, 0.95, 1.2, -3.0, 0.3 + 0.4j, 0.3 - 0.4j, -1 + 2j, -2 + 0.5j, -0.1 + 1j, 4j])
 

@@ -4,10 +4,10 @@ import control
 import numpy as np
 import pytest
 import scipy.linalg
+from conftest import GENERIC_F, GENERIC_G, GENERIC_Z_STAR, random_plant
 
 import robustctl as rc
 from robustctl.rlqr import rlqr_step, rlqr_step_block
-from conftest import GENERIC_F, GENERIC_G, GENERIC_Z_STAR, random_plant
 
 
 def _random_case(rng, n=None, m=None, l=None, p=None):
@@ -118,7 +118,7 @@ def test_mu_inf_equals_nullspace_constrained_lqr(seed):
         Bn = plant.G @ N
         try:
             P, _, _ = control.dare(A, Bn, Q + Kp.T @ R @ Kp, N.T @ R @ N, S=Kp.T @ R @ N)
-        except Exception:
+        except Exception:  # noqa: BLE001 - any refusal of control.dare (ControlArgument, LinAlgError, ...): draw again
             continue
         W = -np.linalg.solve(N.T @ R @ N + Bn.T @ P @ Bn, Bn.T @ P @ A + N.T @ R @ Kp)
         break
@@ -174,7 +174,7 @@ def test_finite_horizon_schedule():
     c3 = short.controller(3)
     np.testing.assert_array_equal(c3.K, short.K[3])
     # step 4 (the last) from P_N by hand with the block system
-    L4, K4, P4 = rlqr_step_block(Q, plant.F, plant.G, EF, EG, Q, R, H, 100.0)
+    _L4, K4, P4 = rlqr_step_block(Q, plant.F, plant.G, EF, EG, Q, R, H, 100.0)
     assert _rel(short.K[4], K4) < 1e-10 and _rel(short.P[4], P4) < 1e-10
 
 
@@ -252,7 +252,7 @@ def test_batch_whole_paper_search_space_is_sound():
     assert (b.residual[b.ok] < 1e-10).all()
     rho = np.abs(np.linalg.eigvals(b.L[b.ok])).max(axis=1)
     assert (rho < 1).all()
-    for i in list(range(0, 60, 7)) + [100, 200, 300]:
+    for i in [*list(range(0, 60, 7)), 100, 200, 300]:
         if b.ok[i]:
             ref = rc.rlqr(plant, z[i, None, :4], z[i, None, 4:6], 10 ** np.sqrt(z[i, 6]), accelerate=False,
                           max_iter=200_000)
@@ -304,7 +304,7 @@ def test_rlqr_bad_input(generic_plant, kw, err, match):
 def test_rlqr_rejects_continuous_and_non_plants():
     with pytest.raises(ValueError, match="discrete-time"):
         rc.rlqr(rc.Plant(np.eye(2), np.ones((2, 1)), None), [[1.0, 0.0]], [[1.0]], 1.0)
-    with pytest.raises(TypeError, match="plant must be a robustctl.Plant"):
+    with pytest.raises(TypeError, match=r"plant must be a robustctl\.Plant"):
         rc.rlqr_gains(np.eye(2), [[1.0, 0.0]], [[1.0]], 1.0)
 
 
@@ -380,7 +380,8 @@ def test_uncertainty_object_equals_the_explicit_matrices(generic_plant):
     H, EF, EG = np.array([[1.0], [0.5], [0.2]]), np.array([[0.1, 0.2, 0.2]]), np.array([[0.1]])
     unc = rc.NormBounded(H, EF, EG)
     explicit = rc.rlqr(generic_plant, EF, EG, 1e4, H=H)
-    for c in (rc.rlqr(generic_plant, mu=1e4, uncertainty=unc), rc.design("rlqr", generic_plant, mu=1e4, uncertainty=unc)):
+    for c in (rc.rlqr(generic_plant, mu=1e4, uncertainty=unc),
+              rc.design("rlqr", generic_plant, mu=1e4, uncertainty=unc)):
         np.testing.assert_array_equal(c.K, explicit.K)
     b = rc.rlqr_gains(generic_plant, mu=[1e2, 1e4], uncertainty=unc)
     np.testing.assert_array_equal(b.K[1], explicit.K)
@@ -388,7 +389,7 @@ def test_uncertainty_object_equals_the_explicit_matrices(generic_plant):
     np.testing.assert_array_equal(sch.K, rc.rlqr_schedule(generic_plant, EF, EG, 1e4, H=H, horizon=3).K)
     with pytest.raises(TypeError, match="either uncertainty=NormBounded"):
         rc.rlqr(generic_plant, EF, EG, 1e4, uncertainty=unc)
-    with pytest.raises(TypeError, match="uncertainty must be a robustctl.NormBounded"):
+    with pytest.raises(TypeError, match=r"uncertainty must be a robustctl\.NormBounded"):
         rc.rlqr(generic_plant, mu=1e4, uncertainty=(H, EF, EG))
     with pytest.raises(ValueError, match="uncertainty is for n=3"):
         rc.rlqr(rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1), mu=1e4, uncertainty=unc)

@@ -16,10 +16,20 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 import moo.problems.selection as selection
+import robustctl as rc
 from moo.problems.applied import AppliedRLQRProblem
 from moo.problems.generic import GenericRLQRProblem
-from moo.problems.selection import (BRYSON_SCALES, applied_errors, build_designs, draw_deltas, generic_errors,
-                           monte_carlo_selection, overload_from_delta, select_design)
+from moo.problems.selection import (
+    BRYSON_SCALES,
+    applied_errors,
+    build_designs,
+    draw_deltas,
+    error_scales,
+    generic_errors,
+    monte_carlo_selection,
+    overload_from_delta,
+    select_design,
+)
 from paper_repro import design_selection
 from robustctl.models import truck
 from robustctl.path import default_route
@@ -204,6 +214,30 @@ def test_applied_errors_scales_and_plain_truck_gains(applied):
     np.testing.assert_allclose(applied_errors(K1[None], deltas, path=applied.path, scales=sigma), ref,
                                rtol=1e-12)
     assert BRYSON_SCALES == (0.25, 0.1, 0.5, 0.05)
+    np.testing.assert_array_equal(error_scales("ours"), BRYSON_SCALES)
+
+
+def test_applied_errors_in_the_authors_setup(applied):
+    """The authors' loop and 1 / sqrt(Q_ii) of their Q as scales: E = sum_k e' Q e, from a direct run."""
+    Q, R = truck.authors_weights()
+    K = -control.dlqr(truck.truck_plant().F, truck.truck_plant().G, Q, R)[0]
+    deltas = [-1.0, 0.3]
+    E = applied_errors(K[None], deltas, path=applied.path, setup="authors")
+    res = simulate(K, applied.path, list(overload_from_delta(deltas)), setup="authors")
+    ref = np.einsum("stj,jk,stk->s", res.errors[0], Q, res.errors[0])
+    np.testing.assert_allclose(E[0], ref, rtol=1e-10)
+    np.testing.assert_allclose(error_scales("authors"), [1 / np.sqrt(25000.0), 1.0, 1.0, 0.1])
+    assert not np.allclose(E, applied_errors(K[None], deltas, path=applied.path))
+
+
+def test_select_design_uses_the_problems_setup():
+    prob = AppliedRLQRProblem(setup="authors", path=default_route(duration=15.0))
+    X = np.array([truck.RLQR_MOP_Z, [10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 100.0]])
+    sel = select_design(prob, X, n_sims=5, seed=2)
+    np.testing.assert_allclose(sel.errors, applied_errors(sel.designs.K, sel.deltas, path=prob.path,
+                                                          setup="authors"), rtol=1e-12)
+    Q, R = truck.authors_weights(doubled=True)
+    np.testing.assert_allclose(sel.designs.K[sel.designs.index("nominal")], rc.lqr(prob.plant, Q=Q, R=R).K)
 
 
 # ---------------------------------------------------------------------------
@@ -340,9 +374,35 @@ def test_script_end_to_end(problem, extra, tmp_path, capsys):
     if problem == "applied":
         assert [d["label"] for d in rec["designs"][-3:]] == ["nominal", "RLQR^A", "random"]
         if win["kind"] != "nominal":
-            line = next(t for t in text.splitlines() if "mse_table.py --z" in t)
+            line = next(t for t in text.splitlines() if "mse_table.py --setup ours --z" in t)
             z = [float(v) for v in line.split("--z")[1].split()]
             np.testing.assert_allclose(z, win["z"], rtol=1e-7)
+
+
+def test_script_authors_setup_records_setup_and_margins(tmp_path, capsys):
+    out = tmp_path / "authors"
+    argv = ["--problem", "applied", "--setup", "authors", "--evals", "24", "--pop-size", "12", "--seed", "3",
+            "--sims", "4", "--horizon-steps", "25", "--out", str(out)]
+    assert design_selection.main(argv) == 0
+    text = capsys.readouterr().out
+    rec = json.loads((out / "selection.json").read_text())
+    assert rec["setup"] == "authors" and "(set-up authors)" in text
+    np.testing.assert_allclose(rec["scales"], [1 / np.sqrt(25000.0), 1.0, 1.0, 0.1])
+    m = rec["winner"]["margins"]
+    assert set(m) == {"polytope 0-300 %", "appendix (printed)", "appendix (computed)"}
+    assert "winner's certified robust-stability margin" in text
+    # the margin of the winner's steering gain, recomputed with the analysis engine
+    Q, R = truck.authors_weights()
+    if rec["winner"]["kind"] == "nominal":
+        K = rc.lqr(truck.truck_plant(), Q=Q, R=R).K
+    else:
+        prob = AppliedRLQRProblem(setup="authors", path=default_route(duration=5.0))
+        K = prob.gains(np.array(rec["winner"]["z"])).K[0].sum(axis=0, keepdims=True)
+    ref = rc.robust_stability((truck.truck_plant(), K),
+                              vertices=[truck.truck_plant(k) for k in (100.0, 200.0, 300.0)])
+    assert m["polytope 0-300 %"] == pytest.approx(ref.margin, rel=1e-6)
+    with pytest.raises(SystemExit):
+        design_selection.main(["--problem", "generic", "--setup", "authors", "--out", str(tmp_path / "g")])
 
 
 def test_script_rejects_bad_options(tmp_path):

@@ -21,9 +21,9 @@ import numpy as np
 import pytest
 
 import robustctl as rc
+from robustctl.batchsim import LinearSimulator
 from robustctl.models import truck
 from robustctl.path import Curve, ReferencePath, Straight, default_route
-from robustctl.batchsim import LinearSimulator
 from robustctl.pathfollow import PathFollowing
 from robustctl.simulate import SimulationResult, simulate, simulate_linear
 
@@ -55,7 +55,7 @@ def test_feedforward_holds_nominal_plant_on_an_arc(backend):
     path = ReferencePath.from_curvature(np.full(300, 1 / 250))
     res = simulate(np.zeros((1, 4)), path, 0.0, x0=np.zeros(4), backend=backend)
     np.testing.assert_allclose(res.errors, 0.0, atol=1e-10)
-    x_ss, a_ss = truck.steady_state_cornering(0.0)
+    _x_ss, a_ss = truck.steady_state_cornering(0.0)
     np.testing.assert_allclose(res.steering, a_ss / 250, rtol=1e-12)
     # a heavier truck with the nominal feedforward drifts off the path (more understeer)
     heavy = simulate(np.zeros((1, 4)), path, 100.0, x0=np.zeros(4), backend=backend)
@@ -167,7 +167,7 @@ def test_divergence_is_flagged_without_warnings(backend):
 def test_pose_on_a_straight():
     path = ReferencePath.straight(5.0)
     res = simulate(np.zeros((1, 4)), path, 0.0, x0=[0, 0, 1.0, 0])
-    X, Y, h = res.pose()
+    X, Y, _h = res.pose()
     np.testing.assert_allclose(Y[0, 0], res.states[0, 0, :, 2])
     np.testing.assert_allclose(X[0, 0], path.X)
 
@@ -309,7 +309,7 @@ def test_kernel_on_saturated_designs_is_bounded_and_close_to_numpy(population):
     assert np.all(np.isfinite(res.errors)) and np.all(np.isfinite(res.steering))
     assert np.max(np.abs(res.steering)) <= truck.STEER_LIMIT
     assert np.max(np.abs(res.errors)) <= 1e3 and np.all(res.mse() <= 1e6)
-    for b, s in zip(*np.nonzero(res.diverged)):
+    for b, s in zip(*np.nonzero(res.diverged), strict=True):
         np.testing.assert_array_equal(np.abs(res.errors[b, s, res.diverged_step[b, s]:]), 1e3)
     assert np.all(res.saturated_steps <= sim.T)
 

@@ -79,6 +79,93 @@ def test_continuous_stabilisability():
     assert rc.Plant(np.diag([-0.3, 1.0]), [[0.0], [1.0]], None).is_stabilizable
 
 
+@pytest.mark.parametrize("discrete", [True, False])
+def test_a_boundary_mode_of_a_large_plant_is_found_at_a_tolerance_that_scales_with_its_norm(discrete):
+    """An uncontrollable mode exactly on the boundary (1, or 0 in continuous time) of a plant with
+    ||F|| ~ 1e6 is computed ~1e-10 away from it (eigenvalues are exact to ~eps ||F||): an absolute
+    1e-12 would call it stable; UNSTABLE_TOL * max(1, ||[F G]||) does not, in either time domain."""
+    from robustctl.stability import UNSTABLE_TOL
+
+    boundary = 1.0 if discrete else 0.0
+    rng = np.random.default_rng(1)
+    missed = 0
+    for _ in range(20):
+        T = rng.standard_normal((3, 3)) + 3 * np.eye(3)
+        F = T @ np.diag([-1e6, -3e5, boundary]) @ np.linalg.inv(T)
+        G = T @ np.array([[1.0], [1.0], [0.0]])                     # the boundary mode is not reached
+        lam = np.linalg.eigvals(F)
+        found = lam[np.argmin(np.abs(lam - boundary))]
+        distance = 1.0 - abs(found) if discrete else -found.real
+        missed += distance > UNSTABLE_TOL                          # what the absolute rule would miss
+        plant = rc.Plant(F, G, 0.1 if discrete else None)
+        np.testing.assert_allclose(plant.unstabilizable_modes, [found])
+        with pytest.raises(rc.NotStabilizableError, match=r"plant is not stabilisable: its mode lambda"):
+            rc.stability.check_stabilizable(plant)
+        reachable = rc.Plant(F, T @ np.ones((3, 1)), plant.dt)     # the same mode, reached by the input
+        assert reachable.is_stabilizable
+    assert missed >= 3       # the case has teeth (about half the draws fall on the stable side)
+
+
+def test_immovable_modes_at_chosen_eigenvalues():
+    from robustctl.stability import immovable_modes
+
+    F, G = np.diag([0.5, 0.2, -0.7]), np.array([[0.0], [1.0], [0.0]])      # 0.5 and -0.7 are not reached
+    np.testing.assert_allclose(np.sort(immovable_modes(F, G, lambda z: np.abs(z) > 0.3).real), [-0.7, 0.5])
+    np.testing.assert_allclose(immovable_modes(F, G, lambda z: z.real > 0.3), [0.5])
+    assert immovable_modes(F, G, lambda z: np.abs(z) < 0.3).size == 0          # 0.2 is reached
+    with pytest.raises(ValueError, match=r"^G must have 3 rows"):
+        immovable_modes(F, np.ones((2, 1)), lambda z: z.real > 0)
+
+
+def test_every_design_raises_not_stabilizable_error_naming_the_vertex():
+    bad = rc.Plant(np.diag([1.2, 0.5]), [[0.0], [1.0]], 0.1)
+    good = rc.Plant(np.diag([1.2, 0.5]), [[1.0], [1.0]], 0.1)
+    kw = dict(Bw=np.eye(2), Cz=np.vstack([np.eye(2), [[0, 0]]]), Dzu=[[0.0], [0.0], [1.0]])
+    for design in (lambda: rc.lqr(bad), lambda: rc.rlqr(bad, [[0.1, 0.1]], [[0.1]], 1e4),
+                   lambda: rc.hinf(bad, **kw), lambda: rc.h2(bad, **kw)):
+        with pytest.raises(rc.NotStabilizableError, match=r"^plant is not stabilisable: its mode lambda = 1\.2"):
+            design()
+    for design in (rc.hinf, rc.h2):
+        with pytest.raises(rc.NotStabilizableError, match=r"^vertices\[0\] is not stabilisable"):
+            design(good, **kw, vertices=[bad])
+
+
+def test_spectral_abscissa_matches_the_eigenvalues():
+    from robustctl.stability import spectral_abscissa
+
+    A = np.random.default_rng(2).standard_normal((5, 3, 3))
+    np.testing.assert_allclose(spectral_abscissa(A), np.linalg.eigvals(A).real.max(axis=-1), rtol=1e-12)
+    assert isinstance(spectral_abscissa(A[0]), float)
+    np.testing.assert_array_equal(spectral_abscissa(np.stack([-np.eye(2), np.full((2, 2), np.nan)])), [-1.0, np.inf])
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_every_stability_decision_uses_the_one_margin(discrete):
+    """A loop inside the margin (rho = 1 - 1e-12, or abscissa -1e-12) is unstable for the controller, the
+    LMI syntheses' internal check, the robust analysis and the worst-case search alike."""
+    from robustctl.hinf._synthesis import check_closed_loop
+
+    edge = 1.0 if discrete else 0.0
+    plant = rc.Plant([[edge + 1e-12]], [[1.0]], 1.0 if discrete else None)
+    ctrl = rc.Controller([[-2e-12]], "x", plant)                       # F + G K = edge - 1e-12
+    assert abs(ctrl.closed_loop()[0, 0] - edge) < 2e-12
+    assert not ctrl.is_stabilizing()
+    with pytest.raises(rc.ConvergenceError, match="does not stabilise plant"):
+        check_closed_loop(ctrl.K, [plant])
+    unc = rc.NormBounded([[1.0]], [[0.1]], [[0.0]])
+    res = rc.robust_stability(ctrl, unc)
+    assert not res.certified and res.margin == 0.0 and res.P is None
+    assert not rc.robust_stability(ctrl, vertices=[plant]).certified
+    wc = rc.worst_case(ctrl, rc.NormBounded([[0.0]], [[0.0]], [[0.0]]), seed=0, n_starts=0)
+    assert wc.destabilizing and wc.radius == pytest.approx(edge - 1e-12, abs=1e-15)
+    with pytest.raises(rc.InfeasibleError, match="nominal closed loop F \\+ G K is unstable"):
+        rc.guaranteed_cost(ctrl, unc, [[1.0]], [[1.0]])
+    stable = rc.Controller([[-1e-6]], "x", plant)                       # 1e-6 inside: stable everywhere
+    assert stable.is_stabilizing() and not rc.worst_case(stable, rc.NormBounded([[0.0]], [[0.0]], [[0.0]]),
+                                                         n_starts=0).destabilizing
+    check_closed_loop(stable.K, [plant])
+
+
 def _rotation(r, phi):
     """r times a rotation by phi: eigenvalues r e^(+-i phi), spectral radius r."""
     return r * np.array([[np.cos(phi), -np.sin(phi)], [np.sin(phi), np.cos(phi)]])

@@ -10,9 +10,19 @@ import numpy as np
 import pytest
 from scipy import stats as sps
 
-from moo.stats import (INDICATORS, Comparison, RunIndicators, compare, pairwise_test, reference_sets,
-                       run_indicators, to_csv, to_latex, to_markdown, true_front)
-
+from moo.stats import (
+    INDICATORS,
+    Comparison,
+    RunIndicators,
+    compare,
+    pairwise_test,
+    reference_sets,
+    run_indicators,
+    to_csv,
+    to_latex,
+    to_markdown,
+    true_front,
+)
 
 # ----------------------------------------------------------------------------- ANOVA / Tukey wrapper
 
@@ -192,8 +202,17 @@ def test_comparison_is_frozen():
 
 # ----------------------------------------------------------------------------- nonparametric statistics
 
-from moo.stats import (FriedmanResult, friedman, friedman_test, holm, nemenyi_cd, rank_sum_test,  # noqa: E402
-                       ranks_to_csv, ranks_to_latex, ranks_to_markdown)
+from moo.stats import (  # noqa: E402
+    FriedmanResult,
+    friedman,
+    friedman_test,
+    holm,
+    nemenyi_cd,
+    rank_sum_test,
+    ranks_to_csv,
+    ranks_to_latex,
+    ranks_to_markdown,
+)
 
 # Demsar (2006), Table 6: AUC of C4.5, C4.5+m, C4.5+cf, C4.5+m+cf on 14 UCI data sets (as printed).
 DEMSAR_AUC = np.array([
@@ -229,21 +248,21 @@ def test_friedman_and_nemenyi_against_demsar_2006():
         res = FriedmanResult("demsar", "auc", names, tuple(ranks), N, chi2, p, nemenyi_cd(k, N, alpha), alpha)
         assert {(a, b) for i, a in enumerate(names) for b in names[i + 1:] if res.differs(a, b)} == pairs
         P = res.nemenyi_p()
-        assert np.array_equal(P < alpha, np.array([[res.differs(a, b) for b in names] for a in names]))
+        assert np.array_equal(alpha > P, np.array([[res.differs(a, b) for b in names] for a in names]))
         assert np.allclose(P, P.T) and np.all(np.diag(P) == 1)
 
 
 def test_nemenyi_q_table_of_demsar():
     """Demsar (2006), Table 5(a): q_0.05 for k = 2..10 (Studentized range / sqrt 2, three decimals)."""
     table = [1.960, 2.343, 2.569, 2.728, 2.850, 2.949, 3.031, 3.102, 3.164]
-    for k, q in zip(range(2, 11), table):
+    for k, q in zip(range(2, 11), table, strict=True):
         assert nemenyi_cd(k, 1, 0.05) / math.sqrt(k * (k + 1) / 6) == pytest.approx(q, abs=1.5e-3)
 
 
 def test_friedman_two_treatments_is_the_sign_test():
     """With k = 2 and no ties, Friedman's chi2 equals (n_+ - n_-)^2 / n (the sign test's statistic)."""
     rng = np.random.default_rng(3)
-    X = rng.normal(size=(15, 2)) + [0.0, 0.4]
+    X = rng.normal(size=(15, 2)) + np.array([0.0, 0.4])   # shifted columns
     ranks, chi2, p, _ = friedman_test(X)
     wins = int(np.sum(X[:, 0] < X[:, 1]))
     assert chi2 == pytest.approx((wins - (15 - wins)) ** 2 / 15, rel=1e-12)

@@ -18,7 +18,7 @@ def _hand_model(m, J, p=P):
     rho' = ydot + v theta;  theta' = r - v kappa.
     """
     def f(x, alpha, kappa):
-        ydot, r, rho, theta = x
+        ydot, r, _rho, theta = x
         Ff = p.c1 * (alpha - (ydot + p.a * r) / p.v)
         Fr = p.c2 * (-(ydot - p.b * r) / p.v)
         return np.array([(Ff + Fr) / m - p.v * r, (p.a * Ff - p.b * Fr) / J,
@@ -113,6 +113,7 @@ def test_batched_discretisation_equals_single():
     for i, ov in enumerate([0.0, 150.0, 300.0]):
         F1, G1, Gk1 = truck.discretise(ov)
         np.testing.assert_allclose(F[i], F1[0], rtol=1e-13)
+        np.testing.assert_allclose(G[i], G1[0], rtol=1e-13)
         np.testing.assert_allclose(Gk[i], Gk1[0], rtol=1e-13)
 
 
@@ -215,3 +216,57 @@ def test_truck_plant_does_not_import_python_control():
             "print('control' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+# -- the authors' set-up (Barbosa et al. 2019's published code) ---------------------------------------
+def test_authors_weights_and_constants():
+    """The values of barbosafilipe/robust_lqr's parameters.m / model.m, mapped to the 4 states."""
+    Q, R = truck.authors_weights()
+    np.testing.assert_array_equal(Q, np.diag([1.0, 1.0, 25000.0, 100.0]))
+    np.testing.assert_array_equal(R, [[33535.0]])
+    _, R2 = truck.authors_weights(doubled=True)
+    np.testing.assert_array_equal(R2, 67070.0 * np.eye(2))
+    assert truck.AUTHORS_X0 == (0.0, 0.0, 0.3, -0.1)
+    assert truck.CODE_EG == (-0.0666666666666667, -0.0066666666666667)
+    np.testing.assert_allclose(truck.CODE_EG, [-1 / 15, -1 / 150], rtol=1e-14)
+
+
+def test_authors_doubled_weight_gives_the_single_column_lqr():
+    """R = 67070 I2 on [G G] and R = 33535 on G give the same steering gain (python-control's dlqr)."""
+    Q, R1 = truck.authors_weights()
+    _, R2 = truck.authors_weights(doubled=True)
+    p1, p2 = truck.truck_plant(0.0), truck.truck_plant(0.0, doubled=True)
+    K1 = -control.dlqr(p1.F, p1.G, Q, R1)[0]
+    K2 = -control.dlqr(p2.F, p2.G, Q, R2)[0]
+    # the doubled column's Riccati equation is worse conditioned (G2 has rank 1): a few 1e-9 across BLAS kernels
+    np.testing.assert_allclose(K2.sum(axis=0, keepdims=True), K1, rtol=1e-7)
+
+
+@pytest.mark.parametrize("overload", [0.0, 150.0])
+def test_open_loop_reference_matches_dlsim(overload):
+    """The open-loop reference against scipy.signal.dlsim of the ZOH model with inputs (u_ref, kappa)."""
+    import scipy.signal
+
+    rng = np.random.default_rng(3)
+    kappa = np.convolve(rng.normal(0, 2e-3, 400), np.ones(25) / 25, mode="same")
+    x_ref, u_ref = truck.open_loop_reference(kappa, overload)
+    _, a_per_kappa = truck.steady_state_cornering(overload)
+    np.testing.assert_allclose(u_ref, a_per_kappa * kappa, rtol=1e-15)
+    A, B, E = truck.continuous_model(overload)
+    sysd = scipy.signal.cont2discrete((A, np.column_stack([B, E]), np.eye(4), np.zeros((4, 2))), P.dt, "zoh")
+    _, y, _ = scipy.signal.dlsim((*sysd[:4], P.dt), np.column_stack([u_ref, kappa]))
+    np.testing.assert_allclose(x_ref, y, rtol=1e-9, atol=1e-12 * np.abs(y).max())
+
+
+def test_open_loop_reference_of_steady_cornering_settles_on_the_steady_state():
+    """On a long constant bend the open-loop vehicle's velocities settle at the steady cornering values."""
+    kappa = np.full(3000, 1 / 300.0)
+    x_ref, _ = truck.open_loop_reference(kappa)
+    x_ss, _ = truck.steady_state_cornering(0.0)
+    np.testing.assert_allclose(x_ref[-1, :2], x_ss[:2] / 300.0, rtol=1e-9)
+
+
+def test_curvature_input_does_not_depend_on_the_payload():
+    """Gk is the same at every payload, so the curvature cancels from x - x_ref (open_loop_reference)."""
+    _, _, Gk = truck.discretise([0.0, 100.0, 300.0])
+    np.testing.assert_allclose(Gk[1:], np.broadcast_to(Gk[0], (2, 4)), rtol=1e-12, atol=1e-15)

@@ -1,12 +1,21 @@
 """Property-based checks: any malformed input gives ValueError/TypeError naming the argument,
 never a NaN, a hang or an exception from deep inside numpy."""
 
+import collections
+import functools
+import os
+import re
+
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import robustctl as rc
+from robustctl.hinf_riccati import hinf_riccati
+from robustctl.lqr import dare
+from robustctl.rlqr import rlqr_step, rlqr_step_block
+from robustctl.stability import unstabilizable_modes
 
 dims = st.integers(1, 4)
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -63,9 +72,13 @@ def test_non_finite_entries_are_named(where, value):
             "EG": np.array([[1.0, 0.5]]), "Q": np.eye(2), "R": np.eye(2), "H": np.ones((2, 1))}
     data[where] = data[where].copy()
     data[where][0, 0] = value
+
+    def design():  # Plant (F, G) or rlqr (the others) refuses the entry
+        rc.rlqr(rc.Plant(data["F"], data["G"], 0.1), data["EF"], data["EG"], 10.0, Q=data["Q"], R=data["R"],
+                H=data["H"])
+
     with pytest.raises(ValueError, match=rf"^{where} must have finite entries"):
-        plant = rc.Plant(data["F"], data["G"], 0.1)
-        rc.rlqr(plant, data["EF"], data["EG"], 10.0, Q=data["Q"], R=data["R"], H=data["H"])
+        design()
 
 
 @SETTINGS
@@ -89,10 +102,6 @@ def test_batch_never_returns_unflagged_nan(B, seed):
 # entry, a junk object. Handled well = ValueError/TypeError whose message starts with the argument's name
 # (the project's subclasses count). TALLY counts cases tried / handled well per (function, cause); set
 # ROBUSTCTL_TALLY=<file> to write the table.
-import collections
-import os
-import re
-
 TALLY = collections.defaultdict(lambda: [0, 0])
 
 F2, G2 = np.array([[1.1, 0.2], [0.0, 0.9]]), np.array([[0.0], [1.0]])
@@ -101,6 +110,7 @@ EF2, EG2, H2 = np.array([[0.1, 0.2]]), np.array([[0.1]]), np.ones((2, 1))
 UNC = rc.NormBounded(H2, EF2, EG2)
 CTRL = rc.rlqr(PLANT, EF2, EG2, 1e4)
 A2 = np.array([[0.0, 1.0], [-2.0, -3.0]])
+I1, I2, X2, DELTA2 = np.eye(1), np.eye(2), np.ones(2), np.array([0.5, -0.5])   # valid default values
 RLQR_ARGS = {"EF": EF2, "EG": EG2, "mu": 1e4, "Q": np.eye(2), "R": np.eye(1), "H": H2, "alpha": 0.1,
              "tol": 1e-10, "max_iter": 100}
 
@@ -127,10 +137,6 @@ def _step(**kw):
     return rlqr_step(**a), rlqr_step_block(**a)
 
 
-from robustctl.lqr import dare  # noqa: E402
-from robustctl.rlqr import rlqr_step, rlqr_step_block  # noqa: E402
-from robustctl.stability import unstabilizable_modes  # noqa: E402
-
 # function -> {argument: (valid value, kind)}; kind "matrix", "scalar" (inf allowed where the function says),
 # "int", "flag", "choice"
 CASES = {
@@ -139,16 +145,16 @@ CASES = {
                               {"A": A2, "B": G2, "dt": 0.1, "method": "zoh"}),
     "NormBounded": (lambda H=H2, EF=EF2, EG=EG2: rc.NormBounded(H, EF, EG), {"H": H2, "EF": EF2, "EG": EG2}),
     "NormBounded.perturb": (lambda plant=PLANT, Delta=0.5: UNC.perturb(plant, Delta), {"plant": PLANT, "Delta": 0.5}),
-    "NormBounded.perturbed_matrices": (lambda Delta=np.array([0.5, -0.5]): UNC.perturbed_matrices(PLANT, Delta),
+    "NormBounded.perturbed_matrices": (lambda Delta=DELTA2: UNC.perturbed_matrices(PLANT, Delta),
                                        {"Delta": np.array([0.5, -0.5])}),
     "Controller": (lambda K=CTRL.K, plant=PLANT: rc.Controller(K, "x", plant), {"K": CTRL.K, "plant": PLANT}),
-    "Controller.__call__": (lambda x=np.ones(2): CTRL(x), {"x": np.ones(2)}),
+    "Controller.__call__": (lambda x=X2: CTRL(x), {"x": np.ones(2)}),
     "Controller.closed_loop": (lambda plant=PLANT: CTRL.closed_loop(plant), {"plant": PLANT}),
     "Controller.to_statespace": (lambda plant=PLANT: CTRL.to_statespace(plant), {"plant": PLANT}),
     "design": (lambda method="lqr": rc.design(method, PLANT), {"method": "lqr"}),
-    "lqr": (lambda plant=PLANT, Q=np.eye(2), R=np.eye(1): rc.lqr(plant, Q=Q, R=R),
+    "lqr": (lambda plant=PLANT, Q=I2, R=I1: rc.lqr(plant, Q=Q, R=R),
             {"plant": PLANT, "Q": np.eye(2), "R": np.eye(1)}),
-    "dare": (lambda F=F2, G=G2, Q=np.eye(2), R=np.eye(1): dare(F, G, Q, R),
+    "dare": (lambda F=F2, G=G2, Q=I2, R=I1: dare(F, G, Q, R),
              {"F": F2, "G": G2, "Q": np.eye(2), "R": np.eye(1)}),
     "rlqr": (_rlqr, {**RLQR_ARGS, "accelerate": True, "implementation": "kkt", "fallback": "newton",
                      "P_N": np.eye(2)}),
@@ -163,7 +169,63 @@ CASES = {
     "is_schur_stable": (lambda A=F2: rc.is_schur_stable(A), {"A": F2}),
     "unstabilizable_modes": (lambda F=F2, G=G2: unstabilizable_modes(F, G), {"F": F2, "G": G2}),
 }
-FLAGS, CHOICES, INTS = {"accelerate"}, {"method", "implementation", "fallback"}, {"max_iter", "horizon"}
+
+# ---- the LMI syntheses (hinf, h2, the Riccati reference), pole regions and the robust analysis
+BW2, CZ2, DZU2 = np.array([[0.0], [1.0]]), np.vstack([np.eye(2), [[0.0, 0.0]]]), np.array([[0.0], [0.0], [1.0]])
+DZW2 = np.zeros((3, 1))
+PERF = {"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, "Dzw": DZW2}
+UNC_A = rc.NormBounded(0.1 * H2, EF2, EG2)   # small enough for CTRL to be robustly stable (margin 3.15)
+VERTEX = UNC_A.perturb(PLANT, 1.0)
+
+
+def _hinf(plant=PLANT, **kw):
+    return rc.hinf(plant, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+def _h2(plant=PLANT, **kw):
+    return rc.h2(plant, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+def _riccati(plant=PLANT, **kw):
+    return hinf_riccati(plant, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+def _hinf_bound(controller=CTRL, uncertainty=UNC_A, **kw):
+    return rc.robust_hinf_bound(controller, uncertainty, **{"Bw": BW2, "Cz": CZ2, "Dzu": DZU2, **kw})
+
+
+CASES.update({
+    "hinf": (_hinf, {"plant": PLANT, **PERF, "vertices": [VERTEX], "gamma": 10.0, "u_max": 100.0,
+                     "w_energy": 1.0, "backoff": 1e-3, "extended": False, "poles": rc.Disk(0.0, 0.999),
+                     "uncertainty": UNC_A, "solver": "CLARABEL"}),
+    "h2": (_h2, {"plant": PLANT, **PERF, "vertices": [VERTEX], "poles": rc.Disk(0.0, 0.999), "backoff": 1e-3,
+                 "solver": "CLARABEL"}),
+    "hinf_riccati": (_riccati, {"plant": PLANT, **PERF, "rtol": 1e-9, "gamma_max": 1e10}),
+    "Disk": (lambda center=0.0, radius=0.5: rc.Disk(center, radius), {"center": 0.0, "radius": 0.5}),
+    "HalfPlane": (lambda boundary=-1.0, side="left": rc.HalfPlane(boundary, side), {"boundary": -1.0, "side": "left"}),
+    "ConicSector": (lambda apex=0.0, angle=0.5: rc.ConicSector(apex, angle), {"apex": 0.0, "angle": 0.5}),
+    "robust_stability": (lambda controller=CTRL, uncertainty=UNC_A: rc.robust_stability(controller, uncertainty),
+                         {"controller": CTRL, "uncertainty": UNC_A}),
+    "robust_stability(vertices)": (lambda vertices=(VERTEX,): rc.robust_stability(CTRL, vertices=vertices),
+                                   {"vertices": [VERTEX]}),
+    "robust_stability((plant, K))": (lambda K=CTRL.K: rc.robust_stability((PLANT, K), UNC_A), {"K": CTRL.K}),
+    "guaranteed_cost": (lambda controller=CTRL, uncertainty=UNC_A, Q=I2, R=I1, x0=None:
+                        rc.guaranteed_cost(controller, uncertainty, Q, R, x0),
+                        {"controller": CTRL, "uncertainty": UNC_A, "Q": np.eye(2), "R": np.eye(1), "x0": np.ones(2)}),
+    "robust_hinf_bound": (_hinf_bound, {"controller": CTRL, "uncertainty": UNC_A, **PERF}),
+    "worst_case": (lambda controller=CTRL, uncertainty=UNC_A, seed=0, n_starts=2:
+                   rc.worst_case(controller, uncertainty, seed=seed, n_starts=n_starts),
+                   {"controller": CTRL, "uncertainty": UNC_A, "seed": 0, "n_starts": 2}),
+})
+FLAGS = {"accelerate", "extended"}
+CHOICES = {"method", "implementation", "fallback", "solver", "side"}
+INTS = {"max_iter", "horizon", "n_starts", "seed"}
+OBJECTS = {"vertices", "poles", "uncertainty", "controller"}   # drawn like a plant: anything but the right type
+VALID_NAMES = ("kkt", "block", "recursion", "newton", "zoh", "tustin", "euler", "lqr", "rlqr", "hinf", "h2",
+               "left", "right", "clarabel", "scs", "scipy", "highs", "osqp", "cvxopt", "mosek")
+# None is a documented value of these (default, identity, continuous time, the design plant, no bound, ...)
+NONE_OK = {"P_N", "P0", "H", "Q", "R", "dt", "Dzw", "vertices", "gamma", "u_max", "w_energy", "poles",
+           "uncertainty", "x0", "seed"}
 INF_OK = {"mu"}  # inf is a valid value of these
 CAUSES = ["bool", "string", "numeric string", "complex", "ragged", "None", "nan", "inf", "object"]
 _JUNK = st.sampled_from([{"key": 1}, object(), {1, 2}, b"bytes", print])
@@ -191,11 +253,12 @@ def _bad(valid, cause, name):
                 "complex": st.just(1j), "ragged": st.just([[True], []]), "nan": st.just(np.nan),
                 "inf": st.sampled_from([0, 1, 1.0])}[cause]
     if name in CHOICES:
-        return {"bool": st.booleans(), "string": st.text(max_size=6).filter(lambda t: t not in ("kkt", "block",
-                "recursion", "newton", "zoh", "tustin", "euler", "lqr", "rlqr", "hinf", "LQR", "RLQR", "HINF")),
+        return {"bool": st.booleans(), "string": st.text(max_size=6).filter(lambda t: t.lower() not in VALID_NAMES),
                 "numeric string": st.just("1"), "complex": st.just(1j), "ragged": st.just([["kkt"], []]),
                 "nan": st.just(np.nan), "inf": st.just(np.inf)}[cause]
-    if isinstance(valid, rc.Plant):
+    if name == "seed" and cause == "ragged":
+        return None  # numpy's SeedSequence takes nested sequences of integers as entropy
+    if isinstance(valid, rc.Plant) or name in OBJECTS:
         return {"bool": st.booleans(), "string": st.text(max_size=5), "numeric string": st.just("1"),
                 "complex": st.just(1j), "ragged": st.just([[1.0], [1.0, 2.0]]), "nan": st.just(np.nan),
                 "inf": st.just(np.inf)}[cause]
@@ -241,7 +304,7 @@ def _handled_well(call, name) -> bool:
     except (TypeError, ValueError) as exc:
         return re.match(rf"{re.escape(name)}\b", str(exc)) is not None or (
             name == "plant" and str(exc).startswith("plant must"))
-    except Exception:  # anything else (numpy, scipy, AttributeError, ...) is not handled well
+    except Exception:  # noqa: BLE001 - anything else (numpy, scipy, AttributeError, ...) is not handled well
         return False
     return False  # a bad value accepted
 
@@ -251,8 +314,8 @@ def _write_tally():
     yield
     if os.environ.get("ROBUSTCTL_TALLY") and TALLY:
         with open(os.environ["ROBUSTCTL_TALLY"], "w") as fh:
-            for (func, cause), (tried, good) in sorted(TALLY.items()):
-                fh.write(f"{func}\t{cause}\t{tried}\t{good}\n")
+            fh.writelines(f"{func}\t{cause}\t{tried}\t{good}\n"
+                          for (func, cause), (tried, good) in sorted(TALLY.items()))
 
 
 @pytest.mark.parametrize("func", sorted(CASES))
@@ -262,8 +325,8 @@ def _write_tally():
 def test_every_bad_argument_is_named(func, cause, data):
     call, args = CASES[func]
     for name, valid in args.items():
-        if cause == "None" and (name in ("P_N", "P0", "H", "Q", "R", "dt") or func.startswith("Controller.")):
-            continue  # None is a documented value there (default, identity, continuous time, the design plant)
+        if cause == "None" and (name in NONE_OK or func.startswith("Controller.")):
+            continue  # None is a documented value there
         if cause in ("nan", "inf") and func in ("spectral_radius", "is_schur_stable"):
             continue  # documented: radius inf, unstable (checked in test_stability)
         strategy = _bad(valid, cause, name)
@@ -271,7 +334,7 @@ def test_every_bad_argument_is_named(func, cause, data):
             continue
         value = data.draw(strategy, label=name)
         TALLY[(func, cause)][0] += 1
-        ok = _handled_well(lambda: call(**{name: value}), name)
+        ok = _handled_well(functools.partial(call, **{name: value}), name)
         TALLY[(func, cause)][1] += ok
         assert ok, (func, name, cause, value)
 
@@ -309,6 +372,7 @@ def test_unstabilisable_plants_raise_in_every_design_and_flag_in_the_batch(seed,
 
 @SETTINGS
 @given(dt=st.floats(0.01, 1.0), other=st.floats(-5.0, 5.0), scale=st.floats(1e200, 1e300))
+@example(dt=0.8585158091592887, other=2.0, scale=1e200)  # I - A dt/2 = diag(eps/2, 0.14): cond 1.3e15 < 1/eps
 def test_discretisation_failures_name_A(dt, other, scale):
     """Cause 6 (tustin with I - A dt/2 singular) and 5 (A dt overflowing is A's fault, not F's)."""
     A = np.diag([2.0 / dt, other])
@@ -328,6 +392,32 @@ def test_controller_refuses_non_finite_states(shape, seed, value):
     x = np.random.default_rng(seed).standard_normal(shape)
     x.flat[seed % x.size] = value
     TALLY[("Controller.__call__", "non-finite state")][0] += 1
-    with pytest.raises(ValueError, match="^x must have finite entries"):
+    with pytest.raises(ValueError, match=r"^x must have finite entries"):
         CTRL(x)
     TALLY[("Controller.__call__", "non-finite state")][1] += 1
+
+
+def test_issue_12_booleans_in_the_lmi_syntheses_and_the_analysis():
+    """Cause 3 for the LMI syntheses: u_max=True was accepted as a bound of 1."""
+    cases = [(lambda: _hinf(u_max=True), TypeError, "^u_max must be a positive number, got a boolean"),
+             (lambda: _hinf(u_max=[True]), TypeError, "^u_max must be a positive number, got booleans"),
+             (lambda: _hinf(backoff=True), TypeError, "^backoff must be a real number, got a boolean"),
+             (lambda: _h2(backoff="0.1"), TypeError, "^backoff must be a real number, got str"),
+             (lambda: _hinf(gamma=True), TypeError, r"^gamma must be a real number > 0, got a boolean"),
+             (lambda: _hinf(extended=1), TypeError, r"^extended must be a bool \(True or False\), got 1"),
+             (lambda: rc.Disk(0.0, True), TypeError, r"^radius must be a real number > 0, got a boolean"),
+             (lambda: rc.ConicSector(0.0, 1j), TypeError, "^angle must be a real number, got complex"),
+             (lambda: rc.worst_case(CTRL, UNC_A, seed=True), TypeError, "^seed must be None, an integer"),
+             (lambda: rc.worst_case(CTRL, UNC_A, seed="x"), TypeError, "^seed must be None, an integer"),
+             (lambda: _riccati(gamma_max=True), TypeError, "^gamma_max must be a real number > 0")]
+    for call, err, match in cases:
+        with pytest.raises(err, match=match):
+            call()
+    m2 = rc.Plant(F2, np.ones((2, 2)), 0.1)
+    kw = dict(Bw=BW2, Cz=np.vstack([np.eye(2), np.zeros((2, 2))]), Dzu=np.vstack([np.zeros((2, 2)), np.eye(2)]))
+    with pytest.raises(ValueError, match=r"^u_max must be a scalar or have 2 entries \(the number of inputs\)"):
+        rc.hinf(m2, **kw, u_max=[1.0, 2.0, 3.0])
+    with pytest.raises(TypeError, match=r"^u_max must be a positive number or 2 positive numbers, got str"):
+        rc.hinf(m2, **kw, u_max="1")
+    with pytest.raises(ValueError, match=r"^u_max must be > 0 for every entry, got \[1.0, -2.0\]"):
+        rc.hinf(m2, **kw, u_max=[1.0, -2.0])

@@ -45,7 +45,6 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from docutils import nodes
 from sphinx.ext import intersphinx
 
 PACKAGES = ("robustctl", "moo")

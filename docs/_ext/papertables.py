@@ -20,8 +20,8 @@ def _cell(row: dict) -> str:
     def side(sign, sig):
         return ARROW.get(sign, "?") + ("*" if sig == "True" else "")
     mark = "=" if row["full_agreement"] == "True" else ("~" if row["direction_agrees"] == "True" else "x")
-    return f"{side(row['paper_sign'], row['paper_significant'])} / " \
-           f"{side(row['our_sign'], row['our_significant'])} {mark}"
+    paper, ours = side(row["paper_sign"], row["paper_significant"]), side(row["our_sign"], row["our_significant"])
+    return f"{paper} / {ours} {mark}"
 
 
 def table(path: Path) -> str:
@@ -35,8 +35,8 @@ def table(path: Path) -> str:
     for alg in algorithms:
         lines.append(f"   * - {alg}")
         lines += [f"     - {cells.get((alg, key), '')}" for key, _ in INDICATORS]
-    lines += ["", f"Direction agrees in {agree} of {len(rows)} cells; direction and significance in "
-                  f"{full} of {len(rows)}.", ""]
+    lines += ["", (f"Direction agrees in {agree} of {len(rows)} cells; direction and significance in "
+                   f"{full} of {len(rows)}."), ""]
     return "\n".join(lines)
 
 

@@ -86,7 +86,7 @@ def numpy_inventory() -> Inventory:
             continue
         if inspect.isclass(obj) and issubclass(obj, np.generic):
             inv.add(full, "py:class", "reference/arrays.scalars.html#$")
-        elif isinstance(obj, (float, int)) and not isinstance(obj, bool) or obj is None:
+        elif (isinstance(obj, (float, int)) and not isinstance(obj, bool)) or obj is None:
             inv.add(full, "py:data", "reference/constants.html#$")
         elif (role := _role(obj)) is not None:
             inv.add(full, role, gen.format(full))
@@ -221,9 +221,9 @@ _CVXPY = {
 
 
 def cvxpy_inventory() -> Inventory:
-    import cvxpy
+    import cvxpy as cp
 
-    inv = Inventory("CVXPY", cvxpy.__version__)
+    inv = Inventory("CVXPY", cp.__version__)
     for full, (uri, alias) in _CVXPY.items():
         module, _, name = full.rpartition(".")
         obj = getattr(importlib.import_module(module), name)

@@ -34,7 +34,7 @@ print(f"{len(F)} non-dominated designs after {moea.n_evals} evaluations")
 
 names = [r"$f_1$ ($\rho$)", r"$f_2$ ($\dot\psi$)", r"$f_3$ ($\dot y$)", r"$f_4$ ($\theta$)"]
 fig, axes = plt.subplots(1, 3, figsize=(11, 3.4), layout="constrained")
-for ax, (i, j) in zip(axes, [(0, 1), (0, 2), (0, 3)]):
+for ax, (i, j) in zip(axes, [(0, 1), (0, 2), (0, 3)], strict=True):
     sc = ax.scatter(F[:, i], F[:, j], c=np.arange(len(F)), cmap="viridis", s=14)
     ax.set(xlabel=names[i], ylabel=names[j])
 fig.colorbar(sc, ax=axes, label="design index (by $f_1$)")
@@ -56,7 +56,7 @@ x = np.arange(1, len(d) + 1)
 fig, ax = plt.subplots(figsize=(9, 3.2), layout="constrained")
 ax.bar(x, counts, color=colors)
 ax.set_xticks([1, *range(10, d.n_front + 1, 10)])
-extras = ", ".join(f"{lab} ({int(counts[i])})" for i, (lab, k) in enumerate(zip(d.labels, d.kinds))
+extras = ", ".join(f"{lab} ({int(counts[i])})" for i, (lab, k) in enumerate(zip(d.labels, d.kinds, strict=True))
                    if k != "front")
 ax.set(xlabel=f"design: 1-{d.n_front} the front by $f_1$; then, in orange, {extras} wins",
        ylabel="wins", title=f"z* = design {d.labels[sel.best]}: {int(counts[sel.best])} of {len(sel.deltas)} wins")

@@ -138,7 +138,7 @@ def true_front_bounds(name: str, n_obj: int | None = None) -> tuple[np.ndarray, 
     raise ValueError(f"true_front_bounds knows ZDT, DTLZ and WFG problems only, got {name!r}")
 
 
-def make_problem(name: str, n_obj: int | None = None) -> Problem:
+def make_problem(name: str, n_obj: int | None = None, *, setup: str | None = None) -> Problem:
     """A problem by name, with ``hv_ref_point`` and ``molsp_ref_point`` attributes.
 
     Parameters
@@ -150,6 +150,9 @@ def make_problem(name: str, n_obj: int | None = None) -> Problem:
         Number of objectives. DTLZ and WFG: 2 to 15, default 3. The others have
         a fixed number (generic 3, applied 4, ZDT 2); giving another one is an
         error.
+    setup : str, optional
+        ``applied`` only: ``"ours"`` (default) or ``"authors"``
+        (:class:`~moo.problems.applied.AppliedRLQRProblem`).
 
     Raises
     ------
@@ -166,6 +169,8 @@ def make_problem(name: str, n_obj: int | None = None) -> Problem:
     if n_obj is not None and (isinstance(n_obj, bool) or not isinstance(n_obj, (int, np.integer))):
         raise TypeError(f"n_obj must be an integer or None, got {type(n_obj).__name__}")
 
+    if setup is not None and key != "applied":
+        raise ValueError(f"setup applies to the 'applied' problem only, got setup={setup!r} for {key!r}")
     if key in _CONTROL:
         module, cls, m = _CONTROL[key]
         if n_obj is not None and n_obj != m:
@@ -174,7 +179,7 @@ def make_problem(name: str, n_obj: int | None = None) -> Problem:
             problem_cls = getattr(import_module(module), cls)
         except (ImportError, AttributeError) as exc:
             raise NotImplementedError(f"problem {key!r} is not available: {exc}") from exc
-        problem = problem_cls()
+        problem = problem_cls() if setup is None else problem_cls(setup=setup)
         for attr in ("hv_ref_point", "molsp_ref_point"):
             if getattr(problem, attr, None) is None:
                 raise NotImplementedError(f"{cls} lacks the {attr} attribute")

@@ -100,7 +100,7 @@ class RLQRTuningProblem(Problem):
     def __init__(self, plant: rc.Plant, H: np.ndarray, F_s: np.ndarray, G_s: np.ndarray, input_map, *,
                  Q, R, alpha: float, max_iter: int, fallback: str, aggregate: str, penalty: float, hv_ref_point,
                  molsp_ref_point, default_hv: np.ndarray, default_molsp: np.ndarray, n_obj: int, xl, xu,
-                 backend: str):
+                 backend: Literal["numba", "numpy"]):
         self.plant, self.H = plant, H
         self.alpha = check_positive_scalar(alpha, "alpha")
         self.max_iter = check_int(max_iter, "max_iter", 1)
@@ -149,7 +149,7 @@ class RLQRTuningProblem(Problem):
         n, m = self.plant.n, self.plant.m
         return z[:, None, :n].copy(), z[:, None, n:n + m].copy(), 10.0 ** np.sqrt(z[:, n + m])
 
-    def gains(self, z) -> "rc.RLQRBatch":
+    def gains(self, z) -> rc.RLQRBatch:
         """The batched RLQR design of a population ``z`` (B, n + m + 1)."""
         EF, EG, mu = self.decode(z)
         return rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
@@ -171,18 +171,20 @@ class RLQRTuningProblem(Problem):
 
     def closed_loop_radius(self, K) -> np.ndarray:
         """Spectral radius (B, S) of the true closed loop per scenario (inf for non-finite K)."""
-        return rc.spectral_radius(self.closed_loops(K))
+        return np.asarray(rc.spectral_radius(self.closed_loops(K)))      # a stack: an array
 
     def stability(self, K) -> tuple[np.ndarray, np.ndarray]:
-        """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the largest spectral
-        radius over the scenarios of the designs unstable somewhere (NaN for the others, which
-        need no eigenvalues; inf for non-finite K)."""
+        """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the worst spectral radius.
+
+        ``rho`` is the largest spectral radius over the scenarios of the designs unstable somewhere
+        (NaN for the others, which need no eigenvalues; inf for non-finite K).
+        """
         A = self.closed_loops(K)
-        stable = rc.is_schur_stable(A)
+        stable = np.asarray(rc.is_schur_stable(A))                         # a stack: an array
         rho = np.full(A.shape[0], np.nan)
         bad = ~stable.all(axis=1)
         if bad.any():
-            rho[bad] = rc.spectral_radius(A[bad]).max(axis=1)
+            rho[bad] = np.asarray(rc.spectral_radius(A[bad])).max(axis=1)
         return stable, rho
 
     def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
@@ -191,7 +193,7 @@ class RLQRTuningProblem(Problem):
 
     # -- pymoo hooks -----------------------------------------------------------------
     def evaluate(self, X, *args, **kwargs):
-        """pymoo's ``Problem.evaluate``, after checking ``X`` (errors that name it, not pymoo's assertion)."""
+        """Check ``X`` (errors that name it, not pymoo's assertion), then pymoo's ``Problem.evaluate``."""
         arr = self.population(X, "X")
         return super().evaluate(arr[0] if np.ndim(X) == 1 else arr, *args, **kwargs)
 

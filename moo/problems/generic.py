@@ -1,12 +1,12 @@
-"""The generic robust-control MOP of the paper (Morais et al. 2022, Section 4.4).
+r"""The generic robust-control MOP of the paper (Morais et al. 2022, Section 4.4).
 
 A three-state, one-input discrete-time plant with a scalar norm-bounded
 uncertainty,
 
 .. math::
 
-    x[k+1] = (F + H \\delta E_F^{true}) x[k] + (G + H \\delta E_G^{true}) u[k],
-    \\qquad |\\delta| \\le 1,
+    x[k+1] = (F + H \delta E_F^{true}) x[k] + (G + H \delta E_G^{true}) u[k],
+    \qquad |\delta| \le 1,
 
 with the paper's ``F``, ``G``, ``H`` (printed as ``M``), ``E_F^{true} = [0.1, 0.2, 0.2]``
 and ``E_G^{true} = 0.1``. A decision vector ``z = (E_F (3), E_G, (log10 mu)^2)``
@@ -224,8 +224,8 @@ class GenericRLQRProblem(RLQRTuningProblem):
         loops get ``e = inf``; designs with no stable scenario are not simulated.
         """
         rho = self.closed_loop_radius(K)
-        stable = rc.is_schur_stable(self.closed_loops(K))
-        e = np.full(rho.shape + (self.plant.n,), np.inf)
+        stable = np.asarray(rc.is_schur_stable(self.closed_loops(K)))  # a stack: an array
+        e = np.full((*rho.shape, self.plant.n), np.inf)
         some = stable.any(axis=1)
         if some.any():
             e[some] = self._simulate(np.asarray(K, dtype=float)[some])

@@ -55,10 +55,10 @@ from dataclasses import dataclass
 import numpy as np
 
 import robustctl as rc
+from robustctl.batchsim import check_gains
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
-from robustctl.batchsim import check_gains
-from robustctl.pathfollow import PathFollowing
+from robustctl.pathfollow import PathFollowing, PathFollowingSetup, get_setup
 
 from .._validation import as_matrix, check_int
 from .applied import AppliedRLQRProblem
@@ -67,7 +67,7 @@ from .generic import GenericRLQRProblem
 __all__ = [
     "SelectionResult", "DesignSet", "DesignSelection", "monte_carlo_selection", "draw_deltas",
     "overload_from_delta", "generic_errors", "applied_errors", "build_designs", "select_design",
-    "MAX_OVERLOAD", "BRYSON_SCALES",
+    "MAX_OVERLOAD", "BRYSON_SCALES", "error_scales",
 ]
 
 #: Largest payload overload of the paper's robustness study [%] (Section 4.5.2: 0 to 300 %).
@@ -106,10 +106,12 @@ class SelectionResult:
 
     @property
     def n_designs(self) -> int:
+        """Number of candidate designs D."""
         return int(self.counts.size)
 
     @property
     def n_simulations(self) -> int:
+        """Number of simulations (realisations) S."""
         return int(self.winners.size)
 
     @property
@@ -285,23 +287,38 @@ def generic_errors(K, deltas, *, problem: GenericRLQRProblem | None = None) -> n
     return E
 
 
-def _as_scales(scales) -> np.ndarray:
-    if scales is None:
-        return np.array(BRYSON_SCALES)
+def error_scales(setup: str | PathFollowingSetup = "ours") -> np.ndarray:
+    """Default scales of :func:`applied_errors`: ``1 / sqrt(Q_ii)`` of the set-up's state weight.
+
+    In the objectives' order (``rho, psidot, ydot, theta``); ``"ours"`` gives :data:`BRYSON_SCALES`.
+    """
+    setup = get_setup(setup)
+    q = np.asarray(setup.Q_diag, dtype=float)[list(truck.OBJECTIVE_STATES)]
+    if np.any(q <= 0):
+        raise ValueError(f"scales: the set-up's Q has a zero weight on an objective's state ({setup.Q_diag}); "
+                         "give scales")
+    return 1.0 / np.sqrt(q)
+
+
+def _as_scales(scales, setup: PathFollowingSetup) -> np.ndarray:
+    if scales is None:                  # E is the quadratic state cost of the set-up's Q
+        return error_scales(setup)
     s = as_matrix(scales, "scales", rows=1, cols=4, cols_what="one per objective: rho, psidot, ydot, theta").ravel()
     if np.any(s <= 0):
         raise ValueError(f"scales must be positive, got {s}")
     return s
 
 
-def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None) -> np.ndarray:
+def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None,
+                   setup: str | PathFollowingSetup = "ours") -> np.ndarray:
     r"""Cumulative normalised tracking errors (D, S) of truck gains ``K``, one column per ``Delta``.
 
     Each ``Delta_s`` is a payload overload ``150 (1 + Delta_s)`` % held over the
     run (:func:`overload_from_delta`); every design drives the true truck at
-    that payload along ``path`` (:class:`robustctl.pathfollow.PathFollowing`: nominal
-    reference states and feedforward, 0.45 rad steering limit, 1 m initial
-    offset), and
+    that payload along ``path`` (:class:`robustctl.pathfollow.PathFollowing`
+    in the ``setup``'s loop, 0.45 rad steering limit; ``"ours"``: nominal
+    steady-cornering reference and feedforward, 1 m initial offset;
+    ``"authors"``: the authors' regulation loop), and
 
     .. math::
 
@@ -310,11 +327,13 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
     with ``e`` the tracking errors of the four objectives' states (``rho``,
     ``psidot``, ``ydot``, ``theta``; ``x - x_ref`` as in the MOP's
     objectives) and ``sigma`` the error scales. The default scales are
-    Bryson's acceptable errors ``[0.25 m, 0.1 rad/s, 0.5 m/s, 0.05 rad]``
-    (:data:`BRYSON_SCALES`), so that ``E`` is the quadratic state cost
-    ``sum_k e[k]^T Q e[k]`` of the weight ``Q`` every truck design uses
-    (:func:`robustctl.models.truck.lqr_weights`): the objectives are added in
-    the units the designs trade them in. ``E = T * sum_i f_i / sigma_i^2``
+    ``1 / sqrt(Q_ii)`` of the set-up's state weight, so that ``E`` is the
+    quadratic state cost ``sum_k e[k]^T Q e[k]`` of the weight ``Q`` the
+    set-up's designs use: the objectives are added in the units the designs
+    trade them in. ``"ours"``: Bryson's acceptable errors ``[0.25 m, 0.1
+    rad/s, 0.5 m/s, 0.05 rad]`` (:data:`BRYSON_SCALES`,
+    :func:`robustctl.models.truck.lqr_weights`); ``"authors"``: ``[1/sqrt(25000)
+    m, 1 rad/s, 1 m/s, 0.1 rad]``. ``E = T * sum_i f_i / sigma_i^2``
     with ``f_i`` the MOP's per-scenario MSEs. A gain with non-finite entries
     gets ``+inf``; a run that diverges is frozen by the simulator at its bound
     (a huge finite error, see :mod:`robustctl.batchsim`).
@@ -331,6 +350,8 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
     scales : (4,) array_like, optional
         ``sigma``; e.g. ``np.sqrt(AppliedRLQRProblem().hv_ref_point)`` weights
         the objectives by the problem's hypervolume reference point instead.
+    setup : str or PathFollowingSetup
+        Loop, initial state and default scales (:data:`robustctl.pathfollow.SETUPS`).
 
     Returns
     -------
@@ -340,7 +361,8 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
     """
     Kb, ok = _as_gains(K, 4, (1, 2))
     overloads = overload_from_delta(deltas)
-    sigma = _as_scales(scales)
+    setup = get_setup(setup)
+    sigma = _as_scales(scales, setup)
     if path is None:
         path = default_route()
     elif not isinstance(path, ReferencePath):
@@ -349,7 +371,8 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None)
     E = np.empty((Kb.shape[0], overloads.size))
     for start in range(0, overloads.size, _SCENARIO_CHUNK):
         chunk = overloads[start:start + _SCENARIO_CHUNK]
-        res = PathFollowing(path, tuple(chunk.tolist()), input_map=steering).run(Kb, keep_trajectories=False)
+        res = PathFollowing(path, tuple(chunk.tolist()), setup=setup, input_map=steering).run(
+            Kb, keep_trajectories=False)
         E[:, start:start + chunk.size] = (res.sq_error_sum[..., list(res.objectives)] / sigma**2).sum(axis=2)
     E[~ok] = np.inf
     return E
@@ -388,6 +411,7 @@ class DesignSet:
 
     @property
     def n_front(self) -> int:
+        """Number of designs taken from the front (the others are the extra designs)."""
         return self.kinds.count("front")
 
     def index(self, kind: str) -> int:
@@ -398,7 +422,7 @@ class DesignSet:
         return self.kinds.index(kind)
 
     def __repr__(self) -> str:
-        extras = [lab for lab, k in zip(self.labels, self.kinds) if k != "front"]
+        extras = [lab for lab, k in zip(self.labels, self.kinds, strict=True) if k != "front"]
         return (f"DesignSet(D={len(self)}, front={self.n_front}, extras={extras}, "
                 f"failed={int((~self.ok).sum())})")
 
@@ -431,7 +455,7 @@ def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     X = as_matrix(X_front, "X_front", cols=problem.n_var, cols_what="the problem's number of variables")
     if np.any(X[:, -1] < 0):
         raise ValueError(f"X_front's last variable, (log10 mu)^2, must be >= 0, got {X[:, -1].min():g}")
-    z_random = _rng(seed).uniform(problem.xl, problem.xu)
+    z_random = np.asarray(_rng(seed).uniform(problem.xl, problem.xu))      # (n_var,): pymoo's bounds are arrays
     batch = problem.gains(np.vstack([X, z_random]))
     K_rlqr = np.where(batch.ok[:, None, None], batch.K, np.nan)
     K_nom = rc.lqr(problem.plant, Q=problem.Q, R=problem.R).K
@@ -482,6 +506,7 @@ class DesignSelection:
 
     @property
     def best(self) -> int:
+        """Index of the selected design (the result's ``best``)."""
         return self.result.best
 
     @property
@@ -522,7 +547,8 @@ def select_design(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     path : ReferencePath, optional
         Applied problem only: the simulated path (default ``problem.path``).
     scales : (4,) array_like, optional
-        Applied problem only: see :func:`applied_errors`.
+        Applied problem only: see :func:`applied_errors` (the loop and the
+        default scales are those of ``problem.setup``).
     """
     _check_problem(problem)
     n_sims = check_int(n_sims, "n_sims", 1)
@@ -535,5 +561,6 @@ def select_design(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     if generic:
         errors = generic_errors(designs.K, deltas, problem=problem)
     else:
-        errors = applied_errors(designs.K, deltas, path=problem.path if path is None else path, scales=scales)
+        errors = applied_errors(designs.K, deltas, path=problem.path if path is None else path, scales=scales,
+                                setup=problem.setup)
     return DesignSelection(designs=designs, deltas=deltas, errors=errors, result=monte_carlo_selection(errors))

@@ -79,10 +79,13 @@ Numerics
 The synthesis is a sequence of pure stages (:mod:`robustctl.hinf._synthesis`
 lists them; every tolerance is named in ``robustctl.hinf._tolerances``):
 
-* Coordinates (:mod:`._coordinates`): states balanced (SLICOT ``TB01ID``)
-  and scaled so that ``||Bw|| = 1``; ``w`` scaled to unit energy when
-  ``u_max`` is given; ``z`` scaled so that the fixed level of a centring
-  problem is 1; ``[Cz Dzu Dzw]`` replaced by a factor with the same Gram
+* Coordinates (:mod:`._coordinates`): ``w`` and ``z`` scaled to unit size
+  first (``||Bw~|| = 1``, or unit energy when ``u_max`` is given, and
+  ``||[Cz~ Dzu~ Dzw~]|| = 1``; the level scales with both, the gain does
+  not), so that the solver's problem does not depend on the units the
+  caller chose; states balanced (SLICOT ``TB01ID``) and scaled so that
+  ``||Bw|| = 1``; ``z`` scaled further so that the fixed level of a
+  centring problem is 1; ``[Cz Dzu Dzw]`` replaced by a factor with the same Gram
   matrix when that has fewer rows. A single plant is solved in coordinates
   where the inverse of its LQR Riccati solution (weight
   ``[Cz Dzu]'[Cz Dzu]``) is ~ I: the optimal ``X`` has roughly that shape,

@@ -4,11 +4,16 @@ Every change here is a similarity ``x = T x^`` or a recorded scaling of
 ``w`` and ``z``: levels and input bounds are unchanged up to the recorded
 factors, only the solver's path (iterations, accuracy) changes.
 
-* :func:`normalised`: states balanced by a diagonal similarity (SLICOT
-  ``TB01ID`` on ``[[F, [Bw G]], [Cz, 0]]``) and scaled so that
-  ``||Bw~|| = 1``; ``w`` scaled by ``w_scale`` (``sqrt(w_energy)`` with an
-  input bound: the bound then reads for unit energy); ``[Cz Dzu Dzw]``
-  replaced by a factor with the same Gram matrix when that has fewer rows.
+* :func:`channel_scales`: the units of ``w`` and ``z``. The level is
+  homogeneous, ``gamma(a z, b w) = a b gamma(z, w)``, and the optimal gain
+  does not depend on ``a, b``; scaling both channels to a unit size first
+  makes every later stage see the same data whatever units the user chose
+  (the authors' truck weights ``R = 33535`` put ``gamma^2 ~ 1e8`` beside
+  ``X ~ 1`` and Clarabel failed).
+* :func:`normalised`: ``w`` and ``z`` scaled, then the states balanced by a
+  diagonal similarity (SLICOT ``TB01ID`` on ``[[F, [Bw~ G]], [Cz~, 0]]``)
+  and scaled so that ``||Bw~|| = 1``; ``[Cz~ Dzu~ Dzw~]`` replaced by a
+  factor with the same Gram matrix when that has fewer rows.
 * :func:`lqr_coordinates`: coordinates in which the inverse of the LQR
   Riccati solution of the nominal vertex is ~ I.
 * :func:`recentred`: coordinates in which a given Lyapunov matrix is ~ I.
@@ -16,15 +21,15 @@ factors, only the solver's path (iterations, accuracy) changes.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import Sequence
 
 import numpy as np
 import scipy.linalg
 
 from . import _tolerances as tol
 
-__all__ = ["Coordinates", "normalised", "lqr_coordinates", "recentred"]
+__all__ = ["Coordinates", "channel_scales", "normalised", "lqr_coordinates", "recentred"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -32,11 +37,13 @@ class Coordinates:
     """The synthesis data in the solver's state coordinates ``x = T x^``.
 
     ``F``, ``G`` hold one matrix per vertex. ``Bw`` and ``Dzw`` include the
-    disturbance scaling ``w = w_scale w~``; ``Cz``, ``Dzu``, ``Dzw`` may be
+    disturbance scaling ``w = w_scale w~``, and ``Cz``, ``Dzu``, ``Dzw`` the
+    output scaling ``z = z_unit z~``: a level ``gamma`` of the user's
+    ``T_zw`` is ``level_scale gamma`` here. ``Cz``, ``Dzu``, ``Dzw`` may be
     the compressed factor (``p`` rows, see :func:`normalised`). ``H``,
     ``EF``, ``EG`` are the norm-bounded uncertainty ``[dF dG] = H Delta [EF
     EG]`` (``None`` without one). ``original`` is ``(F, G, Bw, Cz, H, EF)``
-    at ``T = I``; ``balancing`` the diagonal similarity of
+    at ``T = I`` (channels scaled); ``balancing`` the diagonal similarity of
     :func:`normalised` (reported in ``info["scaling"]``).
     """
 
@@ -53,6 +60,12 @@ class Coordinates:
     H: np.ndarray | None = None
     EF: np.ndarray | None = None
     EG: np.ndarray | None = None
+    z_unit: float = 1.0
+
+    @property
+    def level_scale(self) -> float:
+        """``w_scale / z_unit``: a level of the user's ``T_zw`` times this is the level of these data."""
+        return self.w_scale / self.z_unit
 
     @property
     def n(self) -> int:
@@ -66,7 +79,7 @@ class Coordinates:
     def p(self) -> int:
         return self.Cz.shape[0]
 
-    def to(self, T: np.ndarray) -> "Coordinates":
+    def to(self, T: np.ndarray) -> Coordinates:
         """The same data in the coordinates ``x = T x^`` (``T`` relative to the original states)."""
         Fs, Gs, Bw, Cz, H, EF = self.original
         return replace(self, T=T, F=tuple(np.linalg.solve(T, F @ T) for F in Fs),
@@ -82,12 +95,37 @@ class Coordinates:
         return np.linalg.solve(self.T.T, K.T).T, self.T @ X @ self.T.T
 
 
-def normalised(F: Sequence[np.ndarray], G: Sequence[np.ndarray], Bw: np.ndarray, Cz: np.ndarray,
-               Dzu: np.ndarray, Dzw: np.ndarray, w_scale: float = 1.0, uncertainty=None) -> Coordinates:
-    """Balanced, ``||Bw~|| = 1`` coordinates of the vertices ``(F[i], G[i])``, with ``z`` compressed.
+def channel_scales(Bw: np.ndarray, Cz: np.ndarray, Dzu: np.ndarray, Dzw: np.ndarray,
+                   w_energy: float | None = None) -> tuple[float, float]:
+    """``(w_scale, z_unit)``: the units of ``w = w_scale w~`` and ``z = z_unit z~`` for :func:`normalised`.
 
-    ``uncertainty`` (a :class:`~robustctl.NormBounded` or ``None``) is carried
-    along (``H`` and ``EF`` change with the coordinates).
+    ``w_scale = sqrt(w_energy)`` with an input bound (``w~`` then has unit
+    energy, and the set of disturbances ``Bw sqrt(w_energy) w~`` is what the
+    later stages see), otherwise ``1 / ||Bw||_2`` (the energy is immaterial
+    without a bound); ``z_unit = ||[Cz Dzu Dzw w_scale]||_2``. Both are 1 for
+    a zero matrix. Scaling ``z`` by ``a`` scales ``z_unit`` by ``a``, and
+    scaling ``w`` by ``b`` (``Bw``, ``Dzw`` by ``b`` and ``w_energy`` by
+    ``1 / b^2``) scales ``w_scale`` by ``1 / b``: the scaled data, hence the
+    solver's problem and the gain, do not change (up to rounding).
+    """
+    if w_energy is None:
+        bw = float(np.linalg.norm(Bw, 2))
+        w_scale = 1.0 / bw if bw > 0 else 1.0
+    else:
+        w_scale = float(np.sqrt(w_energy))
+    size = float(np.linalg.norm(np.hstack([Cz, Dzu, Dzw * w_scale]), 2))
+    return w_scale, size if size > 0 else 1.0
+
+
+def normalised(F: Sequence[np.ndarray], G: Sequence[np.ndarray], Bw: np.ndarray, Cz: np.ndarray,
+               Dzu: np.ndarray, Dzw: np.ndarray, w_scale: float = 1.0, uncertainty=None, *,
+               z_unit: float = 1.0) -> Coordinates:
+    """Balanced, ``||Bw~|| = 1`` coordinates of the vertices ``(F[i], G[i])``, with ``z`` scaled and compressed.
+
+    ``w = w_scale w~`` and ``z = z_unit z~`` (:func:`channel_scales`) are
+    applied first, so that the balancing too sees the scaled channels.
+    ``uncertainty`` (a :class:`~robustctl.NormBounded` or ``None``) is
+    carried along (``H`` and ``EF`` change with the coordinates).
 
     Only ``z'z`` matters to every synthesis here, so ``[Cz Dzu Dzw]`` is
     replaced by ``R`` with ``R'R = [Cz Dzu Dzw]'[Cz Dzu Dzw]`` (full row
@@ -95,20 +133,21 @@ def normalised(F: Sequence[np.ndarray], G: Sequence[np.ndarray], Bw: np.ndarray,
     """
     Fs, Gs = tuple(F), tuple(G)
     n, m = Cz.shape[1], Dzu.shape[1]
+    Bw, Dzw = Bw * w_scale, Dzw * w_scale
+    Cz, Dzu, Dzw = Cz / z_unit, Dzu / z_unit, Dzw / z_unit
     d = _balance(Fs[0], Bw, Gs[0], Cz)
-    bw = np.linalg.norm(Bw / d[:, None] * w_scale, 2)
+    bw = np.linalg.norm(Bw / d[:, None], 2)
     if bw > 0 and np.isfinite(bw):
         d = d * bw
     CD = np.hstack([Cz, Dzu, Dzw])
     _, sv, Vt = np.linalg.svd(CD, full_matrices=False)
-    r = int(np.sum(sv > tol.Z_RANK * max(1.0, sv[0] if sv.size else 0.0)))
+    r = int(np.sum(sv > tol.Z_RANK * (sv[0] if sv.size else 0.0)))
     if 0 < r < CD.shape[0]:
         CD = sv[:r, None] * Vt[:r]
         Cz, Dzu, Dzw = CD[:, :n], CD[:, n:n + m], CD[:, n + m:]
     H, EF, EG = (None, None, None) if uncertainty is None else (uncertainty.H, uncertainty.EF, uncertainty.EG)
-    base = Coordinates(F=Fs, G=Gs, Bw=Bw * w_scale, Cz=Cz, Dzu=Dzu, Dzw=Dzw * w_scale, T=np.eye(n),
-                       original=(Fs, Gs, Bw * w_scale, Cz, H, EF), w_scale=float(w_scale), balancing=d,
-                       H=H, EF=EF, EG=EG)
+    base = Coordinates(F=Fs, G=Gs, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, T=np.eye(n), original=(Fs, Gs, Bw, Cz, H, EF),
+                       w_scale=float(w_scale), balancing=d, H=H, EF=EF, EG=EG, z_unit=float(z_unit))
     return base.to(np.diag(d))
 
 
@@ -121,7 +160,7 @@ def _balance(F, Bw, G, Cz) -> np.ndarray:
 
         _, _, _, _, d = tb01id(n, B.shape[1], Cz.shape[0], 0.0, F.copy(), B.copy(), Cz.copy(), job="A")
         d = np.asarray(d, dtype=float)
-    except Exception:  # slycot missing or failed: no scaling
+    except (ImportError, RuntimeError, ValueError, ArithmeticError):  # slycot missing or failed: no scaling
         return np.ones(n)
     if d.shape != (n,) or not np.all(np.isfinite(d)) or np.any(d <= 0):
         return np.ones(n)
@@ -143,8 +182,8 @@ def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
     F, G, C, D = data.F[0], data.G[0], data.Cz, data.Dzu
     n, m = data.n, data.m
     Q, R, S = C.T @ C, D.T @ D, C.T @ D
-    Q = Q + tol.LQR_REG * max(1.0, np.linalg.norm(Q, 2)) * np.eye(n)
-    R = R + tol.LQR_REG * max(1.0, np.linalg.norm(R, 2)) * np.eye(m)
+    Q = Q + tol.LQR_REG * max(1.0, float(np.linalg.norm(Q, 2))) * np.eye(n)
+    R = R + tol.LQR_REG * max(1.0, float(np.linalg.norm(R, 2))) * np.eye(m)
     are = scipy.linalg.solve_discrete_are if discrete else scipy.linalg.solve_continuous_are
     try:
         with np.errstate(all="ignore"):
@@ -156,7 +195,9 @@ def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
         return None
     X = np.linalg.inv(0.5 * (P + P.T) + max(0.0, tol.RECENTRE_REG * lam[-1] - lam[0]) * np.eye(n))
     moved = recentred(data, X, tol.RECENTRE_REG)  # X > 0 by construction
-    bw = np.linalg.norm(moved[0].Bw, 2) if moved is not None else 0.0
+    if moved is None:
+        return None
+    bw = float(np.linalg.norm(moved[0].Bw, 2))
     if not (bw > 0 and np.isfinite(bw)):  # no disturbance: nothing to normalise by
         return None
     return moved[0].to(moved[0].T * bw)

@@ -27,8 +27,8 @@ certificate). ``backoff=0`` returns the optimal point itself
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Callable, Iterator
 
 import numpy as np
 import scipy.linalg
@@ -109,7 +109,7 @@ def optimum_certified(problem: Problem, opt: Optimum, backoff: float) -> Attempt
     if not problem.discrete or problem.extended or problem.polytopic or problem.uncertainty is not None:
         return Attempt()
     data = opt.data
-    z_scale = 1.0 / (data.w_scale * opt.gamma_opt * (1.0 + backoff))
+    z_scale = 1.0 / (data.level_scale * opt.gamma_opt * (1.0 + backoff))
     K = opt.point.gain()
     A = data.F[0] + data.G[0] @ K
     B, C, D = data.Bw, z_scale * (data.Cz + data.Dzu @ K), z_scale * data.Dzw
@@ -195,22 +195,25 @@ def _optimal_lyapunov(opt: Optimum) -> np.ndarray:
 
 def _max_margin(problem: Problem, data: Coordinates, gamma: float, infeasible_msg: str,
                 x_upper: float | None = None, margin: float = 0.0):
-    """Maximise ``t`` at level ``gamma``: the margin of every block (``t <= 1``), or with ``x_upper``
-    the smallest eigenvalue of ``X`` (blocks ``>= margin``). Returns ``(V, t, report)``."""
+    """Maximise ``t`` at level ``gamma``; returns ``(V, t, report)``.
+
+    ``t`` is the margin of every block (``t <= 1``), or with ``x_upper`` the smallest
+    eigenvalue of ``X`` (blocks ``>= margin``).
+    """
     import cvxpy as cp
 
     V = variables(data.n, data.m, len(data.F), problem.extended, uncertain=problem.uncertainty is not None)
     t = cp.Variable(name="t")
-    z_scale = 1.0 / (data.w_scale * gamma)  # the scaled level is then 1
+    z_scale = 1.0 / (data.level_scale * gamma)  # the scaled level is then 1
     if x_upper is None:
         lmis = blocks(problem, data, V, 1.0, margin=t, z_scale=z_scale)
         cons = [t <= 1.0]
     else:
-        lmis = blocks(problem, data, V, 1.0, margin=margin, z_scale=z_scale, x_margin=t, x_upper=x_upper)
+        lmis = blocks(problem, data, V, 1.0, margin=margin, z_scale=z_scale, x_bounds=(t, x_upper))
         cons = []
     rep = _cvx.solve_sdp(cp.Maximize(t), lmis, cons, solver=problem.solver, tol=tol.CENTRE_TOL,
                          infeasible_msg=infeasible_msg)
-    return V, float(t.value), rep
+    return V, float(_cvx.value(t)), rep
 
 
 def _centring(problem: Problem, data: Coordinates, opt: Optimum, backoff: float, variant: str) -> Attempt:

@@ -35,7 +35,7 @@ __all__ = ["Optimum", "Solved", "minimise_level", "solve_level"]
 
 
 class Solved(NamedTuple):
-    """One level minimisation: the point (arrays), the scaled level ``(w_scale z_scale gamma)^2``, the report."""
+    """One level minimisation: the point (arrays), the scaled level ``(level_scale z_scale gamma)^2``, the report."""
 
     point: Point
     level_sq: float
@@ -76,7 +76,7 @@ class Optimum:
 
 def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, preconditioned: bool = False,
                 extended: bool | None = None) -> Solved:
-    """One minimisation of the scaled level ``(w_scale z_scale gamma)^2``.
+    """One minimisation of the scaled level ``(level_scale z_scale gamma)^2`` (``data.level_scale``).
 
     Raises InfeasibleError (no gain at any level, e.g. an input bound too
     tight or no common Lyapunov matrix) or ConvergenceError (solver failure).
@@ -91,7 +91,7 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
                          solver=problem.solver, tol=tol.LEVEL_TOL if preconditioned else tol.LEVEL_TOL_GENERAL,
                          infeasible_msg=f"no H-infinity state feedback: {problem.infeasibility()}",
                          fast=preconditioned)
-    return Solved(V.values(), float(level_sq.value), rep)
+    return Solved(V.values(), float(_cvx.value(level_sq)), rep)
 
 
 def minimise_level(problem: Problem, balanced: Coordinates, lqr: Coordinates | None) -> Optimum:
@@ -122,7 +122,7 @@ def minimise_level(problem: Problem, balanced: Coordinates, lqr: Coordinates | N
             solves.append(polished[1].report.as_dict())
             if polished[1].level_sq < found.level_sq:  # both certified: the lower is nearer the infimum
                 data, found = polished
-    gamma_opt = float(np.sqrt(max(found.level_sq, 0.0))) / (data.w_scale * z_scale)
+    gamma_opt = float(np.sqrt(max(found.level_sq, 0.0))) / (data.level_scale * z_scale)
     return Optimum(point=found.point, data=data, centring=centring, gamma_opt=gamma_opt,
                    preconditioned=preconditioned, report=found.report, solves=tuple(solves))
 

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from .. import _cvx
-from . import _tolerances as tol
 from ..regions import region_lmi
+from . import _tolerances as tol
 from ._coordinates import Coordinates
 
 __all__ = ["Point", "variables", "blocks", "hinf_blocks", "lyapunov_blocks", "input_bound_blocks",
@@ -43,14 +43,12 @@ class Point:
     def extended(self) -> bool:
         return self.S is not None
 
-    def values(self) -> "Point":
+    def values(self) -> Point:
         """The solution held by the cvxpy variables, as arrays."""
         if self.extended:
-            return Point(P=tuple(np.asarray(P.value, dtype=float) for P in self.P),
-                         S=np.asarray(self.S.value, dtype=float), L=np.asarray(self.L.value, dtype=float))
-        X = np.asarray(self.X.value, dtype=float)
-        return Point(X=0.5 * (X + X.T), Y=np.asarray(self.Y.value, dtype=float),
-                     eps=tuple(float(e.value) for e in self.eps))
+            return Point(P=tuple(_cvx.value(P) for P in self.P), S=_cvx.value(self.S), L=_cvx.value(self.L))
+        X = _cvx.value(self.X)
+        return Point(X=0.5 * (X + X.T), Y=_cvx.value(self.Y), eps=tuple(float(_cvx.value(e)) for e in self.eps))
 
     def shape_matrix(self) -> np.ndarray:
         """The matrix whose shape defines recentred coordinates: ``X``, or the symmetric part of ``S``."""
@@ -87,7 +85,7 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
                 z_scale: float = 1.0) -> list[_cvx.LMI]:
     """The bounded-real-lemma block of every vertex, ``hinf[i]``, at the scaled level ``level_sq``.
 
-    ``level_sq`` is ``(w_scale z_scale gamma)^2`` (a float or a cvxpy
+    ``level_sq`` is ``(level_scale z_scale gamma)^2`` (a float or a cvxpy
     variable); ``z_scale`` multiplies ``z``. The constant disturbance block
     ``I`` is eliminated by a Schur complement (``q`` rows smaller, still
     linear). With an uncertainty in ``data`` (and multipliers in ``V``) the
@@ -100,7 +98,7 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
     Bw = data.Bw
     BB, BD, DD = Bw @ Bw.T, Bw @ Dzw.T, Dzw @ Dzw.T
     out = []
-    for i, (F, G) in enumerate(zip(data.F, data.G)):
+    for i, (F, G) in enumerate(zip(data.F, data.G, strict=True)):
         if V.extended:
             P, S, L = V.P[i], V.S, V.L
             AS, CS = F @ S + G @ L, Cz @ S + Dzu @ L
@@ -133,6 +131,7 @@ def _robust_block(data: Coordinates, eps, X, Y, AX, CX, W, BB, BD, discrete: boo
     """
     import cvxpy as cp
 
+    assert data.H is not None and data.EF is not None and data.EG is not None  # V.eps: an uncertainty was given
     EX = data.EF @ X + data.EG @ Y
     n, p, l = data.n, W.shape[0], EX.shape[0]
     epsHH, epsI = eps * (data.H @ data.H.T), eps * np.eye(l)
@@ -188,21 +187,21 @@ def input_bound_blocks(V: Point, u_max: np.ndarray) -> list[_cvx.LMI]:
 def region_blocks(regions, data: Coordinates, V: Point, margin=0.0) -> list[_cvx.LMI]:
     """``poles[k][i]``: the closed loop of vertex ``i`` has its poles in region ``k`` (same ``X``)."""
     return [_cvx.LMI(f"poles[{k}][{i}]", region_lmi(region, F @ V.X + G @ V.Y, V.X), margin)
-            for k, region in enumerate(regions) for i, (F, G) in enumerate(zip(data.F, data.G))]
+            for k, region in enumerate(regions) for i, (F, G) in enumerate(zip(data.F, data.G, strict=True))]
 
 
-def blocks(problem, data: Coordinates, V: Point, level_sq, *, margin=0.0, z_scale: float = 1.0, x_margin=None,
-           x_upper: float | None = None) -> list[_cvx.LMI]:
+def blocks(problem, data: Coordinates, V: Point, level_sq, *, margin=0.0, z_scale: float = 1.0,
+           x_bounds: tuple[Any, float] | None = None) -> list[_cvx.LMI]:
     """Every LMI block of one H-infinity synthesis problem (a :class:`._problem.Problem`), named.
 
-    The H-infinity and pole-region blocks get ``margin``. With ``x_margin``
-    the Lyapunov (or slack) matrix is also bounded, ``x_margin I <= X <=
-    x_upper I``; otherwise continuous time adds ``X >= margin I`` (discrete
-    time implies ``X > 0``). An input bound adds its blocks.
+    The H-infinity and pole-region blocks get ``margin``. With ``x_bounds =
+    (x_margin, x_upper)`` the Lyapunov (or slack) matrix is also bounded,
+    ``x_margin I <= X <= x_upper I``; otherwise continuous time adds ``X >=
+    margin I`` (discrete time implies ``X > 0``). An input bound adds its blocks.
     """
     out = hinf_blocks(data, V, level_sq, discrete=problem.discrete, margin=margin, z_scale=z_scale)
-    if x_margin is not None:
-        out += lyapunov_blocks(V, x_margin, x_upper)
+    if x_bounds is not None:
+        out += lyapunov_blocks(V, *x_bounds)
     elif not problem.discrete:
         out.append(_cvx.LMI("X", V.X, margin))
     out += region_blocks(problem.regions, data, V, margin)

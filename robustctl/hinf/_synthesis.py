@@ -1,8 +1,9 @@
 """The H-infinity synthesis driver: the stages in order.
 
 1. :func:`._problem.validate` - every argument, and stabilisability (PBH);
-2. :func:`._coordinates.normalised` and :func:`._coordinates.lqr_coordinates`
-   - the balanced coordinates, and for one plant the LQR ones;
+2. :func:`._coordinates.channel_scales`, :func:`._coordinates.normalised` and
+   :func:`._coordinates.lqr_coordinates` - the units of ``w`` and ``z``, the
+   balanced coordinates, and for one plant the LQR ones;
 3. :mod:`._lmis` - the named LMI blocks (used by every solve and every
    certificate);
 4. :func:`._level.minimise_level` - ``gamma_opt`` (or, with a fixed ``gamma``,
@@ -15,22 +16,24 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import _cvx
 from ..controller import Controller
 from ..errors import ConvergenceError
 from ..plant import Plant
 from ..regions import Region
+from ..stability import is_stable
 from ..uncertainty import NormBounded
 from . import _tolerances as tol
-from ._coordinates import lqr_coordinates, normalised
+from ._coordinates import channel_scales, lqr_coordinates, normalised
 from ._gains import Gain, gain_at_level, gain_near_optimum
 from ._level import minimise_level
-from ._problem import Problem, validate
+from ._problem import Problem, validate, vertex_name
 
 __all__ = ["hinf", "HinfController", "check_closed_loop", "guaranteed_input_bound"]
 
@@ -142,10 +145,12 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         returned point), ``gain_from`` (``"optimum-certified"``,
         ``"optimum"`` for ``backoff=0``, or the centring variant),
         ``X_min_eig``, ``margin`` (centring margin ``t``), ``solves``
-        (per-solve diagnostics), ``X`` (Lyapunov matrix; ``P`` of the
-        nominal vertex when ``extended``), ``u_bound`` (guaranteed
-        ``max |u_j|`` for ``w_energy``, when ``u_max`` is given),
-        ``scaling`` (state balancing), ``lmi``, ``vertices``, ``backoff``
+        (per-solve diagnostics), ``X`` (Lyapunov matrix, ``x' X^-1 x <= 1``
+        on the states reached by disturbances of energy ``w_energy``, 1
+        without ``u_max``; ``P`` of the nominal vertex when ``extended``),
+        ``u_bound`` (guaranteed ``max |u_j|`` for ``w_energy``, when
+        ``u_max`` is given), ``scaling`` (state balancing), ``lmi``,
+        ``vertices``, ``backoff``
         (the value used), ``poles`` (the regions), ``uncertainty`` and, with
         one, ``multipliers`` (the S-procedure multipliers). Each entry of
         ``solves`` has the solver's ``status``, ``value``, ``tol``,
@@ -155,7 +160,8 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     Raises
     ------
     InfeasibleError
-        A vertex is not stabilisable, the fixed ``gamma`` or the input bound
+        A vertex is not stabilisable (:class:`~robustctl.errors.NotStabilizableError`,
+        an ``InfeasibleError``), the fixed ``gamma`` or the input bound
         cannot be met, no common Lyapunov matrix exists for the vertices (or
         the uncertainty), or the pole regions cannot be reached (the reason:
         regions without a common stable point, a mode outside them that the
@@ -165,15 +171,28 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
 
     Examples
     --------
-    >>> ctrl = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)   # doctest: +SKIP
-    >>> ctrl.gamma, ctrl.info["gamma_opt"]                       # doctest: +SKIP
+    The truck of the paper with a disturbance entering like the steering
+    input and ``z = (x, u)``; the optimal level agrees with the independent
+    game-Riccati bisection of :mod:`robustctl.hinf_riccati`:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.hinf_riccati import hinf_riccati
+    >>> from robustctl.models.truck import truck_plant
+    >>> plant = truck_plant(0.0)
+    >>> Bw, Cz, Dzu = plant.G, np.vstack([np.eye(4), np.zeros((1, 4))]), np.vstack([np.zeros((4, 1)), [[1.0]]])
+    >>> ctrl = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    >>> round(ctrl.gamma_opt, 4), round(ctrl.gamma / ctrl.gamma_opt - 1, 6), ctrl.is_stabilizing()
+    (1.2547, 0.001, True)
+    >>> bool(abs(ctrl.gamma_opt / hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu).gamma - 1) < 1e-6)
+    True
     """
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
                        w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
                        uncertainty=uncertainty)
-    w_scale = float(np.sqrt(problem.w_energy)) if problem.u_max is not None else 1.0
+    w_scale, z_unit = channel_scales(problem.Bw, problem.Cz, problem.Dzu, problem.Dzw, problem.w_energy)
     balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
-                          problem.Dzu, problem.Dzw, w_scale, problem.uncertainty)
+                          problem.Dzu, problem.Dzw, w_scale, problem.uncertainty, z_unit=z_unit)
     lqr = None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
     if problem.gamma is not None:
         gain, solves = gain_at_level(problem, lqr or balanced, problem.gamma)
@@ -183,6 +202,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         gain, used_backoff, centring = gain_near_optimum(problem, opt)
         level, gamma_opt, solves = opt.gamma_opt * (1.0 + used_backoff), opt.gamma_opt, opt.solves + centring
     K, X = gain.data.to_original(gain.point.gain(), gain.point.nominal_lyapunov())
+    X = X * (problem.w_energy or 1.0) / w_scale**2  # the reachable set of disturbances of energy w_energy (1)
     check_closed_loop(K, problem.plants, problem.regions)
     info = _info(problem, gain, K, X, level, gamma_opt, used_backoff, solves)
     return HinfController(K=K, method="hinf", plant=plant, info=info, gamma=float(level), gamma_opt=gamma_opt)
@@ -191,17 +211,18 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
 def check_closed_loop(K: np.ndarray, plants, regions: Sequence[Region] = ()) -> None:
     """ConvergenceError unless ``K`` is finite and stabilises every vertex with its poles in the regions.
 
-    An internal check of the returned gain (the LMI certificate implies both).
+    An internal check of the returned gain (the LMI certificate implies both);
+    stable means :func:`robustctl.stability.is_stable` (the library's one margin).
     """
     if not np.all(np.isfinite(K)):
         raise ConvergenceError("the gain K = Y X^-1 is not finite; increase backoff")
     for i, p in enumerate(plants):
-        poles = np.linalg.eigvals(p.F + p.G @ K)
-        stable = np.max(np.abs(poles)) < 1 if p.is_discrete else np.max(poles.real) < 0
-        where = "plant" if i == 0 else f"vertices[{i - 1}]"
-        if not stable:
+        A = p.F + p.G @ K
+        where = vertex_name(i)
+        if not is_stable(A, discrete=p.is_discrete):
             raise ConvergenceError(f"internal check failed: the LMI gain does not stabilise {where}; "
                                    "increase backoff")
+        poles = np.linalg.eigvals(A)
         for r in regions:
             if not np.all(r.contains(poles)):
                 raise ConvergenceError(f"internal check failed: a closed-loop pole of {where} lies outside {r!r} "
@@ -219,9 +240,7 @@ def _info(problem: Problem, gain: Gain, K, X, level, gamma_opt, backoff, solves)
     info = {
         "gamma": level, "gamma_opt": gamma_opt, "backoff": backoff,
         "lmi": ("extended" if problem.extended else "standard") + ("-discrete" if problem.discrete else "-continuous"),
-        "vertices": len(problem.plants), "status": solves[-1]["status"],
-        "solve_time": float(sum(s["solve_time"] for s in solves)),
-        "iterations": int(sum(s["iterations"] or 0 for s in solves)),
+        "vertices": len(problem.plants), "status": solves[-1]["status"], **_cvx.totals(solves),
         "certificate": gain.certificate, "gain_from": gain.route, "X_min_eig": float(np.linalg.eigvalsh(Xs).min()),
         "margin": float(gain.margin), "solves": list(solves), "X": Xs, "scaling": gain.data.balancing,
         "solver": problem.solver, "poles": problem.regions, "uncertainty": problem.uncertainty,

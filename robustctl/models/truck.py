@@ -66,7 +66,8 @@ __all__ = [
     "STEER_LIMIT", "continuous_model", "truck_plant", "discretise", "steady_state_cornering",
     "reference_states", "AlgebraicUncertainty", "algebraic_uncertainty", "uncertainty_from_z",
     "RLQR_MOP_Z", "PRINTED_EF", "PRINTED_EG", "PRINTED_LOG10_MU_SQ", "check_overload",
-    "MAX_ERRORS", "MAX_STEER", "lqr_weights", "DOUBLED_INPUT_MAP",
+    "MAX_ERRORS", "MAX_STEER", "lqr_weights", "DOUBLED_INPUT_MAP", "open_loop_reference",
+    "AUTHORS_Q_DIAG", "AUTHORS_R_DOUBLED", "AUTHORS_X0", "CODE_EG", "authors_weights",
 ]
 
 #: State names, in the model's order.
@@ -177,7 +178,7 @@ def _params(params) -> TruckParameters:
     return params
 
 
-def _continuous_batch(p: TruckParameters, load: np.ndarray):
+def _continuous_batch(p: TruckParameters, load: float | np.ndarray):
     """A (k,4,4), B (k,4,1), E (4,) for payload multipliers ``load`` (k,)."""
     load = np.atleast_1d(np.asarray(load, dtype=float))
     m = p._mass(load)
@@ -340,6 +341,55 @@ def reference_states(kappa, overload: float = 0.0, *, params: TruckParameters | 
     return kappa[:, None] * xk[None, :], ak * kappa
 
 
+def open_loop_reference(kappa, overload: float = 0.0, *, params: TruckParameters | None = None
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """The truck at ``overload`` driven open loop by its steady-cornering steering along a path.
+
+    The reference of the authors' published code (Barbosa et al. 2019, GitHub
+    ``barbosafilipe/robust_lqr``, ``standard_formulation/parameters.m``): the
+    nominal vehicle, started at rest on the path, is driven by a smooth
+    steering command ``u_ref`` and its simulated states are the reference
+    (there: two 5 s sine steering lane changes on a straight road). Here the
+    command is the steady-cornering steering of the path's curvature,
+    ``u_ref[k] = alpha_per_kappa kappa[k]`` (:func:`steady_state_cornering`),
+    so lane changes and bends of any :class:`robustctl.path.ReferencePath`
+    give the command::
+
+        x_ref[0] = 0,   x_ref[k+1] = F x_ref[k] + G u_ref[k] + Gk kappa[k]
+
+    (the ZOH model of :func:`discretise`). Open loop, the vehicle lags the
+    path in every transition and nothing pulls it back, so ``rho_ref``
+    drifts away from the path (about 22 m over the 9 km default route):
+    the reference trajectory is the open-loop vehicle's, the path only its
+    frame. Because the curvature enters the true and the reference vehicle
+    alike (``Gk`` does not depend on the payload), it cancels from the
+    tracking error ``x - x_ref``: only ``u_ref`` matters.
+
+    Parameters
+    ----------
+    kappa : (T,) array_like
+        Path curvature at each sample [1/m].
+    overload : float
+        Payload of the reference vehicle (the controller's nominal model).
+
+    Returns
+    -------
+    x_ref : (T, 4) ndarray
+        States ``[ydot, psidot, rho, theta]`` of the open-loop vehicle.
+    u_ref : (T,) ndarray
+        The steering command [rad].
+    """
+    kappa = as_batch(kappa, "kappa", (None,))
+    _, a_per_kappa = steady_state_cornering(overload, params=params)
+    u_ref = a_per_kappa * kappa
+    F, G, Gk = discretise(overload, params=params)
+    drive = G[0, :, 0][None, :] * u_ref[:, None] + Gk[0][None, :] * kappa[:, None]   # (T, 4)
+    x_ref = np.zeros((kappa.size, 4))
+    for k in range(kappa.size - 1):                  # one sequential recursion (T steps of a 4 x 4 product)
+        x_ref[k + 1] = F[0] @ x_ref[k] + drive[k]
+    return x_ref, u_ref
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class AlgebraicUncertainty:
     """Norm-bounded uncertainty of the RLQR^A design (paper's Appendix A).
@@ -430,6 +480,44 @@ def lqr_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
     Q = np.diag(1.0 / np.square(MAX_ERRORS))
     r = 1.0 / MAX_STEER**2
     return Q, (2.0 * r * np.eye(2) if doubled else np.array([[r]]))
+
+
+#: State weight of the authors' published code (Barbosa et al. 2019, GitHub
+#: ``barbosafilipe/robust_lqr``, ``standard_formulation/parameters.m`` and
+#: ``alternative_formulation/model.m``: ``Q = diag(1, 1, 1, 1, 25000, 100)`` on
+#: the articulated truck's six states), on ``[ydot, psidot, rho, theta]``.
+AUTHORS_Q_DIAG = (1.0, 1.0, 25000.0, 100.0)
+#: The code's input weight on the doubled steering column, ``R = 67070 I2`` (same files).
+AUTHORS_R_DOUBLED = 67070.0
+#: The code's initial state (same files: ``x0 = [0; 0; 0; 0; 0.3; -0.1]``): 0.3 m
+#: left of the path, heading -0.1 rad, velocities zero; ``[ydot, psidot, rho, theta]``.
+AUTHORS_X0 = (0.0, 0.0, 0.3, -0.1)
+#: RLQR^A's ``E_G`` in the code (``standard_formulation/parameters.m``,
+#: ``alternative_formulation/model.m``: ``Eg = [-0.0666666666666667 -0.0066666666666667]``,
+#: ``[-1/15, -1/150]`` to the 16 digits printed); the paper prints two equal entries, :data:`PRINTED_EG`.
+CODE_EG = (-0.0666666666666667, -0.0066666666666667)
+
+
+def authors_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """The weights of the authors' published code: ``Q = diag(1, 1, 25000, 100)``, ``R = 67070 I2``.
+
+    From Barbosa et al. (2019)'s code (GitHub ``barbosafilipe/robust_lqr``,
+    ``standard_formulation/parameters.m``, ``alternative_formulation/model.m``),
+    whose RLQR and H-infinity designs both use them; 25000 weighs the lateral
+    displacement ``rho``, 100 the orientation ``theta``, 1 the velocities (the
+    code's articulation states are dropped). ``R = 67070 I2`` is on the doubled
+    steering column; on the plain truck (``doubled=False``) the equivalent
+    weight is ``67070 / 2 = 33535``: the cheapest split of a steering angle
+    ``alpha`` is ``u1 = u2 = alpha/2`` at a cost ``67070 alpha^2 / 2`` (the rule
+    of :func:`lqr_weights`).
+
+    Returns
+    -------
+    Q : (4, 4) ndarray
+    R : (1, 1) or (2, 2) ndarray
+    """
+    Q = np.diag(AUTHORS_Q_DIAG)
+    return Q, (AUTHORS_R_DOUBLED * np.eye(2) if doubled else np.array([[AUTHORS_R_DOUBLED / 2.0]]))
 
 
 def uncertainty_from_z(z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -72,8 +72,8 @@ equal to the LQR as ``mu -> inf``. With ``EF = EG = 0`` and ``H != 0``,
 Errors. :func:`rlqr` raises :class:`~robustctl.errors.NotStabilizableError`
 for a plant that is not stabilisable (PBH test,
 :func:`robustctl.stability.check_stabilizable`), as :func:`robustctl.lqr`
-does; :func:`robustctl.hinf` raises an ``InfeasibleError`` with the same
-message, and ``NotStabilizableError`` is one too. Without the check the
+does, and so do :func:`robustctl.hinf` and :func:`robustctl.h2`
+(``NotStabilizableError`` is also an ``InfeasibleError``). Without the check the
 recursion would not fail: for finite ``mu`` the fictitious input ``v``
 "stabilises" ``L`` while no ``K`` stabilises ``F + G K``.
 :func:`rlqr_gains` flags every design ``"unstabilizable"`` instead.
@@ -94,8 +94,9 @@ state gains for the discrete optimal regulator. IEEE TAC 16(4), 382-384.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any, overload
 
 import numpy as np
 
@@ -103,7 +104,7 @@ from .._validation import as_matrix, check_bool, check_choice, check_int, check_
 from ..controller import Controller
 from ..errors import ConvergenceError
 from ..plant import Plant, _frozen
-from ..stability import STABILITY_MARGIN, _schur, check_stabilizable
+from ..stability import check_stabilizable, is_schur_stable
 from ._model import DEFAULT_ALPHA, Model, build
 from ._steady import DEFAULT_MAX_ITER, DEFAULT_TOL, steady_state
 from ._step import block_steps, kkt_step, rlqr_step, rlqr_step_block
@@ -180,6 +181,7 @@ class RLQRSchedule:
 
     @property
     def horizon(self) -> int:
+        """Number of steps ``N``."""
         return self.K.shape[0]
 
     def controller(self, k: int) -> Controller:
@@ -276,14 +278,24 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
     ok = reason == "ok"
     K[~ok], P[~ok], L[~ok] = np.nan, np.nan, np.nan
     stabilizing = np.zeros(B, dtype=bool)
-    stabilizing[ok] = _schur(plant.F + plant.G @ K[ok], 1.0 - STABILITY_MARGIN)
-    return RLQRBatch(*(_frozen(a) for a in (K, P, L)), ok, reason, stabilizing, iterations, residual)
+    stabilizing[ok] = is_schur_stable(plant.F + plant.G @ K[ok])
+    return RLQRBatch(_frozen(K), _frozen(P), _frozen(L), ok, reason, stabilizing, iterations, residual)
+
+
+@overload
+def rlqr(plant: Plant, EF=..., EG=..., mu=..., *, Q=..., R=..., H=..., alpha: float = ..., uncertainty=...,
+         P_N=..., tol: float = ..., max_iter: int = ..., accelerate: bool = ..., implementation: str = ...,
+         fallback: str = ..., horizon: None = ...) -> Controller: ...
+@overload
+def rlqr(plant: Plant, EF=..., EG=..., mu=..., *, Q=..., R=..., H=..., alpha: float = ..., uncertainty=...,
+         P_N=..., tol: float = ..., max_iter: int = ..., accelerate: bool = ..., implementation: str = ...,
+         fallback: str = ..., horizon: int) -> RLQRSchedule: ...  # deprecated: use rlqr_schedule
 
 
 def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alpha: float = DEFAULT_ALPHA,
          uncertainty=None, P_N=None, tol: float = DEFAULT_TOL, max_iter: int = DEFAULT_MAX_ITER,
          accelerate: bool = True, implementation: str = "kkt", fallback: str = "recursion",
-         horizon: int | None = None) -> Controller:
+         horizon: int | None = None) -> Controller | RLQRSchedule:
     """Steady-state robust LQR for ``[dF dG] = H Delta [EF EG]``, ``||Delta|| <= 1`` (paper Theorem 1).
 
     Parameters
@@ -334,8 +346,8 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     Raises
     ------
     NotStabilizableError
-        ``(F, G)`` is not stabilisable; :func:`robustctl.lqr` raises the same,
-        :func:`robustctl.hinf` an ``InfeasibleError`` (which this error also is).
+        ``(F, G)`` is not stabilisable; :func:`robustctl.lqr`, :func:`robustctl.hinf`
+        and :func:`robustctl.h2` raise the same (it is also an ``InfeasibleError``).
     RankConditionError
         ``mu = inf`` and ``EG`` is not of full row rank (``[I -G; 0 -EG]`` is
         then not of full row rank and ``EF + EG K = 0`` may have no solution).
@@ -398,11 +410,15 @@ def rlqr_schedule(plant: Plant, EF=None, EG=None, mu=None, *, horizon: int, Q=No
     if not d.rank_ok()[0]:
         raise d.rank_error()
     step = block_steps if implementation == "block" else kkt_step
-    Ps, Ks, Ls = [P_N], [], []
+    Ps: list[np.ndarray] = [P_N]
+    Ks: list[np.ndarray] = []
+    Ls: list[np.ndarray] = []
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for _ in range(horizon):
             Pk, Kk, Lk = step(Ps[0][None], d)
-            Ps.insert(0, Pk[0]); Ks.insert(0, Kk[0]); Ls.insert(0, Lk[0])
+            Ps.insert(0, Pk[0])
+            Ks.insert(0, Kk[0])
+            Ls.insert(0, Lk[0])
     K, L, P = (_frozen(np.array(a)) for a in (Ks, Ls, Ps))
     if not (np.isfinite(K).all() and np.isfinite(P).all()):
         raise ConvergenceError("the finite-horizon recursion produced non-finite values")

@@ -9,8 +9,8 @@ import numpy as np
 from .._validation import as_batch, as_float_array, as_matrix, check_positive_scalar
 from ..errors import RankConditionError
 from ..lqr import _weights
-from ..plant import Plant
-from ..uncertainty import NormBounded
+from ..plant import check_plant
+from ..uncertainty import check_norm_bounded
 
 #: Default margin of ``lambda = (1 + alpha) ||mu H'H||``.
 DEFAULT_ALPHA = 0.1
@@ -53,7 +53,7 @@ class Model:
             return np.zeros_like(self.mu)
         return (1.0 + self.alpha) * self.mu * self.h_norm2
 
-    def select(self, mask: np.ndarray) -> "Model":
+    def select(self, mask: np.ndarray) -> Model:
         """The designs selected by the boolean ``mask`` (or index array)."""
         if mask.dtype == bool and mask.all():
             return self
@@ -111,11 +111,9 @@ def _uncertainty(plant, EF, EG, H, uncertainty):
             if value is None:
                 raise TypeError(f"{name} is required: give EF and EG (or uncertainty=NormBounded(H, EF, EG))")
         return EF, EG, H
-    if not isinstance(uncertainty, NormBounded):
-        raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(uncertainty).__name__}")
+    check_norm_bounded(uncertainty, plant)
     if EF is not None or EG is not None or H is not None:
         raise TypeError("give either uncertainty=NormBounded(...) or EF, EG (and H), not both")
-    uncertainty.check_plant(plant)
     return uncertainty.EF, uncertainty.EG, uncertainty.H
 
 
@@ -135,10 +133,7 @@ def build(plant, EF, EG, mu, *, Q, R, H, alpha, uncertainty=None, batch: bool) -
     ``batch``: ``EF``, ``EG`` may be stacks (B, l, n), (B, l, m) and ``mu``
     a 1-D array, any of them without the batch axis to be shared.
     """
-    if not isinstance(plant, Plant):
-        raise TypeError(f"plant must be a robustctl.Plant, got {type(plant).__name__}")
-    if not plant.is_discrete:
-        raise ValueError("plant must be discrete-time (dt > 0) for the RLQR; discretise it first")
+    check_plant(plant, discrete_for="the RLQR")
     n, m = plant.n, plant.m
     EF, EG, H = _uncertainty(plant, EF, EG, H, uncertainty)
     EF = _as_designs(EF, "EF", (None, n), ("", "the number of states"), batch)
@@ -153,7 +148,7 @@ def build(plant, EF, EG, mu, *, Q, R, H, alpha, uncertainty=None, batch: bool) -
     H = np.ones((n, l)) if H is None else as_matrix(H, "H", rows=n, vector="column",
                                                    rows_what="the number of states")
     alpha = check_positive_scalar(alpha, "alpha")
-    EF, EG, mu = (np.broadcast_to(a, (B,) + a.shape[1:]) for a in (EF, EG, mu))
+    EF, EG, mu = (np.broadcast_to(a, (B, *a.shape[1:])) for a in (EF, EG, mu))
     with np.errstate(divide="ignore"):
         mu_inv = np.where(np.isinf(mu), 0.0, 1.0 / mu)
     hh = _norm2(H)

@@ -1,13 +1,17 @@
-"""Steady state of the RLQR recursion for a batch: doubling, Newton refinement, the plain recursion,
-and the acceptance test that every result passes (package docstring)."""
+"""Steady state of the RLQR recursion for a batch.
+
+Doubling, Newton refinement, the plain recursion, and the acceptance test that every result
+passes (package docstring).
+"""
 
 from __future__ import annotations
 
-from typing import Callable, NamedTuple
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
-from ..stability import STABILITY_MARGIN, _schur
+from ..stability import is_schur_stable
 from ._model import Model
 from ._step import Step, kkt_step, solve, sym
 
@@ -33,8 +37,11 @@ _TINY = np.finfo(float).tiny
 
 
 class Evaluation(NamedTuple):
-    """The acceptance test at ``X``: ``P = f(X)`` and its ``K``, ``L`` (NaN where ``X`` diverged),
-    ``residual = ||f(X) - X|| / ||f(X)||`` and ``stable`` = ``rho(L) < 1 - STABILITY_MARGIN``."""
+    """The acceptance test at ``X``.
+
+    ``P = f(X)`` and its ``K``, ``L`` (NaN where ``X`` diverged),
+    ``residual = ||f(X) - X|| / ||f(X)||`` and ``stable`` = ``rho(L) < 1 - STABILITY_MARGIN``.
+    """
 
     P: np.ndarray
     K: np.ndarray
@@ -45,15 +52,17 @@ class Evaluation(NamedTuple):
     def accepted(self, tol: float) -> np.ndarray:
         return (self.residual < tol) & self.stable
 
-    def put(self, where: np.ndarray, other: "Evaluation") -> None:
+    def put(self, where: np.ndarray, other: Evaluation) -> None:
         """Overwrite the designs ``where`` (indices) with ``other``."""
-        for mine, theirs in zip(self, other):
+        for mine, theirs in zip(self, other, strict=True):
             mine[where] = theirs
 
 
 class SteadyState(NamedTuple):
-    """Per design: ``P``, ``K``, ``L``, steps taken, residual and ``reason`` in
-    ``{"ok", "diverged", "not converged"}``."""
+    """Per design: ``P``, ``K``, ``L``, steps taken, residual and ``reason``.
+
+    ``reason`` is one of ``{"ok", "diverged", "not converged"}``.
+    """
 
     P: np.ndarray
     K: np.ndarray
@@ -86,7 +95,7 @@ def evaluate(X: np.ndarray, d: Model, step: StepFunction) -> Evaluation:
     if good.any():
         idx = np.flatnonzero(good)
         new = step(X[idx], d.select(good))
-        ev.put(idx, Evaluation(*new, relchange(new.P, X[idx]), _schur(new.L, 1.0 - STABILITY_MARGIN)))
+        ev.put(idx, Evaluation(*new, relchange(new.P, X[idx]), np.asarray(is_schur_stable(new.L))))
     return ev
 
 
@@ -97,7 +106,7 @@ def recursion(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter
     was still moving after ``max_iter`` steps.
     """
     B = d.size
-    P = np.broadcast_to(P0, (B,) + P0.shape[-2:]).copy()
+    P = np.broadcast_to(P0, (B, *P0.shape[-2:])).copy()
     iterations = np.zeros(B, dtype=int)
     active = np.ones(B, dtype=bool)
     for it in range(1, max_iter + 1):
@@ -184,7 +193,7 @@ def newton(d: Model, P: np.ndarray, tol: float) -> tuple[Evaluation, np.ndarray]
     kept. Returns it and the number of evaluations per design.
     """
     B = P.shape[0]
-    best = Evaluation(np.full_like(P, np.nan), np.full((B,) + d.G.shape[::-1], np.nan), np.full_like(P, np.nan),
+    best = Evaluation(np.full_like(P, np.nan), np.full((B, *d.G.shape[::-1]), np.nan), np.full_like(P, np.nan),
                       np.full(B, np.inf), np.zeros(B, dtype=bool))
     evaluations = np.zeros(B, dtype=int)
     active = np.ones(B, dtype=bool)
@@ -195,7 +204,7 @@ def newton(d: Model, P: np.ndarray, tol: float) -> tuple[Evaluation, np.ndarray]
             break
         P_old = P[idx]
         new = kkt_step(P_old, d.select(active))
-        ev = Evaluation(*new, relchange(new.P, P_old), _schur(new.L, 1.0 - STABILITY_MARGIN))
+        ev = Evaluation(*new, relchange(new.P, P_old), np.asarray(is_schur_stable(new.L)))  # a stack: an array
         evaluations[idx] += 1
         better = ev.residual < best.residual[idx]
         best.put(idx[better], Evaluation(*(a[better] for a in ev)))

@@ -1,8 +1,11 @@
-"""One RLQR recursion step ``P[k+1] -> (P[k], K[k], L[k])``: the batched penalty/KKT form and the
-paper's block system (the reference)."""
+"""One RLQR recursion step ``P[k+1] -> (P[k], K[k], L[k])``.
+
+The batched penalty/KKT form and the paper's block system (the reference).
+"""
 
 from __future__ import annotations
 
+import contextlib
 from typing import NamedTuple
 
 import numpy as np
@@ -35,10 +38,8 @@ def solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     except np.linalg.LinAlgError:
         out = np.full(b.shape, np.nan)
         for i in range(A.shape[0]):  # rare fallback, only when some system is singular
-            try:
+            with contextlib.suppress(np.linalg.LinAlgError):
                 out[i] = np.linalg.solve(A[i], b[i])
-            except np.linalg.LinAlgError:
-                pass
         return out
 
 
@@ -80,16 +81,13 @@ def block_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float) -> Step:
     Ih = np.vstack([np.eye(n), np.zeros((l, n))])
     off = np.concatenate([[0], np.cumsum([n, m, n, n + l, n, m])])
     Xi = np.zeros((off[-1], off[-1]))
-
-    def put(i, j, blk):
+    for i, j, blk in ((0, 0, np.linalg.inv(P_next)), (0, 4, np.eye(n)),
+                      (1, 1, np.linalg.inv(R)), (1, 5, np.eye(m)),
+                      (2, 2, np.linalg.inv(Q)),
+                      (3, 3, Sigma), (3, 4, Ih), (3, 5, -Gh),
+                      (4, 0, np.eye(n)), (4, 3, Ih.T),
+                      (5, 1, np.eye(m)), (5, 3, -Gh.T)):
         Xi[off[i]:off[i + 1], off[j]:off[j + 1]] = blk
-
-    put(0, 0, np.linalg.inv(P_next)); put(0, 4, np.eye(n))
-    put(1, 1, np.linalg.inv(R)); put(1, 5, np.eye(m))
-    put(2, 2, np.linalg.inv(Q))
-    put(3, 3, Sigma); put(3, 4, Ih); put(3, 5, -Gh)
-    put(4, 0, np.eye(n)); put(4, 3, Ih.T)
-    put(5, 1, np.eye(m)); put(5, 3, -Gh.T)
     b = np.zeros((off[-1], n))
     b[off[2]:off[3]] = -np.eye(n)
     b[off[3]:off[4]] = Fh
@@ -109,7 +107,7 @@ def block_steps(P: np.ndarray, d: Model) -> Step:
             step = block_step(P[i], d.F, d.G, d.EF[i], d.EG[i], d.Q, d.R, d.H, float(d.mu[i]), d.alpha)
         except np.linalg.LinAlgError:
             continue
-        for arr, value in zip(out, step):
+        for arr, value in zip(out, step, strict=True):
             arr[i] = value
     return out
 
