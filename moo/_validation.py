@@ -8,6 +8,7 @@ the argument (and the shape), e.g. ``"pop_size must be >= 2, got 1"``.
 from __future__ import annotations
 
 import numbers
+from typing import TypeVar
 
 import numpy as np
 
@@ -65,13 +66,20 @@ def check_int(value, name: str, minimum: int) -> int:
     return int(value)
 
 
-def check_choice(value, name: str, choices: tuple[str, ...]) -> str:
-    """One of the lower-case strings ``choices`` (matched case-insensitively); returned lower-cased."""
+_Choice = TypeVar("_Choice", bound=str)
+
+
+def check_choice(value, name: str, choices: tuple[_Choice, ...]) -> _Choice:
+    """One of the lower-case strings ``choices`` (matched case-insensitively); returned lower-cased.
+
+    The result is the matching entry of ``choices``, so a tuple of ``Literal``
+    strings gives a value of that ``Literal`` type.
+    """
     if not isinstance(value, str):
         raise TypeError(f"{name} must be one of {', '.join(map(repr, choices))}, got {type(value).__name__}")
     if value.lower() not in choices:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
-    return value.lower()
+    return choices[choices.index(value.lower())]
 
 
 def check_real(value, name: str, *, positive: bool) -> float:
@@ -115,8 +123,10 @@ def as_objectives(F, name: str = "F") -> np.ndarray:
 
 
 def check_directions(W, name: str = "ref_dirs") -> np.ndarray:
-    """Weight / reference-direction vectors: a finite, non-negative ``(n_dirs, n_obj)`` array,
-    ``n_obj >= 2``, every row with a positive sum."""
+    """Weight / reference-direction vectors: a finite, non-negative ``(n_dirs, n_obj)`` array.
+
+    ``n_obj >= 2`` and every row must have a positive sum.
+    """
     W = np.asarray(W, dtype=float)
     if W.ndim != 2 or W.shape[0] < 1 or W.shape[1] < 2:
         raise ValueError(f"{name} must be a 2-D array (n_dirs, n_obj) with n_obj >= 2, got shape {W.shape}")
