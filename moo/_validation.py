@@ -82,11 +82,18 @@ def check_choice(value, name: str, choices: tuple[_Choice, ...]) -> _Choice:
     return choices[choices.index(value.lower())]
 
 
+def _real_scalar(value, name: str, want: str) -> float:
+    """A real number (Python or NumPy, or a 0-d real array) as a float, NaN and inf kept; ``bool`` is refused."""
+    real = (isinstance(value, numbers.Real) or (isinstance(value, np.ndarray) and value.shape == ()
+                                               and value.dtype.kind in "iuf"))
+    if isinstance(value, (bool, np.bool_)) or not real:
+        raise TypeError(f"{name} must be {want}, got {type(value).__name__}")
+    return float(value)
+
+
 def check_real(value, name: str, *, positive: bool) -> float:
     """A finite real number, ``> 0`` if ``positive`` else ``>= 0`` (``bool`` is refused)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    x = float(value)
+    x = _real_scalar(value, name, "a real number")
     if not np.isfinite(x):
         raise ValueError(f"{name} must be finite, got {x}")
     if positive and x <= 0:
@@ -97,12 +104,13 @@ def check_real(value, name: str, *, positive: bool) -> float:
 
 
 def check_positive_scalar(value, name: str, *, allow_inf: bool = False) -> float:
-    """A real scalar > 0, a NumPy 0-d array included (``inf`` only if ``allow_inf``; ``bool`` is refused)."""
-    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
-        arr = np.asarray(value)
-        if arr.shape != () or not np.issubdtype(arr.dtype, np.number) or np.iscomplexobj(arr):
-            raise TypeError(f"{name} must be a real scalar, got {type(value).__name__}")
-    x = float(value)
+    """A real number > 0, a NumPy 0-d array included (``inf`` only if ``allow_inf``; ``bool`` is refused).
+
+    moo's own copy of :func:`robustctl.validation.check_positive_scalar`, with
+    the same checks: the generic core does not import robustctl, and
+    :mod:`moo.problems` uses robustctl's.
+    """
+    x = _real_scalar(value, name, "a real number > 0")
     if np.isnan(x):
         raise ValueError(f"{name} must be a number, got NaN")
     if np.isinf(x) and not (allow_inf and x > 0):

@@ -130,6 +130,12 @@ def leader_scores(F: ArrayLike, ref_point: ArrayLike) -> np.ndarray:
     return np.where(inside, np.prod(np.where(inside[:, None], gap, 1.0), axis=1), gap.min(axis=1))
 
 
+def _check_max_leaders(max_leaders) -> None:
+    if max_leaders is not None and (isinstance(max_leaders, bool) or not isinstance(max_leaders, (int, np.integer))
+                                    or max_leaders < 1):
+        raise ValueError(f"max_leaders must be None or an integer >= 1, got {max_leaders!r}")
+
+
 def candidates(F: ArrayLike, ref_point: ArrayLike, max_leaders: int | None = None) -> np.ndarray:
     """Indices of the MO-LSP candidates, leader first.
 
@@ -139,9 +145,7 @@ def candidates(F: ArrayLike, ref_point: ArrayLike, max_leaders: int | None = Non
     truncated to ``max_leaders`` if given.
     """
     F = as_matrix(F, "F")
-    if max_leaders is not None and (isinstance(max_leaders, bool) or not isinstance(max_leaders, (int, np.integer))
-                                    or max_leaders < 1):
-        raise ValueError(f"max_leaders must be None or an integer >= 1, got {max_leaders!r}")
+    _check_max_leaders(max_leaders)
     score = leader_scores(F, ref_point)
     fronts = NonDominatedSorting().do(F, n_stop_if_ranked=len(F))
     idx = np.concatenate([np.asarray(f, dtype=int) for f in fronts[:2]])
@@ -412,9 +416,7 @@ def molsp(algorithm: Algorithm, *, ref_point: ArrayLike, max_leaders: int | None
     if algorithm.problem is not None or algorithm.is_initialized:
         raise ValueError("algorithm must not be set up yet: wrap it before minimize()/setup()")
     r = as_matrix(ref_point, "ref_point", rows=1).ravel()
-    if max_leaders is not None and (isinstance(max_leaders, bool) or not isinstance(max_leaders, (int, np.integer))
-                                    or max_leaders < 1):
-        raise ValueError(f"max_leaders must be None or an integer >= 1, got {max_leaders!r}")
+    _check_max_leaders(max_leaders)
     host: type = type(algorithm)
     wrapped = copy.deepcopy(algorithm)
     wrapped.__class__ = _wrapped_class(host)
