@@ -84,9 +84,8 @@ def check_choice(value, name: str, choices: tuple[_Choice, ...]) -> _Choice:
 
 def _real_scalar(value, name: str, want: str) -> float:
     """A real number (Python or NumPy, or a 0-d real array) as a float, NaN and inf kept; ``bool`` is refused."""
-    real = (isinstance(value, numbers.Real) or (isinstance(value, np.ndarray) and value.shape == ()
-                                               and value.dtype.kind in "iuf"))
-    if isinstance(value, (bool, np.bool_)) or not real:
+    real_0d = isinstance(value, np.ndarray) and value.shape == () and value.dtype.kind in "iuf"
+    if isinstance(value, (bool, np.bool_)) or not (isinstance(value, numbers.Real) or real_0d):
         raise TypeError(f"{name} must be {want}, got {type(value).__name__}")
     return float(value)
 

@@ -270,10 +270,10 @@ if TYPE_CHECKING:
     class _SurvivalHost:
         """What :class:`MOLSP` uses of its host, a pymoo survival-based algorithm (type checking only).
 
-        The attributes of :class:`pymoo.core.algorithm.Algorithm` and
-        :class:`~pymoo.algorithms.base.genetic.GeneticAlgorithm` as they are once
-        the algorithm is set up; at run time the host is the class ``MOLSP[<Host>]``
-        derives from, and :class:`MOLSP` derives from ``object``.
+        The attributes of a set-up :class:`pymoo.core.algorithm.Algorithm` /
+        :class:`~pymoo.algorithms.base.genetic.GeneticAlgorithm` and the two
+        hooks MO-LSP extends. At run time :class:`MOLSP` derives from ``object``
+        and finds all of them on the host, the other base of ``MOLSP[<Host>]``.
         """
 
         problem: Problem

@@ -22,7 +22,7 @@ Indicators (:mod:`moo.indicators`) on each run's final non-dominated set ``F``:
   one stored in the record) and PD (pure diversity, greedy computation).
 
 The first five are the paper's (its column order, :data:`INDICATORS`); IGD+
-(Ishibuchi et al. 2015, the Pareto-compliant IGD), is ours, after them. The
+(Ishibuchi et al. 2015, the Pareto-compliant IGD) is ours, after them. The
 paper-layout tables of ``paper_repro/moea_tables.py`` keep the paper's five:
 :func:`to_markdown` and :func:`to_latex` show the indicators of the rows
 they are given.
