@@ -8,6 +8,7 @@ the argument (and the shape), e.g. ``"pop_size must be >= 2, got 1"``.
 from __future__ import annotations
 
 import numbers
+from typing import TypeVar
 
 import numpy as np
 
@@ -65,20 +66,33 @@ def check_int(value, name: str, minimum: int) -> int:
     return int(value)
 
 
-def check_choice(value, name: str, choices: tuple[str, ...]) -> str:
-    """One of the lower-case strings ``choices`` (matched case-insensitively); returned lower-cased."""
+_Choice = TypeVar("_Choice", bound=str)
+
+
+def check_choice(value, name: str, choices: tuple[_Choice, ...]) -> _Choice:
+    """One of the lower-case strings ``choices`` (matched case-insensitively); returned lower-cased.
+
+    The result is the matching entry of ``choices``, so a tuple of ``Literal``
+    strings gives a value of that ``Literal`` type.
+    """
     if not isinstance(value, str):
         raise TypeError(f"{name} must be one of {', '.join(map(repr, choices))}, got {type(value).__name__}")
     if value.lower() not in choices:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
-    return value.lower()
+    return choices[choices.index(value.lower())]
+
+
+def _real_scalar(value, name: str, want: str) -> float:
+    """A real number (Python or NumPy, or a 0-d real array) as a float, NaN and inf kept; ``bool`` is refused."""
+    real_0d = isinstance(value, np.ndarray) and value.shape == () and value.dtype.kind in "iuf"
+    if isinstance(value, (bool, np.bool_)) or not (isinstance(value, numbers.Real) or real_0d):
+        raise TypeError(f"{name} must be {want}, got {type(value).__name__}")
+    return float(value)
 
 
 def check_real(value, name: str, *, positive: bool) -> float:
     """A finite real number, ``> 0`` if ``positive`` else ``>= 0`` (``bool`` is refused)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    x = float(value)
+    x = _real_scalar(value, name, "a real number")
     if not np.isfinite(x):
         raise ValueError(f"{name} must be finite, got {x}")
     if positive and x <= 0:
@@ -89,12 +103,13 @@ def check_real(value, name: str, *, positive: bool) -> float:
 
 
 def check_positive_scalar(value, name: str, *, allow_inf: bool = False) -> float:
-    """A real scalar > 0, a NumPy 0-d array included (``inf`` only if ``allow_inf``; ``bool`` is refused)."""
-    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
-        arr = np.asarray(value)
-        if arr.shape != () or not np.issubdtype(arr.dtype, np.number) or np.iscomplexobj(arr):
-            raise TypeError(f"{name} must be a real scalar, got {type(value).__name__}")
-    x = float(value)
+    """A real number > 0, a NumPy 0-d array included (``inf`` only if ``allow_inf``; ``bool`` is refused).
+
+    moo's own copy of :func:`robustctl.validation.check_positive_scalar`, with
+    the same checks: the generic core does not import robustctl, and
+    :mod:`moo.problems` uses robustctl's.
+    """
+    x = _real_scalar(value, name, "a real number > 0")
     if np.isnan(x):
         raise ValueError(f"{name} must be a number, got NaN")
     if np.isinf(x) and not (allow_inf and x > 0):
@@ -115,8 +130,10 @@ def as_objectives(F, name: str = "F") -> np.ndarray:
 
 
 def check_directions(W, name: str = "ref_dirs") -> np.ndarray:
-    """Weight / reference-direction vectors: a finite, non-negative ``(n_dirs, n_obj)`` array,
-    ``n_obj >= 2``, every row with a positive sum."""
+    """Weight / reference-direction vectors: a finite, non-negative ``(n_dirs, n_obj)`` array.
+
+    ``n_obj >= 2`` and every row must have a positive sum.
+    """
     W = np.asarray(W, dtype=float)
     if W.ndim != 2 or W.shape[0] < 1 or W.shape[1] < 2:
         raise ValueError(f"{name} must be a 2-D array (n_dirs, n_obj) with n_obj >= 2, got shape {W.shape}")

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.distance import cdist
 
-from ._validation import as_matrix
+from ._validation import as_matrix, check_positive_scalar
 
 __all__ = ["igd", "igd_plus", "spacing", "hypervolume", "pure_diversity", "spread"]
 
@@ -297,10 +297,7 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
     optimization", IEEE Trans. Cybernetics 47(6), 1510-1522.
     """
     A = _points(F, "F")
-    if isinstance(p, bool) or not isinstance(p, (int, float, np.integer, np.floating)):
-        raise TypeError(f"p must be a real number > 0, got {type(p).__name__}")
-    if not p > 0:
-        raise ValueError(f"p must be a number > 0, got {p!r}")
+    p = check_positive_scalar(p, "p", allow_inf=True)
     if method not in ("greedy", "exact"):
         raise ValueError(f"method must be 'greedy' or 'exact', got {method!r}")
     n = A.shape[0]
@@ -308,7 +305,7 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
         return 0.0
     A = A[np.lexsort(A.T[::-1])]          # canonical order: ties broken by the points, not the rows
     c = _common_scale(A)
-    D = _minkowski_dissimilarity(A / c, float(p))
+    D = _minkowski_dissimilarity(A / c, p)
     if method == "exact":
         if n > PD_EXACT_MAX_POINTS:
             raise ValueError(f"method='exact' handles at most {PD_EXACT_MAX_POINTS} points, "

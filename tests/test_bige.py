@@ -115,7 +115,7 @@ def test_equal_proximity_splits_the_discriminator_at_random():
     F = np.array([[0.0, 1.0], [0.0, 1.0], [1.0, 0.0]])
     seen = set()
     for seed in range(20):
-        fpr, fcd = bige_estimation(F, 0.5, np.random.default_rng(seed))
+        _, fcd = bige_estimation(F, 0.5, np.random.default_rng(seed))
         assert sorted(fcd[:2].tolist()) == [0.5, 1.5] and fcd[2] == 0.0
         seen.add(tuple(fcd[:2]))
     assert seen == {(0.5, 1.5), (1.5, 0.5)}
@@ -141,7 +141,7 @@ def test_estimation_rejects_bad_input():
         bige_estimation([[1.0, np.inf]], 0.5, rng)
     with pytest.raises(ValueError, match="radius must be finite and > 0"):
         bige_estimation(FRONT, 0.0, rng)
-    with pytest.raises(TypeError, match="random_state must be a numpy.random.Generator"):
+    with pytest.raises(TypeError, match=r"random_state must be a numpy\.random\.Generator"):
         bige_estimation(FRONT, 0.5, 3)
 
 

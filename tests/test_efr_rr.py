@@ -167,7 +167,7 @@ def test_bad_arguments(kwargs, exc, word):
 
 
 def test_bad_ranking_inputs():
-    with pytest.raises(ValueError, match="ref_dirs.*3 columns"):
+    with pytest.raises(ValueError, match=r"ref_dirs.*3 columns"):
         maximum_ranking(np.zeros((4, 3)), W3)
     with pytest.raises(ValueError, match="ref_dirs"):
         maximum_ranking(np.zeros((4, 2)), -W3)

@@ -20,13 +20,13 @@ def igd_loop(A, R):
 
 def igd_plus_loop(A, R):
     """IGD+ by explicit loops: only the objectives in which the point is worse than the reference count."""
-    return sum(min(math.sqrt(sum(max(a_j - r_j, 0.0) ** 2 for a_j, r_j in zip(a, r))) for a in A)
+    return sum(min(math.sqrt(sum(max(a_j - r_j, 0.0) ** 2 for a_j, r_j in zip(a, r, strict=True))) for a in A)
                for r in R) / len(R)
 
 
 def hv_inclusion_exclusion(A, r):
     """HV as the measure of a union of boxes, by inclusion-exclusion over all subsets."""
-    A = [a for a in A if all(x < y for x, y in zip(a, r))]
+    A = [a for a in A if all(x < y for x, y in zip(a, r, strict=True))]
     total = 0.0
     for k in range(1, len(A) + 1):
         for subset in itertools.combinations(A, k):
@@ -44,7 +44,7 @@ def hv_grid(A, r):
     for cell in itertools.product(*[range(len(ax) - 1) for ax in axes]):
         lo = np.array([axes[k][i] for k, i in enumerate(cell)])
         hi = np.array([axes[k][i + 1] for k, i in enumerate(cell)])
-        if np.any(np.all(A <= lo, axis=1)):         # the cell lies in a dominated box
+        if np.any(np.all(lo >= A, axis=1)):         # the cell lies in a dominated box
             total += float(np.prod(hi - lo))
     return total
 
@@ -71,7 +71,7 @@ def test_igd_hand_case():
 
 def test_igd_zero_when_set_contains_reference():
     R = [[0, 1], [0.5, 0.5], [1, 0]]
-    assert igd(R + [[2, 2]], R) == 0.0
+    assert igd([*R, [2, 2]], R) == 0.0
 
 
 @pytest.mark.parametrize("m", [2, 3, 5])

@@ -88,8 +88,8 @@ def _r2_ranking_loop(F, W, ideal, nadir):
     norms = [float(np.sqrt(sum(v * v for v in row))) for row in Fn]
     rank = [len(F) + 1] * len(F)
     zero = 1e-6 if W.shape[1] == 2 else 1e-2         # the authors' wzero (EMO framework, utility.c)
-    for w in W:
-        w = [wi if wi > 0 else zero for wi in w]
+    for w_row in W:
+        w = [wi if wi > 0 else zero for wi in w_row]
         values = [max(row[i] / w[i] for i in range(len(w))) for row in Fn]
         order = sorted(range(len(F)), key=lambda n: (values[n], norms[n], n))
         for pos, n in enumerate(order, start=1):
@@ -122,7 +122,7 @@ def test_update_waits_for_a_full_record():
 
 def test_update_large_variance_sets_all_to_largest_candidate():
     # record of objective 1: 1, 1, 3 -> mean 5/3, variance (2*(2/3)^2 + (4/3)^2)/3 = 24/27 > 0.5
-    nadir, record, marks = update_reference_points(
+    nadir, record, _ = update_reference_points(
         np.ones(2), np.zeros(2), np.array([3.0, 2.0]), np.ones((2, 2)), np.zeros(2, int),
         alpha=0.5, epsilon=1e-3, record_size=3)
     np.testing.assert_array_equal(nadir, [3.0, 3.0])

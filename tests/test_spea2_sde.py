@@ -58,11 +58,14 @@ def _pop(F, cv=None):
 
 
 def _reference_sd(F):
-    """Shifted distance by the case definition (Li et al. 2014, Sec. III): f_k(q') = f_k(p) if f_k(q) < f_k(p) else f_k(q)."""
+    """Shifted distance by the case definition (Li et al. 2014, Sec. III).
+
+    f_k(q') = f_k(p) if f_k(q) < f_k(p) else f_k(q).
+    """
     n = len(F)
     D = np.full((n, n), np.inf)
     for p, q in itertools.permutations(range(n), 2):
-        shifted = np.array([F[p, k] if F[q, k] < F[p, k] else F[q, k] for k in range(F.shape[1])])
+        shifted = np.array([max(F[q, k], F[p, k]) for k in range(F.shape[1])])
         D[p, q] = cdist(F[p][None], shifted[None])[0, 0]
     return D
 
@@ -143,7 +146,7 @@ def test_fitness_hand_example_raw_objectives():
     #   p2: to p1 (0,1/3), to p3 (0,2/3), to p0 (0,1)              -> sigma = 2/3, D = 3/8
     #   p3: to p1 0, to p0 (0,1/3), to p2 (3/7,0)                  -> sigma = 1/3, D = 3/7
     #   p4: all 0                                                  -> D = 1/2
-    fit_n, raw_n, dens_n = sde_fitness(F)
+    _, raw_n, dens_n = sde_fitness(F)
     np.testing.assert_array_equal(raw_n, raw)
     np.testing.assert_allclose(dens_n, [7 / 18, 3 / 8, 3 / 8, 3 / 7, 0.5], rtol=1e-14)
 
@@ -158,7 +161,7 @@ def test_fitness_matches_per_individual_reference():
         for normalize, G in [(False, F), (True, (F - lo) / (hi - lo))]:
             got = sde_fitness(F, normalize=normalize)
             want = _reference_fitness(F, G)
-            for g, w in zip(got, want):
+            for g, w in zip(got, want, strict=True):
                 np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-15)
 
 
@@ -166,7 +169,7 @@ def test_fitness_below_one_iff_nondominated():
     rng = np.random.default_rng(5)
     F = rng.random((40, 3))
     fit, raw, _ = sde_fitness(F)
-    dominated = np.array([np.any(np.all(F <= f, axis=1) & np.any(F < f, axis=1)) for f in F])
+    dominated = np.array([np.any(np.all(f >= F, axis=1) & np.any(f > F, axis=1)) for f in F])
     np.testing.assert_array_equal(fit < 1.0, ~dominated)
     np.testing.assert_array_equal(raw == 0, ~dominated)
 

@@ -127,10 +127,10 @@ P1, P2, P3, Q, R, S = range(6)
 def test_environmental_selection_hand_population(n_survive, expected):
     surv = SPEARSurvival(DIRS5)
     out = surv.do(_Dummy(), _pop(HAND), n_survive=n_survive, random_state=np.random.default_rng(0))
-    got = {int(np.flatnonzero(np.all(HAND == f, axis=1))[0]) for f in out.get("F")}
+    got = {int(np.flatnonzero(np.all(f == HAND, axis=1))[0]) for f in out.get("F")}
     assert got == expected
     if n_survive == 6:
-        fit = dict(zip(map(tuple, out.get("F")), out.get("fitness")))
+        fit = dict(zip(map(tuple, out.get("F")), out.get("fitness"), strict=True))
         tb = math.atan(0.5)
         assert fit[tuple(HAND[Q])] == pytest.approx(_density(math.atan2(0.75, 0.25) - math.atan2(1.0, 0.5), tb))
         assert fit[tuple(HAND[R])] == pytest.approx(6.0 + _density(np.pi / 4 - math.atan2(0.6, 0.7), tb))
@@ -260,7 +260,7 @@ def test_runs_wrapped_in_molsp():
 def _brute_spea_r_survivors(F, n_survive, W, Fn=None):
     """The paper's selection by loops; angles from ``Fn`` when given, else the front's min/max normalisation."""
     n, M = F.shape
-    dom = [[all(x <= y for x, y in zip(F[i], F[j])) and any(x < y for x, y in zip(F[i], F[j]))
+    dom = [[all(x <= y for x, y in zip(F[i], F[j], strict=True)) and any(x < y for x, y in zip(F[i], F[j], strict=True))
             for j in range(n)] for i in range(n)]
     nd = [i for i in range(n) if not any(dom[j][i] for j in range(n))]
     lo = [min(F[i, m] for i in nd) for m in range(M)]
@@ -268,7 +268,7 @@ def _brute_spea_r_survivors(F, n_survive, W, Fn=None):
     rng = [hi[m] - lo[m] if hi[m] - lo[m] > 1e-10 else max(F[:, m]) - lo[m] for m in range(M)]
     rng = [r if r > 1e-10 else 1.0 for r in rng]
     norm = lambda v: math.sqrt(sum(x * x for x in v))  # noqa: E731
-    cosang = lambda u, v: sum(a * b for a, b in zip(u, v)) / (norm(u) * norm(v))  # noqa: E731
+    cosang = lambda u, v: sum(a * b for a, b in zip(u, v, strict=True)) / (norm(u) * norm(v))  # noqa: E731
     theta_bar = max(min(math.acos(min(1.0, cosang(W[i], W[j]))) for j in range(len(W)) if j != i)
                     for i in range(len(W)))
     niche, angle = [], []

@@ -194,7 +194,7 @@ A_, B_, C_, D_, E_, F_, G_ = range(7)
 def test_theta_survival_hand_population(n_survive, expected):
     surv = ThetaSurvival(DIRS2, theta=5.0)
     out = surv.do(_Dummy(), _pop(HAND), n_survive=n_survive, random_state=np.random.default_rng(0))
-    got = {int(np.flatnonzero(np.all(HAND == f, axis=1))[0]) for f in out.get("F")}
+    got = {int(np.flatnonzero(np.all(f == HAND, axis=1))[0]) for f in out.get("F")}
     assert got == expected
 
 
@@ -320,7 +320,10 @@ def test_runs_wrapped_in_molsp():
 def _brute_theta_survivors(F, n_survive, ideal, nadir, W, theta):
     """Reference: Pareto peeling, loop clustering, theta-ranks; returns (S, rank of each member of S)."""
     n, M = F.shape
-    dom = lambda a, b: all(x <= y for x, y in zip(a, b)) and any(x < y for x, y in zip(a, b))  # noqa: E731
+
+    def dom(a, b):
+        return all(x <= y for x, y in zip(a, b, strict=True)) and any(x < y for x, y in zip(a, b, strict=True))
+
     remaining, S = list(range(n)), []
     while len(S) < n_survive:
         front = [i for i in remaining if not any(dom(F[j], F[i]) for j in remaining if j != i)]
@@ -332,7 +335,7 @@ def _brute_theta_survivors(F, n_survive, ideal, nadir, W, theta):
         best = None
         for j, w in enumerate(W):
             nw = math.sqrt(sum(x * x for x in w))
-            d1 = sum(a * b for a, b in zip(fn, w)) / nw
+            d1 = sum(a * b for a, b in zip(fn, w, strict=True)) / nw
             d2 = math.sqrt(sum((fn[m] - d1 * w[m] / nw) ** 2 for m in range(M)))
             if best is None or d2 < best[0]:
                 best = (d2, j, d1)

@@ -8,6 +8,8 @@
   a comparison function.
 - :func:`check_ref_dirs_fit`: reference directions must match the problem's
   number of objectives.
+- :func:`float_column`: a per-individual attribute read from a population,
+  with the entries never set filled in.
 - :func:`factory_arguments`, :func:`factory_ref_dirs`: the checks every
   registry factory makes (the shape documented in :mod:`moo.algorithms`).
 """
@@ -23,14 +25,21 @@ from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.util.display.multi import MultiObjectiveOutput
 
 from .._validation import check_choice, check_directions, check_int
-from .operators import (OPERATOR_CHOICES, PAPER_OPERATORS, OperatorSettings, paper_crossover, paper_mutation,
-                        reference_directions, variation_operators)
+from .operators import (
+    OPERATOR_CHOICES,
+    PAPER_OPERATORS,
+    OperatorSettings,
+    paper_crossover,
+    paper_mutation,
+    reference_directions,
+    variation_operators,
+)
 
 if TYPE_CHECKING:
     from ._normalize import HyperplaneNormalization
 
 __all__ = ["BinaryTournament", "MIN_POP_SIZE", "NormalizationForwarding", "check_ref_dirs_fit", "factory_arguments",
-           "factory_ref_dirs", "paper_operators"]
+           "factory_ref_dirs", "float_column", "paper_operators"]
 
 #: Smallest population a registry factory accepts.
 MIN_POP_SIZE = 4
@@ -84,6 +93,18 @@ def check_ref_dirs_fit(ref_dirs, problem) -> None:
     """Raise ``ValueError`` unless ``ref_dirs`` has one column per objective of ``problem``."""
     if ref_dirs.shape[1] != problem.n_obj:
         raise ValueError(f"ref_dirs has {ref_dirs.shape[1]} columns but the problem has {problem.n_obj} objectives")
+
+
+def float_column(values, fill: float) -> np.ndarray:
+    """``values`` (``pop.get(name)``, one per individual) as float64 ``(n,)``, ``None`` entries as ``fill``.
+
+    pymoo stores an attribute never set on an individual as ``None`` (an object
+    array); a 2-D attribute such as ``CV`` gives its first column.
+    """
+    arr = np.asarray(values)
+    if arr.dtype == object:
+        arr = np.where(np.equal(arr, np.array(None)), fill, arr)
+    return arr.astype(float).reshape(len(arr), -1)[:, 0]
 
 
 class NormalizationForwarding:

@@ -1,11 +1,11 @@
-"""Objective normalisation for reference-direction MOEAs: ideal point, extreme points, intercepts.
+r"""Objective normalisation for reference-direction MOEAs: ideal point, extreme points, intercepts.
 
 Many-objective algorithms that compare solutions against reference directions
 (NSGA-III, theta-DEA, SPEA/R, ...) first map the objectives to a common scale
 
 .. math::
 
-    \\tilde f_i(x) = \\frac{f_i(x) - z^*_i}{z^{nad}_i - z^*_i}, \\qquad i = 1, \\dots, M,
+    \tilde f_i(x) = \frac{f_i(x) - z^*_i}{z^{nad}_i - z^*_i}, \qquad i = 1, \dots, M,
 
 where :math:`z^*` is the ideal point (the smallest value of each objective seen
 so far) and :math:`z^{nad}` an estimate of the nadir point. This module offers
@@ -18,8 +18,8 @@ the two estimates in use:
 
   .. math::
 
-      \\mathrm{ASF}_j(x) = \\max_{i} \\frac{|f_i(x) - z^*_i|}{s_i\\, w^j_i},
-      \\qquad w^j_i = 1 \\text{ if } i = j \\text{ else } \\varepsilon = 10^{-6},
+      \mathrm{ASF}_j(x) = \max_{i} \frac{|f_i(x) - z^*_i|}{s_i\, w^j_i},
+      \qquad w^j_i = 1 \text{ if } i = j \text{ else } \varepsilon = 10^{-6},
 
   over the non-dominated solutions and the previous extreme points
   (:math:`s = z^{nad} - z^*` from the previous call, so the ASF is scale
@@ -128,7 +128,7 @@ def extreme_points(F: np.ndarray, ideal: np.ndarray, scale: np.ndarray | None = 
     M = F.shape[1]
     scale = np.ones(M) if scale is None else np.asarray(scale, dtype=float)
     T = np.abs(F - ideal) / scale                              # (n, M)
-    T[T < zero_tol] = 0.0
+    T[zero_tol > T] = 0.0
     weights = np.full((M, M), epsilon)
     np.fill_diagonal(weights, 1.0)
     asf = np.max(T[None, :, :] / weights[:, None, :], axis=2)  # (M axes, n)

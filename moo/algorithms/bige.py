@@ -234,8 +234,7 @@ class BiGESurvival(Survival):
             need = n_survive - n_taken
             f_pr, f_cd = bige_estimation(F[critical], niche_radius(int(n_survive), m), rng)
             layers = self._nds.do(np.column_stack([f_pr, f_cd]), n_stop_if_ranked=need)
-            for layer in layers:
-                layer = np.asarray(layer)
+            for layer in map(np.asarray, layers):
                 if layer.size <= need:
                     survivors.append(critical[layer])
                     need -= layer.size

@@ -69,7 +69,7 @@ Readings where the paper leaves room
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
@@ -78,8 +78,8 @@ from pymoo.core.survival import Survival
 from pymoo.operators.selection.rnd import RandomSelection
 
 from .._validation import as_matrix, check_choice, check_int, check_real
-from ._normalize import HyperplaneNormalization
 from ._base import NormalizationForwarding, factory_arguments, factory_ref_dirs, paper_operators
+from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = ["EFRRR", "EFRRRSurvival", "maximum_ranking", "make_efr_rr", "ORIGINAL_OPERATORS"]
@@ -90,8 +90,10 @@ ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=30.0, mu
                                       source="Yuan, Xu, Wang, Zhang & Yao (2016), Sec. V")
 
 _ZERO_WEIGHT = 1e-6
-_SCALARIZINGS = ("tchebycheff", "pbi")
-_MATINGS = ("random", "tournament")
+_Scalarizing = Literal["tchebycheff", "pbi"]
+_Mating = Literal["random", "tournament"]
+_SCALARIZINGS: tuple[_Scalarizing, ...] = get_args(_Scalarizing)
+_MATINGS: tuple[_Mating, ...] = get_args(_Mating)
 
 
 def perpendicular_distances(F: np.ndarray, W: np.ndarray) -> np.ndarray:
@@ -107,7 +109,7 @@ def maximum_ranking(
     ref_dirs: np.ndarray,
     *,
     n_neighbors: int = 2,
-    scalarizing: Literal["tchebycheff", "pbi"] = "tchebycheff",
+    scalarizing: _Scalarizing = "tchebycheff",
     theta: float = 5.0,
 ) -> np.ndarray:
     """Global ranks ``R_g`` of EFR-RR (maximum ranking with ranking restriction).
@@ -177,7 +179,7 @@ class EFRRRSurvival(NormalizationForwarding, Survival):
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, n_neighbors: int = 2,
-                 scalarizing: str = "tchebycheff", theta: float = 5.0):
+                 scalarizing: _Scalarizing = "tchebycheff", theta: float = 5.0):
         super().__init__(filter_infeasible=True)
         self.ref_dirs = np.asarray(ref_dirs, dtype=float)
         self.n_neighbors = n_neighbors
@@ -242,7 +244,7 @@ class EFRRR(GeneticAlgorithm):
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, pop_size: int = POP_SIZE, n_neighbors: int = 2,
-                 scalarizing: str = "tchebycheff", theta: float = 5.0, mating: str = "random",
+                 scalarizing: _Scalarizing = "tchebycheff", theta: float = 5.0, mating: _Mating = "random",
                  sampling=None, crossover=None, mutation=None, eliminate_duplicates: bool = True,
                  output=None):
         ref_dirs = as_matrix(ref_dirs, "ref_dirs")
@@ -278,8 +280,8 @@ class EFRRR(GeneticAlgorithm):
 
 
 def make_efr_rr(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
-                n_neighbors: int = 2, scalarizing: Literal["tchebycheff", "pbi"] = "tchebycheff",
-                theta: float = 5.0, mating: Literal["random", "tournament"] = "random",
+                n_neighbors: int = 2, scalarizing: _Scalarizing = "tchebycheff",
+                theta: float = 5.0, mating: _Mating = "random",
                 ref_dirs: np.ndarray | None = None) -> EFRRR:
     """EFR-RR with the paper's settings; the shape of every factory (:mod:`moo.algorithms`).
 

@@ -1,4 +1,4 @@
-"""MOEA/IGD-NS: selection by the IGD with non-contributing solutions.
+r"""MOEA/IGD-NS: selection by the IGD with non-contributing solutions.
 
 Reference
 ---------
@@ -17,8 +17,8 @@ distance,
 
 .. math::
 
-    \\mathrm{IGD\\text{-}NS}(Q, P^*) = \\sum_{y \\in P^*} \\min_{x \\in Q} d(x, y)
-        + \\sum_{x' \\in Q^*} \\min_{y \\in P^*} d(x', y).
+    \mathrm{IGD\text{-}NS}(Q, P^*) = \sum_{y \in P^*} \min_{x \in Q} d(x, y)
+        + \sum_{x' \in Q^*} \min_{y \in P^*} d(x', y).
 
 The first term is (unnormalised) IGD; the second pulls the solutions that do
 not serve any reference point towards the archive, so they too carry
@@ -27,7 +27,7 @@ selection pressure.
 *Environmental selection.* The received population is sorted into
 non-dominated fronts; whole fronts are accepted while they fit, and the last
 front ``F_l`` is reduced one solution at a time: each step removes the
-solution ``x`` whose removal leaves the smallest ``IGD-NS(F_l \\ {x}, P*)``
+solution ``x`` whose removal leaves the smallest ``IGD-NS(F_l \ {x}, P*)``
 (computed for all candidates at once from the nearest and second-nearest
 solution of every reference point, see :func:`igd_ns_deletion_scores`).
 
@@ -191,7 +191,7 @@ def _relative_scores(n1, n2, d1, d2, con, alive) -> tuple[np.ndarray, float]:
 
 
 def igd_ns_deletion_scores(D: np.ndarray, alive: np.ndarray) -> np.ndarray:
-    """``IGD-NS(Q \\ {x}, P*)`` for every alive ``x`` at once.
+    r"""``IGD-NS(Q \ {x}, P*)`` for every alive ``x`` at once.
 
     Parameters
     ----------
@@ -216,7 +216,7 @@ def igd_ns_deletion_scores(D: np.ndarray, alive: np.ndarray) -> np.ndarray:
     reference point it served to ``n2(y)`` and makes those ``n2(y)`` that were
     non-contributing contributing:
     ``I + sum_{y: n1(y)=x} (d2(y) - d1(y)) - sum_{z in S(x)} c(z)`` with
-    ``S(x) = {n2(y) : n1(y) = x} \\ C``.
+    ``S(x) = {n2(y) : n1(y) = x} \ C``.
     """
     D = np.asarray(D, dtype=float)
     alive = np.asarray(alive, dtype=bool)
@@ -329,13 +329,15 @@ class IGDNSSurvival(Survival):
         """Empty the archive (called when a run is set up)."""
         self.archive = None
 
-    def _update_archive(self, pop, random_state) -> None:
+    def _update_archive(self, pop, random_state) -> Population:
+        """Merge ``pop`` into the archive and update it by :func:`update_archive`; returns the new archive."""
         merged = pop if self.archive is None else Population.merge(self.archive, pop)
         keep = update_archive(merged.get("F").astype(float), self.archive_size, random_state=random_state)
         self.archive = merged[keep]
+        return self.archive
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
-        self._update_archive(pop, random_state)
+        archive = self._update_archive(pop, random_state)
         F = pop.get("F").astype(float)
         fronts = NonDominatedSorting().do(F, n_stop_if_ranked=n_survive)
         selected: list[np.ndarray] = []
@@ -345,7 +347,7 @@ class IGDNSSurvival(Survival):
                 selected.append(front)
                 n_sel += len(front)
             else:
-                kept = reduce_by_igd_ns(F[front], self.archive.get("F").astype(float), n_survive - n_sel)
+                kept = reduce_by_igd_ns(F[front], archive.get("F").astype(float), n_survive - n_sel)
                 selected.append(front[kept])
                 n_sel += len(kept)
             if n_sel >= n_survive:

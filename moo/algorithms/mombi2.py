@@ -1,4 +1,4 @@
-"""MOMBI-II: many-objective metaheuristic based on the R2 indicator, version II.
+r"""MOMBI-II: many-objective metaheuristic based on the R2 indicator, version II.
 
 Reference
 ---------
@@ -11,17 +11,17 @@ What is implemented
 *Normalisation.* With the ideal point ``z_min`` and the nadir estimate
 ``z_max`` kept by the survival, objective vectors are scaled as
 
-.. math:: \\bar f_i(x) = \\frac{f_i(x) - z^{min}_i}{z^{max}_i - z^{min}_i}.
+.. math:: \bar f_i(x) = \frac{f_i(x) - z^{min}_i}{z^{max}_i - z^{min}_i}.
 
 *Achievement scalarising function (ASF).* For a weight vector ``w``
 
-.. math:: \\mathrm{ASF}(x \\mid w) = \\max_{i=1..M} \\bar f_i(x) / w_i ,
+.. math:: \mathrm{ASF}(x \mid w) = \max_{i=1..M} \bar f_i(x) / w_i ,
 
 zero weight components being replaced by ``1e-2`` (``1e-6`` with two
 objectives), the values of the first author's own framework (see "Readings").
 
 *R2 ranking.* For every weight vector the population is sorted by ASF value,
-ties broken by the Euclidean norm ``||\\bar f(x)||_2`` (smaller first); the
+ties broken by the Euclidean norm ``||\bar f(x)||_2`` (smaller first); the
 rank of ``x`` is its best (smallest, 1-based) position over all weight
 vectors. Environmental selection keeps the ``N`` individuals that are first
 in the lexicographic order (rank, norm).
@@ -112,7 +112,7 @@ from pymoo.core.survival import Survival
 from pymoo.operators.selection.tournament import TournamentSelection
 
 from .._validation import check_directions, check_int, check_real
-from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, paper_operators
+from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, float_column, paper_operators
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -141,7 +141,10 @@ ZERO_WEIGHT = 1e-2
 
 
 def zero_weight(n_obj: int) -> float:
-    """The ASF's stand-in for a zero weight component: :data:`ZERO_WEIGHT_2D` for 2 objectives, else :data:`ZERO_WEIGHT`."""
+    """The ASF's stand-in for a zero weight component.
+
+    :data:`ZERO_WEIGHT_2D` for 2 objectives, else :data:`ZERO_WEIGHT`.
+    """
     return ZERO_WEIGHT_2D if n_obj == 2 else ZERO_WEIGHT
 
 
@@ -306,7 +309,7 @@ class R2RankingSurvival(Survival):
         if F.shape[1] != self.weights.shape[1]:
             raise ValueError(f"the problem has {F.shape[1]} objectives but the weights have "
                              f"{self.weights.shape[1]} columns")
-        if self.ideal is None:
+        if self.ideal is None or self.nadir is None:        # set together (reset() clears both)
             self.ideal = F.min(axis=0)
             self.nadir = F.max(axis=0)
         else:
@@ -321,13 +324,6 @@ class R2RankingSurvival(Survival):
         rank_s, norm_s = r2_ranking(F_s, self.weights, self.ideal, self.nadir)
         survivors.set("rank", rank_s, "r2_norm", norm_s)
         return survivors
-
-
-def _as_float_column(values, fill: float) -> np.ndarray:
-    arr = np.asarray(values)
-    if arr.dtype == object:
-        arr = np.where(np.equal(arr, None), fill, arr)
-    return arr.astype(float).reshape(len(arr), -1)[:, 0]
 
 
 def r2_tournament(P: np.ndarray, cv: np.ndarray, rank: np.ndarray, norm: np.ndarray,
@@ -365,9 +361,9 @@ def r2_tournament(P: np.ndarray, cv: np.ndarray, rank: np.ndarray, norm: np.ndar
 
 
 def _compare_in_population(pop, P, random_state=None, **kwargs) -> np.ndarray:
-    """pymoo ``TournamentSelection`` hook: read CV, rank and norm from ``pop``."""
-    return r2_tournament(P, _as_float_column(pop.get("CV"), 0.0), _as_float_column(pop.get("rank"), np.inf),
-                         _as_float_column(pop.get("r2_norm"), np.inf), random_state)
+    """Comparison hook of pymoo's ``TournamentSelection``: read CV, rank and norm from ``pop``."""
+    return r2_tournament(P, float_column(pop.get("CV"), 0.0), float_column(pop.get("rank"), np.inf),
+                         float_column(pop.get("r2_norm"), np.inf), random_state)
 
 
 class MOMBI2(GeneticAlgorithm):

@@ -119,6 +119,7 @@ class PaperPM(PM):
         self.expected_mutations = float(expected_mutations)
 
     def get_prob_var(self, problem, **kwargs):
+        """The per-variable mutation probability ``min(1, expected_mutations / n_var)``, one per individual."""
         return np.full(kwargs.get("size", 1), min(1.0, self.expected_mutations / problem.n_var))
 
 

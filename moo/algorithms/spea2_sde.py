@@ -84,7 +84,7 @@ from pymoo.core.survival import Survival
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 
 from .._validation import as_float_array, as_objectives
-from ._base import BinaryTournament, factory_arguments, paper_operators
+from ._base import BinaryTournament, factory_arguments, float_column, paper_operators
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -338,10 +338,7 @@ def _sde_tournament(pop, P, random_state=None, **kwargs):
     cv = pop.get("CV")
     cv = np.zeros(n) if cv is None else np.asarray(cv, dtype=np.float64).reshape(n, -1)[:, 0]
     feasible = cv <= 0
-    fit = pop.get(_FITNESS)
-    if fit.dtype == object:                     # individuals never ranked carry None
-        fit = np.where(np.equal(fit, None), np.nan, fit)
-    fit = fit.astype(np.float64)
+    fit = float_column(pop.get(_FITNESS), np.nan)    # individuals never ranked carry None: NaN
     if np.any(np.isnan(fit[feasible])):
         # feasible individuals not ranked by the survival (e.g. a user-supplied population):
         # rank the feasible ones now, as the survival does

@@ -1,4 +1,4 @@
-"""SPEA/R: the strength Pareto evolutionary algorithm based on reference directions.
+r"""SPEA/R: the strength Pareto evolutionary algorithm based on reference directions.
 
 S. Jiang and S. Yang, "A strength Pareto evolutionary algorithm based on
 reference direction for multiobjective and many-objective optimization",
@@ -27,15 +27,15 @@ union ``Q = P u P'`` of parents and offspring:
 
    .. math::
 
-      S(x)  &= |\\{y \\in Q : x \\succ y\\}|, &
-      R(x)  &= \\sum_{y \\in Q,\\ y \\succ x} S(y)            & \\text{(global)} \\\\
-      S'(x) &= |\\{y \\in \\Omega(x) : x \\succ y\\}|, &
-      R'(x) &= \\sum_{y \\in \\Omega(x),\\ y \\succ x} S'(y)  & \\text{(local)}
+      S(x)  &= |\{y \in Q : x \succ y\}|, &
+      R(x)  &= \sum_{y \in Q,\ y \succ x} S(y)            & \text{(global)} \\
+      S'(x) &= |\{y \in \Omega(x) : x \succ y\}|, &
+      R'(x) &= \sum_{y \in \Omega(x),\ y \succ x} S'(y)  & \text{(local)}
 
    .. math::
 
-      F(x) = \\begin{cases} R'(x) + D(x) & |\\Omega(x)| = 1 \\\\
-                             R'(x) + R(x) + D(x) & \\text{otherwise,} \\end{cases}
+      F(x) = \begin{cases} R'(x) + D(x) & |\Omega(x)| = 1 \\
+                             R'(x) + R(x) + D(x) & \text{otherwise,} \end{cases}
 
    so a solution alone in its subregion is never penalised for being dominated
    by solutions elsewhere (diversity first); ``F(x) < 1`` iff ``x`` is
@@ -251,11 +251,12 @@ class SPEARSurvival(Survival):
     def _do(self, problem, pop, n_survive=None, random_state=None, **kwargs):
         F = pop.get("F").astype(float)
         if F.shape[1] != self.ref_dirs.shape[1]:
-            raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has {self.ref_dirs.shape[1]} columns")
+            raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has "
+                             f"{self.ref_dirs.shape[1]} columns")
         if not np.all(np.isfinite(F)):
             return finite_first(self._do, problem, pop, n_survive, random_state)
         dom = dominance_matrix(F)
-        niche, angle = associate_by_angle(self._normalized(F, ~dom.any(axis=0)), self.ref_dirs)
+        niche, angle = associate_by_angle(self._normalized(F, ~np.any(dom, axis=0)), self.ref_dirs)
         fitness = spea_r_fitness(F, niche, angle, self.theta_bar, dom=dom)
         rounds = theta_nondominated_ranks(niche, fitness)
         keep = select_by_fronts(rounds, n_survive, fitness)

@@ -1,4 +1,4 @@
-"""theta-DEA: the theta-dominance based evolutionary algorithm.
+r"""theta-DEA: the theta-dominance based evolutionary algorithm.
 
 Y. Yuan, H. Xu, B. Wang and X. Yao, "A new dominance relation-based
 evolutionary algorithm for many-objective optimization", IEEE Transactions on
@@ -19,9 +19,9 @@ One generation (the paper's Algorithm 1):
 
    .. math::
 
-      d_{j,1}(x) = \\frac{\\tilde f(x)^T w_j}{\\lVert w_j \\rVert}, \\qquad
-      d_{j,2}(x) = \\Big\\lVert \\tilde f(x) - d_{j,1}(x)
-                   \\frac{w_j}{\\lVert w_j \\rVert} \\Big\\rVert .
+      d_{j,1}(x) = \frac{\tilde f(x)^T w_j}{\lVert w_j \rVert}, \qquad
+      d_{j,2}(x) = \Big\lVert \tilde f(x) - d_{j,1}(x)
+                   \frac{w_j}{\lVert w_j \rVert} \Big\rVert .
 
 5. theta-dominance (Sec. III-E, Def. 1): ``x`` theta-dominates ``y`` iff both
    are in the same cluster ``C_j`` and ``F_j(x) < F_j(y)`` with the
@@ -29,9 +29,9 @@ One generation (the paper's Algorithm 1):
 
    .. math::
 
-      F_j(x) = d_{j,1}(x) + \\theta_j\\, d_{j,2}(x), \\qquad
-      \\theta_j = \\begin{cases} 10^6 & w_j \\text{ an objective axis} \\\\
-                                 \\theta & \\text{otherwise.} \\end{cases}
+      F_j(x) = d_{j,1}(x) + \theta_j\, d_{j,2}(x), \qquad
+      \theta_j = \begin{cases} 10^6 & w_j \text{ an objective axis} \\
+                                 \theta & \text{otherwise.} \end{cases}
 
    Since theta-dominance only relates members of one cluster, which it orders
    totally, the theta-non-dominated fronts are: front ``k`` holds the
@@ -114,7 +114,8 @@ ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=30.0, mu
 AXIS_THETA = 1.0e6
 
 
-def theta_clustering(Fn: np.ndarray, ref_dirs: np.ndarray, theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def theta_clustering(Fn: np.ndarray, ref_dirs: np.ndarray,
+                     theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Cluster normalised objectives on reference directions and compute ``F_j``.
 
     Parameters
@@ -245,7 +246,8 @@ class ThetaSurvival(NormalizationForwarding, Survival):
     def _do(self, problem, pop, n_survive=None, random_state=None, **kwargs):
         F = pop.get("F").astype(float)
         if F.shape[1] != self.ref_dirs.shape[1]:
-            raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has {self.ref_dirs.shape[1]} columns")
+            raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has "
+                             f"{self.ref_dirs.shape[1]} columns")
         if not np.all(np.isfinite(F)):
             return finite_first(self._do, problem, pop, n_survive, random_state)
         fronts = NonDominatedSorting().do(F, n_stop_if_ranked=n_survive)
