@@ -11,11 +11,20 @@ runs, see PAPER_NOTES.md).
 indicator          function                 better    source
 =================  =======================  ========  ==========================================
 IGD                :func:`igd`              lower     Coello & Reyes Sierra (2004)
+IGD+               :func:`igd_plus`         lower     Ishibuchi et al. (2015); moocore
 Spacing (SP)       :func:`spacing`          lower     Schott (1995)
 Hypervolume (HV)   :func:`hypervolume`      higher    While et al. (2006); moocore
 Pure diversity     :func:`pure_diversity`   higher    Wang, Jin & Yao (2017)
 Spread             :func:`spread`           lower     Zhou et al. (2006); Wang, Wu & Yuan (2010)
 =================  =======================  ========  ==========================================
+
+Scale. Every indicator is computed on the objective vectors divided by a
+common power of two (the largest magnitude in ``F``, ``ref_set`` and
+``ref_point``, an exact division) and scaled back: distances are homogeneous
+of degree 1, the hypervolume of degree ``m``, Spread of degree 0. So
+coordinates up to the float range give finite, accurate values (squared
+distances would overflow above about 1e154 and underflow below 1e-154); a
+hypervolume that itself exceeds the float range raises ``OverflowError``.
 """
 
 from __future__ import annotations
@@ -27,9 +36,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.distance import cdist
 
-from ._validation import as_matrix
+from ._validation import as_matrix, check_positive_scalar
 
-__all__ = ["igd", "spacing", "hypervolume", "pure_diversity", "spread"]
+__all__ = ["igd", "igd_plus", "spacing", "hypervolume", "pure_diversity", "spread"]
 
 #: Largest set :func:`pure_diversity` accepts with ``method="exact"`` (2^n subsets).
 PD_EXACT_MAX_POINTS = 16
@@ -40,6 +49,20 @@ def _points(F: ArrayLike, name: str, *, n_obj: int | None = None, min_rows: int 
     if arr.shape[0] < min_rows:
         raise ValueError(f"{name} must have at least {min_rows} points (rows), got shape {arr.shape}")
     return arr
+
+
+def _common_scale(*arrays: np.ndarray) -> float:
+    """A power of two near the largest magnitude in ``arrays`` (1 when they are all zero)."""
+    top = max(float(np.max(np.abs(a))) for a in arrays)
+    return 1.0 if top == 0.0 else float(2.0 ** np.frexp(top)[1])
+
+
+def _distance_to_reference(indicator, F: ArrayLike, ref_set: ArrayLike) -> float:
+    """``indicator(F, ref=ref_set)`` (a moocore distance indicator, degree 1) on the scaled sets."""
+    A = _points(F, "F")
+    R = _points(ref_set, "ref_set", n_obj=A.shape[1])
+    c = _common_scale(A, R)
+    return c * float(indicator(A / c, ref=R / c))
 
 
 def _nearest_neighbour(D: np.ndarray) -> np.ndarray:
@@ -74,9 +97,35 @@ def igd(F: ArrayLike, ref_set: ArrayLike) -> float:
     of a coevolutionary multi-objective evolutionary algorithm", MICAI 2004, LNCS 2972.
     Computed by :func:`moocore.igd`.
     """
-    A = _points(F, "F")
-    R = _points(ref_set, "ref_set", n_obj=A.shape[1])
-    return float(moocore.igd(A, ref=R))
+    return _distance_to_reference(moocore.igd, F, ref_set)
+
+
+def igd_plus(F: ArrayLike, ref_set: ArrayLike) -> float:
+    r"""IGD+, the Pareto-compliant modification of IGD (minimisation).
+
+    .. math::
+
+        IGD^+(P, P^*) = \frac{1}{|P^*|} \sum_{k \in P^*} \min_{i \in P}
+        \Big(\sum_{j=1}^{m} \max(i_j - k_j, 0)^2\Big)^{1/2},
+
+    the distance from each reference point to the part of the nearest point's
+    dominated region: only the objectives in which ``i`` is worse than ``k``
+    count. Zero when ``F`` weakly dominates every reference point.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m)
+        The approximation ``P``.
+    ref_set : array_like, shape (k, m)
+        The reference set ``P*``.
+
+    References
+    ----------
+    H. Ishibuchi, H. Masuda, Y. Tanigaki and Y. Nojima (2015), "Modified distance
+    calculation in generational distance and inverted generational distance",
+    EMO 2015, LNCS 9019, 110-125. Computed by :func:`moocore.igd_plus`.
+    """
+    return _distance_to_reference(moocore.igd_plus, F, ref_set)
 
 
 def spacing(F: ArrayLike) -> float:
@@ -107,8 +156,9 @@ def spacing(F: ArrayLike) -> float:
     genetic algorithm optimization", MSc thesis, MIT.
     """
     A = _points(F, "F", min_rows=2)
-    d = _nearest_neighbour(cdist(A, A, metric="cityblock"))
-    return float(np.std(d, ddof=1))
+    c = _common_scale(A)
+    d = _nearest_neighbour(cdist(A / c, A / c, metric="cityblock"))
+    return c * float(np.std(d, ddof=1))
 
 
 def hypervolume(F: ArrayLike, ref_point: ArrayLike) -> float:
@@ -136,13 +186,28 @@ def hypervolume(F: ArrayLike, ref_point: ArrayLike) -> float:
     A = _points(F, "F")
     r = as_matrix(ref_point, "ref_point", rows=1, cols=A.shape[1],
                   cols_what="the number of objectives of F").ravel()
-    return float(moocore.hypervolume(A, ref=r))
+    c = _common_scale(A, r)
+    with np.errstate(over="ignore"):
+        hv = float(moocore.hypervolume(A / c, ref=r / c) * np.float64(c) ** A.shape[1])
+    if not np.isfinite(hv):
+        raise OverflowError(f"the hypervolume exceeds the float range (the boxes reach about {c:.1e} in each of "
+                            f"the {A.shape[1]} objectives); rescale the objectives")
+    return hv
 
 
 def _minkowski_dissimilarity(A: np.ndarray, p: float) -> np.ndarray:
-    # (sum_j |a_j - b_j|^p)^(1/p); cdist's "minkowski" refuses p < 1, so computed here.
+    """``(sum_j |a_j - b_j|^p)^(1/p)``, ``max_j |a_j - b_j|`` for ``p = inf`` (cdist refuses ``p < 1``).
+
+    Computed as ``d_max (sum_j (|a_j - b_j| / d_max)^p)^(1/p)``, which neither
+    overflows nor underflows for large or small ``p``.
+    """
     diff = np.abs(A[:, None, :] - A[None, :, :])
-    return np.sum(diff**p, axis=2) ** (1.0 / p)
+    top = diff.max(axis=2)
+    if np.isinf(p):
+        return top
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(top[..., None] > 0, diff / top[..., None], 0.0)
+    return top * np.sum(ratio**p, axis=2) ** (1.0 / p)
 
 
 def _pd_exact(D: np.ndarray) -> float:
@@ -193,7 +258,8 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
         d(s, X) = \min_{s_i \in X} \lVert s - s_i \rVert_p,
 
     with the Minkowski dissimilarity :math:`\lVert a - b\rVert_p =
-    (\sum_j |a_j - b_j|^p)^{1/p}`, ``p = 0.1`` (an L_p "norm" with p < 1, which
+    (\sum_j |a_j - b_j|^p)^{1/p}` (its limit :math:`\max_j |a_j - b_j|` for
+    ``p = inf``), ``p = 0.1`` (an L_p "norm" with p < 1, which
     Wang et al. chose because it separates points better in many objectives).
     The paper's Eq. (ds) prints ``max`` in :math:`d(s, X)`; the original
     definition, followed here, is the dissimilarity to the *nearest* individual.
@@ -202,7 +268,7 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
     ----------
     F : array_like, shape (n, m)
     p : float, default 0.1
-        Minkowski exponent (> 0).
+        Minkowski exponent (> 0; ``inf`` is the Chebyshev distance).
     method : {"greedy", "exact"}
         ``"exact"`` evaluates the recursion exactly by dynamic programming over
         subsets, O(2^n n^2), for n <= 16. ``"greedy"`` (default) is the practical
@@ -231,21 +297,21 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
     optimization", IEEE Trans. Cybernetics 47(6), 1510-1522.
     """
     A = _points(F, "F")
-    if isinstance(p, bool) or not isinstance(p, (int, float, np.integer, np.floating)) or not p > 0:
-        raise ValueError(f"p must be a number > 0, got {p!r}")
+    p = check_positive_scalar(p, "p", allow_inf=True)
     if method not in ("greedy", "exact"):
         raise ValueError(f"method must be 'greedy' or 'exact', got {method!r}")
     n = A.shape[0]
     if n == 1:
         return 0.0
     A = A[np.lexsort(A.T[::-1])]          # canonical order: ties broken by the points, not the rows
-    D = _minkowski_dissimilarity(A, float(p))
+    c = _common_scale(A)
+    D = _minkowski_dissimilarity(A / c, p)
     if method == "exact":
         if n > PD_EXACT_MAX_POINTS:
             raise ValueError(f"method='exact' handles at most {PD_EXACT_MAX_POINTS} points, "
                              f"F has {n}; use method='greedy'")
-        return _pd_exact(D)
-    return _pd_greedy(D)
+        return c * _pd_exact(D)
+    return c * _pd_greedy(D)
 
 
 def spread(F: ArrayLike, ref_set: ArrayLike) -> float:
@@ -289,6 +355,8 @@ def spread(F: ArrayLike, ref_set: ArrayLike) -> float:
     """
     A = _points(F, "F", min_rows=2)
     R = _points(ref_set, "ref_set", n_obj=A.shape[1])
+    c = _common_scale(A, R)                # Spread is a ratio: scaled distances give the same value
+    A, R = A / c, R / c
     extremes = R[np.argmax(R, axis=0)]
     d_ext = cdist(extremes, A).min(axis=1).sum()
     d = _nearest_neighbour(cdist(A, A))

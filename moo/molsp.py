@@ -85,6 +85,7 @@ from __future__ import annotations
 
 import copy
 from functools import cache
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -95,6 +96,13 @@ from pymoo.termination.max_eval import MaximumFunctionCallTermination
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from ._validation import as_matrix
+
+if TYPE_CHECKING:
+    from pymoo.core.evaluator import Evaluator
+    from pymoo.core.problem import Problem
+    from pymoo.core.survival import Survival
+    from pymoo.core.termination import Termination
+    from pymoo.util.archive import Archive
 
 __all__ = ["MOLSP", "molsp", "candidates", "leader_scores", "mutation_steps", "build_mutants",
            "repair_bounds", "propose"]
@@ -122,6 +130,12 @@ def leader_scores(F: ArrayLike, ref_point: ArrayLike) -> np.ndarray:
     return np.where(inside, np.prod(np.where(inside[:, None], gap, 1.0), axis=1), gap.min(axis=1))
 
 
+def _check_max_leaders(max_leaders) -> None:
+    if max_leaders is not None and (isinstance(max_leaders, bool) or not isinstance(max_leaders, (int, np.integer))
+                                    or max_leaders < 1):
+        raise ValueError(f"max_leaders must be None or an integer >= 1, got {max_leaders!r}")
+
+
 def candidates(F: ArrayLike, ref_point: ArrayLike, max_leaders: int | None = None) -> np.ndarray:
     """Indices of the MO-LSP candidates, leader first.
 
@@ -131,9 +145,7 @@ def candidates(F: ArrayLike, ref_point: ArrayLike, max_leaders: int | None = Non
     truncated to ``max_leaders`` if given.
     """
     F = as_matrix(F, "F")
-    if max_leaders is not None and (isinstance(max_leaders, bool) or not isinstance(max_leaders, (int, np.integer))
-                                    or max_leaders < 1):
-        raise ValueError(f"max_leaders must be None or an integer >= 1, got {max_leaders!r}")
+    _check_max_leaders(max_leaders)
     score = leader_scores(F, ref_point)
     fronts = NonDominatedSorting().do(F, n_stop_if_ranked=len(F))
     idx = np.concatenate([np.asarray(f, dtype=int) for f in fronts[:2]])
@@ -218,7 +230,7 @@ def repair_bounds(M: ArrayLike, xl: ArrayLike, xu: ArrayLike, rng: np.random.Gen
         raise ValueError("xu must be >= xl entry-wise")
     u = rng.random(M.shape)
     span = np.where(np.isfinite(xu - xl), xu - xl, 0.0) * REPAIR_SHARE
-    return np.where(M < xl, xl + u * span, np.where(M > xu, xu - u * span, M))
+    return np.where(xl > M, xl + u * span, np.where(xu < M, xu - u * span, M))
 
 
 def propose(X: ArrayLike, F: ArrayLike, xl: ArrayLike, xu: ArrayLike, ref_point: ArrayLike,
@@ -254,7 +266,35 @@ def _eval_budget(termination) -> float | None:
     return None
 
 
-class MOLSP:
+if TYPE_CHECKING:
+    class _SurvivalHost:
+        """What :class:`MOLSP` uses of its host, a pymoo survival-based algorithm (type checking only).
+
+        The attributes of a set-up :class:`pymoo.core.algorithm.Algorithm` /
+        :class:`~pymoo.algorithms.base.genetic.GeneticAlgorithm` and the two
+        hooks MO-LSP extends. At run time :class:`MOLSP` derives from ``object``
+        and finds all of them on the host, the other base of ``MOLSP[<Host>]``.
+        """
+
+        problem: Problem
+        pop: Population
+        pop_size: int
+        survival: Survival
+        evaluator: Evaluator
+        termination: Termination
+        random_state: np.random.Generator
+        n_iter: int
+        data: dict[str, Any]
+        archive: Archive | None
+
+        def _setup(self, problem: Problem, **kwargs: Any) -> None: ...
+
+        def _advance(self, infills: Population | None = None, **kwargs: Any) -> bool | None: ...
+else:
+    _SurvivalHost = object
+
+
+class MOLSP(_SurvivalHost):
     """Mixin that runs MO-LSP after every generation of its host algorithm.
 
     Not instantiated directly: use :func:`molsp`. ``isinstance(alg, MOLSP)``
@@ -267,15 +307,16 @@ class MOLSP:
 
     molsp_ref_point: np.ndarray
     molsp_max_leaders: int | None
+    _molsp_host: ClassVar[type]      # set by _wrapped_class
 
-    def _setup(self, problem, **kwargs):
+    def _setup(self, problem: Problem, **kwargs: Any) -> None:
         super()._setup(problem, **kwargs)
         if self.molsp_ref_point.size != problem.n_obj:
             raise ValueError(f"ref_point must have {problem.n_obj} entries (the number of objectives), "
                              f"got {self.molsp_ref_point.size}")
         self.data["molsp_n_eval"] = 0
 
-    def _advance(self, infills=None, **kwargs):
+    def _advance(self, infills: Population | None = None, **kwargs: Any) -> bool | None:
         value = super()._advance(infills=infills, **kwargs)
         if value is None or value:
             self._molsp_step()
@@ -319,7 +360,7 @@ class MOLSP:
         if self.archive is not None:
             self.archive = self.archive.add(mutants)
 
-    def __reduce_ex__(self, protocol):
+    def __reduce_ex__(self, protocol: Any) -> tuple[Any, ...]:
         return _restore, (type(self)._molsp_host,), self.__dict__.copy()
 
 
@@ -375,11 +416,10 @@ def molsp(algorithm: Algorithm, *, ref_point: ArrayLike, max_leaders: int | None
     if algorithm.problem is not None or algorithm.is_initialized:
         raise ValueError("algorithm must not be set up yet: wrap it before minimize()/setup()")
     r = as_matrix(ref_point, "ref_point", rows=1).ravel()
-    if max_leaders is not None and (isinstance(max_leaders, bool) or not isinstance(max_leaders, (int, np.integer))
-                                    or max_leaders < 1):
-        raise ValueError(f"max_leaders must be None or an integer >= 1, got {max_leaders!r}")
+    _check_max_leaders(max_leaders)
+    host: type = type(algorithm)
     wrapped = copy.deepcopy(algorithm)
-    wrapped.__class__ = _wrapped_class(type(algorithm))
+    wrapped.__class__ = _wrapped_class(host)
     wrapped.molsp_ref_point = r
     wrapped.molsp_max_leaders = None if max_leaders is None else int(max_leaders)
     return wrapped

@@ -3,7 +3,7 @@
 Pipeline (``python -m moo stats DIR``)::
 
     records = load_records(DIR)              # moo.store: one dict per run
-    runs    = run_indicators(records)        # five indicators per run (RunIndicators)
+    runs    = run_indicators(records)        # six indicators per run (RunIndicators)
     table   = compare(runs)                  # one Comparison per (problem, algorithm, indicator)
     to_markdown(table) / to_csv(...) / to_latex(...)
     ranks   = friedman(runs)                 # one FriedmanResult per (problem, indicator)
@@ -11,15 +11,21 @@ Pipeline (``python -m moo stats DIR``)::
 
 Indicators (:mod:`moo.indicators`) on each run's final non-dominated set ``F``:
 
-* IGD and Spread need a reference set ``P*``. For the control-design MOPs
+* IGD, IGD+ and Spread need a reference set ``P*``. For the control-design MOPs
   (``generic``, ``applied``) the true front is unknown; ``P*`` is the
   non-dominated union of the final sets of *all* runs recorded for the problem
   (every algorithm, both variants, every seed), as PAPER_NOTES.md asks. It
   therefore depends on what the directory holds: adding runs can change every
-  IGD. For ZDT1-6 and DTLZ1-7 ``P*`` is a dense sample of the true Pareto front
+  IGD (and IGD+). For ZDT1-6 and DTLZ1-7 ``P*`` is a dense sample of the true Pareto front
   from its closed form (:func:`true_front`).
 * SP (Schott's spacing), HV (reference point ``problem.hv_ref_point``, the
   one stored in the record) and PD (pure diversity, greedy computation).
+
+The first five are the paper's (its column order, :data:`INDICATORS`); IGD+
+(Ishibuchi et al. 2015, the Pareto-compliant IGD) is ours, after them. The
+paper-layout tables of ``paper_repro/moea_tables.py`` keep the paper's five:
+:func:`to_markdown` and :func:`to_latex` show the indicators of the rows
+they are given.
 
 A run whose final set has fewer than two points has SP and Spread undefined
 (NaN); a run with an empty set (no feasible point) has HV 0 and the others NaN.
@@ -30,7 +36,7 @@ ANOVA (:func:`scipy.stats.f_oneway`) and Tukey's HSD at 95 %
 (:func:`scipy.stats.tukey_hsd`) between the runs of the MOEA and those of its
 MO-LSP version. With two groups both p-values equal that of the two-sided
 pooled-variance t-test; both are reported. ``better`` is the variant with the
-better mean (lower IGD, SP, Spread; higher HV, PD; note that the paper's
+better mean (lower IGD, SP, Spread, IGD+; higher HV, PD; note that the paper's
 tables bold the *larger* SP as the better one); ``significant`` is
 ``p_tukey < alpha``. If both groups are constant the tests are undefined: p is
 1 when the two constants are equal and 0 otherwise.
@@ -96,14 +102,15 @@ __all__ = ["INDICATORS", "HIGHER_IS_BETTER", "LABELS", "RunIndicators", "Compari
            "nemenyi_cd", "registry_order", "compare", "friedman", "to_csv", "to_markdown", "to_latex", "ranks_to_csv",
            "ranks_to_markdown", "ranks_to_latex", "analyse"]
 
-#: Indicator names in the paper's column order. (A new indicator, e.g. IGD+ once
-#: moo.indicators has it, is one entry here, in HIGHER_IS_BETTER and _LABELS, a
-#: field of RunIndicators and one line in run_indicators.)
-INDICATORS: tuple[str, ...] = ("igd", "sp", "hv", "pd", "spread")
+#: Indicator names: the paper's five in its column order, then IGD+. (A new indicator
+#: is one entry here, in HIGHER_IS_BETTER and LABELS, a field of RunIndicators and
+#: one line in run_indicators.)
+INDICATORS: tuple[str, ...] = ("igd", "sp", "hv", "pd", "spread", "igd_plus")
 #: Direction of each indicator (True: larger is better).
-HIGHER_IS_BETTER: dict[str, bool] = {"igd": False, "sp": False, "hv": True, "pd": True, "spread": False}
+HIGHER_IS_BETTER: dict[str, bool] = {"igd": False, "sp": False, "hv": True, "pd": True, "spread": False,
+                                     "igd_plus": False}
 #: Column labels of the indicators.
-LABELS: dict[str, str] = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
+LABELS: dict[str, str] = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread", "igd_plus": "IGD+"}
 _LABELS = LABELS
 
 _TRUE_FRONT_POINTS = 5000
@@ -111,7 +118,11 @@ _TRUE_FRONT_POINTS = 5000
 
 @dataclass(frozen=True)
 class RunIndicators:
-    """The five indicators of one run's final non-dominated set."""
+    """The indicators of one run's final non-dominated set (:data:`INDICATORS`).
+
+    ``igd_plus`` defaults to NaN, so that rows built with the paper's five
+    values only stay valid.
+    """
 
     problem: str
     n_obj: int
@@ -124,6 +135,7 @@ class RunIndicators:
     hv: float
     pd: float
     spread: float
+    igd_plus: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -287,7 +299,7 @@ def reference_sets(records: Iterable[dict]) -> dict[tuple[str, int], np.ndarray]
 
 def run_indicators(records: Sequence[dict], ref_sets: dict[tuple[str, int], np.ndarray] | None = None
                    ) -> list[RunIndicators]:
-    """The five indicators of every run (see the module docstring for ``P*`` and NaNs)."""
+    """The indicators of every run (see the module docstring for ``P*`` and NaNs)."""
     records = list(records)
     if ref_sets is None:
         ref_sets = reference_sets(records)
@@ -306,7 +318,8 @@ def run_indicators(records: Sequence[dict], ref_sets: dict[tuple[str, int], np.n
             sp=ind.spacing(F) if n >= 2 else nan,
             hv=hv,
             pd=ind.pure_diversity(F) if n else nan,
-            spread=ind.spread(F, R) if n >= 2 and len(R) else nan))
+            spread=ind.spread(F, R) if n >= 2 and len(R) else nan,
+            igd_plus=ind.igd_plus(F, R) if n and len(R) else nan))
     return rows
 
 
@@ -581,7 +594,14 @@ def _marks(c: Comparison, molsp: bool, best: dict) -> tuple[bool, str]:
     return is_better, ",".join(marks)
 
 
-def _rows(table: dict, best: dict, problem: str, cell: Callable[[float, float, bool, str], str]):
+def _columns(items: Iterable[Comparison] | Iterable[FriedmanResult]) -> tuple[str, ...]:
+    """The indicators ``items`` are about, in the order of :data:`INDICATORS`: a table's columns."""
+    present = {x.indicator for x in items}
+    return tuple(n for n in INDICATORS if n in present)
+
+
+def _rows(table: dict, best: dict, problem: str, columns: Sequence[str],
+          cell: Callable[[float, float, bool, str], str]):
     """``(algorithm, molsp, cell texts)`` of each MOEA of ``problem``: its MO-LSP row, then its plain row.
 
     ``cell(mean, std, bold, marks)`` writes one cell; a missing indicator is ``""``.
@@ -591,7 +611,7 @@ def _rows(table: dict, best: dict, problem: str, cell: Callable[[float, float, b
             continue
         for molsp in (True, False):
             cells = []
-            for name in INDICATORS:
+            for name in columns:
                 c = cs.get(name)
                 if c is None:
                     cells.append("")
@@ -601,11 +621,14 @@ def _rows(table: dict, best: dict, problem: str, cell: Callable[[float, float, b
             yield alg, molsp, cells
 
 
-def _legend(rows: Sequence[Comparison]) -> str:
+def _legend(rows: Sequence[Comparison], columns: Sequence[str]) -> str:
     alpha = rows[0].alpha if rows else 0.05
     level = f"{100 * (1 - alpha):g} %"
+    directions = "; ".join(f"{word} {', '.join(LABELS[n] for n in columns if HIGHER_IS_BETTER[n] is higher)}"
+                           for word, higher in (("lower", False), ("higher", True))
+                           if any(HIGHER_IS_BETTER[n] is higher for n in columns))
     return (f"Mean ± standard deviation over the runs (n/a: no finite value). Bold: the better mean of the "
-            f"pair MOEA / MOEA with MO-LSP (lower IGD, SP, Spread; higher HV, PD). "
+            f"pair MOEA / MOEA with MO-LSP ({directions}). "
             f"^a: the difference is significant at {level} by one-way ANOVA and Tukey's HSD (the paper's test), "
             f"in favour of this row. ^w: significant at {level} by the two-sided Wilcoxon rank-sum test with "
             f"Holm's correction over the MOEAs of the column, in favour of this row. "
@@ -613,24 +636,28 @@ def _legend(rows: Sequence[Comparison]) -> str:
 
 
 def to_markdown(rows: Sequence[Comparison]) -> str:
-    """The paper's layout: per MOEA a ``/MO-LSP`` row and a plain row, five indicator columns.
+    """The paper's layout: per MOEA a ``/MO-LSP`` row and a plain row, one column per indicator.
 
-    The better mean of each pair is bold; ``^a`` marks a significant
-    difference (Tukey, 95 %) in its favour, ``^w`` one by the Wilcoxon
-    rank-sum test with Holm's correction, ``^*`` the best value over the table
-    (every cell sharing it, on ties). A legend explaining the marks follows.
+    The columns are the indicators of ``rows`` (all of :data:`INDICATORS`
+    for a :func:`compare` table; pass the rows of the paper's five for its
+    layout), in that order. The better mean of each pair is bold; ``^a``
+    marks a significant difference (Tukey, 95 %) in its favour, ``^w`` one by
+    the Wilcoxon rank-sum test with Holm's correction, ``^*`` the best value
+    over the table (every cell sharing it, on ties). A legend explaining the
+    marks follows.
     """
     table, best = _layout(rows)
+    columns = _columns(rows)
     lines = []
     for problem in dict.fromkeys(p for p, _ in table):
         lines += [f"**{problem}**", "",
-                  "| MOEA | " + " | ".join(_LABELS[n] for n in INDICATORS) + " |",
-                  "|---|" + "---|" * len(INDICATORS)]
-        for alg, molsp, cells in _rows(table, best, problem, _markdown_cell):
+                  "| MOEA | " + " | ".join(_LABELS[n] for n in columns) + " |",
+                  "|---|" + "---|" * len(columns)]
+        for alg, molsp, cells in _rows(table, best, problem, columns, _markdown_cell):
             lines.append(f"| {alg}{'/MO-LSP' if molsp else ''} | " + " | ".join(cells) + " |")
         lines.append("")
     if rows:
-        lines += [_legend(rows), ""]
+        lines += [_legend(rows, columns), ""]
     return "\n".join(lines)
 
 
@@ -642,16 +669,17 @@ def _latex_text(text: str) -> str:
 def to_latex(rows: Sequence[Comparison]) -> str:
     """The same layout as :func:`to_markdown` as a LaTeX ``tabular`` (one per problem), legend below."""
     table, best = _layout(rows)
+    columns = _columns(rows)
     out = []
     for problem in dict.fromkeys(p for p, _ in table):
-        out += [f"% {problem}", r"\begin{tabular}{l" + "c" * len(INDICATORS) + "}", r"\hline",
-                "MOEA & " + " & ".join(_LABELS[n] for n in INDICATORS) + r" \\", r"\hline"]
-        for alg, molsp, cells in _rows(table, best, problem, _latex_cell):
+        out += [f"% {problem}", r"\begin{tabular}{l" + "c" * len(columns) + "}", r"\hline",
+                "MOEA & " + " & ".join(_LABELS[n] for n in columns) + r" \\", r"\hline"]
+        for alg, molsp, cells in _rows(table, best, problem, columns, _latex_cell):
             name = alg.replace("_", r"\_") + ("/MO-LSP" if molsp else "")
             out.append(f"{name} & " + " & ".join(cells) + r" \\")
         out += [r"\hline", r"\end{tabular}", ""]
     if rows:
-        out += [r"\par\smallskip\noindent{\footnotesize " + _latex_text(_legend(rows)) + "}", ""]
+        out += [r"\par\smallskip\noindent{\footnotesize " + _latex_text(_legend(rows, columns)) + "}", ""]
     return "\n".join(out)
 
 
@@ -685,7 +713,7 @@ def _ranks_legend(results: Sequence[FriedmanResult]) -> str:
             f"(p < {alpha:g}). Last rows: the Friedman chi-square p-value, CD and N of each column.")
 
 
-def _ranks_rows(results: Sequence[FriedmanResult], bold, sup):
+def _ranks_rows(results: Sequence[FriedmanResult], columns: Sequence[str], bold, sup):
     """(problem, [(label, cells)], footer rows) for each problem, cells written with bold(text) and sup(marks)."""
     for problem, by_ind in _ranks_layout(results).items():
         variants = next(iter(by_ind.values())).variants
@@ -695,20 +723,24 @@ def _ranks_rows(results: Sequence[FriedmanResult], bold, sup):
             text, is_best, marks = _rank_cell(r, v)
             return (bold(text) if is_best else text) + (sup(marks) if marks else "")
 
-        rows = [(v.replace("+molsp", "/MO-LSP"), [cell(by_ind.get(n), v) for n in INDICATORS]) for v in variants]
-        footer = [("Friedman p", [f"{by_ind[n].p_value:.3g}" if n in by_ind else "" for n in INDICATORS]),
-                  ("CD", [f"{by_ind[n].cd:.3g}" if n in by_ind else "" for n in INDICATORS]),
-                  ("N", [str(by_ind[n].n_blocks) if n in by_ind else "" for n in INDICATORS])]
+        rows = [(v.replace("+molsp", "/MO-LSP"), [cell(by_ind.get(n), v) for n in columns]) for v in variants]
+        footer = [("Friedman p", [f"{by_ind[n].p_value:.3g}" if n in by_ind else "" for n in columns]),
+                  ("CD", [f"{by_ind[n].cd:.3g}" if n in by_ind else "" for n in columns]),
+                  ("N", [str(by_ind[n].n_blocks) if n in by_ind else "" for n in columns])]
         yield problem, rows, footer
 
 
 def ranks_to_markdown(results: Sequence[FriedmanResult]) -> str:
-    """Mean Friedman ranks, one row per variant and one column per indicator, per problem, legend below."""
+    """Mean Friedman ranks, one row per variant and one column per indicator, per problem, legend below.
+
+    The columns are the indicators of ``results``, in the order of :data:`INDICATORS`.
+    """
+    columns = _columns(results)
     lines = []
-    for problem, rows, footer in _ranks_rows(results, lambda t: f"**{t}**", lambda m: f"^{m}"):
+    for problem, rows, footer in _ranks_rows(results, columns, lambda t: f"**{t}**", lambda m: f"^{m}"):
         lines += [f"**{problem}: mean ranks (Friedman, Nemenyi)**", "",
-                  "| variant | " + " | ".join(_LABELS[n] for n in INDICATORS) + " |",
-                  "|---|" + "---|" * len(INDICATORS)]
+                  "| variant | " + " | ".join(_LABELS[n] for n in columns) + " |",
+                  "|---|" + "---|" * len(columns)]
         lines += [f"| {label} | " + " | ".join(cells) + " |" for label, cells in rows + footer]
         lines.append("")
     if results:
@@ -718,10 +750,12 @@ def ranks_to_markdown(results: Sequence[FriedmanResult]) -> str:
 
 def ranks_to_latex(results: Sequence[FriedmanResult]) -> str:
     """The table of :func:`ranks_to_markdown` as a LaTeX ``tabular`` per problem, legend below."""
+    columns = _columns(results)
     out = []
-    for problem, rows, footer in _ranks_rows(results, lambda t: rf"\textbf{{{t}}}", lambda m: f"$^{{{m}}}$"):
-        out += [f"% {problem}: mean Friedman ranks", r"\begin{tabular}{l" + "c" * len(INDICATORS) + "}",
-                r"\hline", "variant & " + " & ".join(_LABELS[n] for n in INDICATORS) + r" \\", r"\hline"]
+    for problem, rows, footer in _ranks_rows(results, columns, lambda t: rf"\textbf{{{t}}}",
+                                             lambda m: f"$^{{{m}}}$"):
+        out += [f"% {problem}: mean Friedman ranks", r"\begin{tabular}{l" + "c" * len(columns) + "}",
+                r"\hline", "variant & " + " & ".join(_LABELS[n] for n in columns) + r" \\", r"\hline"]
         out += [f"{label.replace('_', chr(92) + '_')} & " + " & ".join(cells) + r" \\" for label, cells in rows]
         out.append(r"\hline")
         out += [f"{label} & " + " & ".join(cells) + r" \\" for label, cells in footer]

@@ -9,16 +9,18 @@ Runs the grid problem x algorithms x {plain, MO-LSP} x runs with
 :func:`moo.experiment.run_experiment` into ``DIR`` (default
 ``out/moea_<problem>``, or ``out/moea_applied_<setup>`` with ``--setup``,
 whose files are then named ``moea_applied_<setup>*``; resumable: rerunning with the same arguments skips
-finished runs, raising ``--runs`` adds runs), computes the five indicators and
+finished runs, raising ``--runs`` adds runs), computes the indicators and
 the ANOVA/Tukey comparisons (:mod:`moo.stats`), and prints
 
-1. our table in the paper's layout (per MOEA a ``/MO-LSP`` row and a plain
-   row; mean ± std; the better mean of a pair in bold, ``^a`` a significant
-   difference in its favour (Tukey HSD, 95 %), ``^*`` the best over the table);
+1. our table in the paper's layout (the paper's five indicators; per MOEA a
+   ``/MO-LSP`` row and a plain row; mean ± std; the better mean of a pair in
+   bold, ``^a`` a significant difference in its favour (Tukey HSD, 95 %),
+   ``^*`` the best over the table);
 2. a cell-by-cell comparison with the paper's published table
    (:mod:`paper_repro.paper_moea_values`), for ``generic`` and ``applied``;
-3. the mean Friedman ranks of all 20 variants per indicator, with the
-   Nemenyi critical difference (:func:`moo.stats.friedman`);
+3. the mean Friedman ranks of all 20 variants per indicator (IGD+ too, as
+   the library's statistics), with the Nemenyi critical difference
+   (:func:`moo.stats.friedman`);
 
 and draws the figures of :mod:`moo.plots` (hypervolume over evaluations,
 box plots, fronts, critical-difference diagrams) into ``DIR/figures``.
@@ -37,7 +39,7 @@ Defaults (5 runs, 2000 evaluations, all ten MOEAs, 2 workers) take a few
 minutes on 2 cores (``generic`` about 1 min, ``applied`` about 3-5 min);
 ``--runs 50 --evals 10000`` is the paper's setting. Files written to ``DIR``:
 ``moea_<problem>.md`` (both tables), ``moea_<problem>.tex``,
-``moea_<problem>_stats.csv`` (one row per MOEA x indicator),
+``moea_<problem>_stats.csv`` (one row per MOEA x indicator, IGD+ included),
 ``moea_<problem>_runs.csv`` (indicators per run), ``moea_<problem>_ranks.csv``
 (Friedman ranks), ``moea_<problem>_vs_paper.csv`` and ``figures/*.png|pdf``.
 The paper's experiment on a cluster: ``--executor dask --scheduler
@@ -62,7 +64,7 @@ from moo.executors import open_executor
 from moo.experiment import run_experiment
 from moo.plots import plot_results
 from moo.stats import (
-    INDICATORS,
+    LABELS,
     Comparison,
     analyse,
     friedman,
@@ -74,9 +76,7 @@ from moo.stats import (
     to_markdown,
 )
 from moo.store import load_records
-from paper_repro.paper_moea_values import PAPER_LABELS, PAPER_MOEA, paper_cell
-
-_LABELS = {"igd": "IGD", "sp": "SP", "hv": "HV", "pd": "PD", "spread": "Spread"}
+from paper_repro.paper_moea_values import INDICATORS, PAPER_LABELS, PAPER_MOEA, paper_cell
 
 
 @dataclass(frozen=True)
@@ -106,7 +106,7 @@ def agreements(problem: str, table: Sequence[Comparison]) -> list[CellAgreement]
         return []
     out = []
     for c in table:
-        if (c.algorithm, True) not in PAPER_MOEA[problem]:
+        if (c.algorithm, True) not in PAPER_MOEA[problem] or c.indicator not in INDICATORS:
             continue
         molsp, plain = (paper_cell(problem, c.algorithm, v, c.indicator) for v in (True, False))
         ours = c.mean_molsp - c.mean_plain
@@ -132,7 +132,7 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
     by = {(c.algorithm, c.indicator): c for c in cells}
     lines = [(f"MO-LSP effect, paper vs ours ({problem}): sign of mean(MO-LSP) - mean(plain), "
               "sig = significant at 95 % (paper: mark 'a'; ours: Tukey p < 0.05); '=' agree, 'x' differ"), "",
-             "| MOEA | " + " | ".join(_LABELS[n] for n in INDICATORS) + " |",
+             "| MOEA | " + " | ".join(LABELS[n] for n in INDICATORS) + " |",
              "|---|" + "---|" * len(INDICATORS)]
     for alg in algs:
         cells_txt = []
@@ -154,7 +154,7 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
     for name in INDICATORS:
         sub = [c for c in cells if c.indicator == name]
         if sub:
-            per.append(f"{_LABELS[name]} {sum(c.direction_agrees for c in sub)}/{len(sub)}"
+            per.append(f"{LABELS[name]} {sum(c.direction_agrees for c in sub)}/{len(sub)}"
                        f" ({sum(c.full_agreement for c in sub)}/{len(sub)})")
     lines.append("Per indicator, direction (and full) agreement: " + ", ".join(per) + ".")
     return "\n".join(lines) + "\n"
@@ -215,7 +215,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     keep = set(names)
     runs = [r for r in runs if r.problem == args.problem and r.algorithm in keep]
     table = [c for c in table if c.problem == args.problem and c.algorithm in keep]
-    ours = to_markdown(table)
+    paper_table = [c for c in table if c.indicator in INDICATORS]      # the paper's layout: its five indicators
+    ours = to_markdown(paper_table)
     cells = agreements(args.problem, table)
     versus = comparison_markdown(args.problem, cells)
     print(f"Our results ({args.runs} runs x {args.evals} evaluations; IGD/Spread reference set: the "
@@ -226,7 +227,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(versus)
     print(ranks_md)
     (out / f"{stem}.md").write_text(ours + "\n" + versus + "\n" + ranks_md, encoding="utf-8")
-    (out / f"{stem}.tex").write_text(to_latex(table) + "\n" + ranks_to_latex(ranks), encoding="utf-8")
+    (out / f"{stem}.tex").write_text(to_latex(paper_table) + "\n" + ranks_to_latex(ranks), encoding="utf-8")
     to_csv(table, out / f"{stem}_stats.csv")
     to_csv(runs, out / f"{stem}_runs.csv")
     ranks_to_csv(ranks, out / f"{stem}_ranks.csv")

@@ -115,7 +115,7 @@ def test_equal_proximity_splits_the_discriminator_at_random():
     F = np.array([[0.0, 1.0], [0.0, 1.0], [1.0, 0.0]])
     seen = set()
     for seed in range(20):
-        fpr, fcd = bige_estimation(F, 0.5, np.random.default_rng(seed))
+        _, fcd = bige_estimation(F, 0.5, np.random.default_rng(seed))
         assert sorted(fcd[:2].tolist()) == [0.5, 1.5] and fcd[2] == 0.0
         seen.add(tuple(fcd[:2]))
     assert seen == {(0.5, 1.5), (1.5, 0.5)}
@@ -141,7 +141,7 @@ def test_estimation_rejects_bad_input():
         bige_estimation([[1.0, np.inf]], 0.5, rng)
     with pytest.raises(ValueError, match="radius must be finite and > 0"):
         bige_estimation(FRONT, 0.0, rng)
-    with pytest.raises(TypeError, match="random_state must be a numpy.random.Generator"):
+    with pytest.raises(TypeError, match=r"random_state must be a numpy\.random\.Generator"):
         bige_estimation(FRONT, 0.5, 3)
 
 
@@ -257,9 +257,10 @@ def test_dtlz2_igd_comparable_to_nsga3():
 
 
 def test_dtlz1_converges_to_the_linear_front():
-    # DTLZ1 (3 objectives, n_var 7): the front is sum f = 0.5. 20000 evaluations (~2.5 s).
+    # DTLZ1 (3 objectives, n_var 7): the front is sum f = 0.5. 30000 evaluations (~3.5 s): at 20000 a run can
+    # still sit on the local front sum f = 1 (seed 1 did once the initial population went through the survival)
     problem = get_problem("dtlz1", n_obj=3)
-    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 20000), seed=1)
+    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 30000), seed=1)
     s = res.F.sum(axis=1)
     assert abs(np.median(s) - 0.5) < 0.01, np.median(s)
     assert np.mean(np.abs(s - 0.5) < 0.05) > 0.9

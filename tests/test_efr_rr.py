@@ -167,7 +167,7 @@ def test_bad_arguments(kwargs, exc, word):
 
 
 def test_bad_ranking_inputs():
-    with pytest.raises(ValueError, match="ref_dirs.*3 columns"):
+    with pytest.raises(ValueError, match=r"ref_dirs.*3 columns"):
         maximum_ranking(np.zeros((4, 3)), W3)
     with pytest.raises(ValueError, match="ref_dirs"):
         maximum_ranking(np.zeros((4, 2)), -W3)
@@ -201,9 +201,10 @@ def test_dtlz2_quality_against_nsga3():
 
 @pytest.mark.slow
 def test_dtlz1_converges_to_linear_front():
-    # DTLZ1's front is sum(f) = 0.5; start far from it (random sums are in the hundreds).
+    # DTLZ1's front is sum(f) = 0.5; start far from it (random sums are in the hundreds). 30000 evaluations:
+    # at 20000 a run can still sit on the local front sum f = 1 (seed 1 does since the normalisation change)
     problem = get_problem("dtlz1", n_obj=3, n_var=7)
-    res = minimize(problem, make_efr_rr(n_obj=3), ("n_eval", 20000), seed=1)
+    res = minimize(problem, make_efr_rr(n_obj=3), ("n_eval", 30000), seed=1)
     sums = res.F.sum(axis=1)
     assert np.median(sums) < 0.55 and np.quantile(sums, 0.75) < 0.75, np.quantile(sums, [0.5, 0.75])
 

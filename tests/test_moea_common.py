@@ -2,13 +2,20 @@
 
 Same seed -> identical run, other seed -> other run; setting an algorithm up
 again resets its survival's state; the algorithm runs wrapped by MO-LSP
-and stays deterministic; the factories reject bad ``n_obj``/``pop_size``.
-Algorithm-specific checks (hand-made cases, quality against NSGA-III, DTLZ1
-convergence) stay in each algorithm's own test file.
+and stays deterministic; every factory has the one constructor shape of
+:mod:`moo.algorithms` (keyword-only arguments with defaults, the same error
+types for the same mistakes, ``operators`` and ``advance_after_initial_infill``
+alike), so a new algorithm that breaks the shape fails here. moo's generic core
+imports no robustctl. Algorithm-specific checks (hand-made cases, quality
+against NSGA-III, DTLZ1 convergence) stay in each algorithm's own test file.
 """
 
 from __future__ import annotations
 
+import copy
+import inspect
+import subprocess
+import sys
 from importlib import import_module
 
 import numpy as np
@@ -16,12 +23,12 @@ import pytest
 from pymoo.optimize import minimize
 from pymoo.problems import get_problem
 
-from moo.algorithms import ALGORITHMS
+from moo.algorithms import ALGORITHMS, MIN_POP_SIZE, POP_SIZE, make_algorithm
+from moo.algorithms.operators import PAPER_OPERATORS, OperatorSettings
 from moo.molsp import molsp
 
 NAMES = list(ALGORITHMS)
-#: The paper's eight compared MOEAs (NSGA-II/III are pymoo's, whose factories check nothing).
-CHECKED_FACTORIES = [name for name in NAMES if name not in ("nsga2", "nsga3")]
+DIRECTION_ALGORITHMS = ["nsga3", "theta-dea", "mombi2", "efr-rr", "spea-r"]
 
 
 def _factory(name: str):
@@ -48,7 +55,7 @@ def _same_state(a, b) -> bool:
     if type(a) is not type(b):
         return False
     if isinstance(a, (list, tuple)):
-        return len(a) == len(b) and all(_same_state(x, y) for x, y in zip(a, b))
+        return len(a) == len(b) and all(_same_state(x, y) for x, y in zip(a, b, strict=True))
     if isinstance(a, dict):
         return a.keys() == b.keys() and all(_same_state(a[k], b[k]) for k in a)
     if hasattr(a, "__dict__"):
@@ -82,12 +89,93 @@ def test_runs_wrapped_with_molsp(name):
     np.testing.assert_array_equal(res.pop.get("F"), again.pop.get("F"))
 
 
-@pytest.mark.parametrize("kwargs, word", [
-    ({"n_obj": 1}, "n_obj"),
-    ({"n_obj": 3, "pop_size": 1}, "pop_size"),
-    ({"n_obj": 3, "pop_size": 0}, "pop_size"),
+# ----------------------------------------------------------------------------- one constructor shape
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_factory_signature_is_keyword_only_with_the_shared_defaults(name):
+    params = inspect.signature(_factory(name)).parameters
+    assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in params.values()), params
+    assert params["n_obj"].default is inspect.Parameter.empty
+    assert params["pop_size"].default == POP_SIZE
+    assert params["operators"].default == "paper"
+    assert all(p.default is not inspect.Parameter.empty for k, p in params.items() if k != "n_obj")
+    assert ("ref_dirs" in params) == (name in DIRECTION_ALGORITHMS)
+
+
+@pytest.mark.parametrize("kwargs, error, word", [
+    ({"n_obj": 1}, ValueError, "n_obj must be >= 2"),
+    ({"n_obj": 3.0}, TypeError, "n_obj must be an integer"),
+    ({"n_obj": True}, TypeError, "n_obj must be an integer"),
+    ({"n_obj": "3"}, TypeError, "n_obj must be an integer"),
+    ({"n_obj": 3, "pop_size": MIN_POP_SIZE - 1}, ValueError, f"pop_size must be >= {MIN_POP_SIZE}"),
+    ({"n_obj": 3, "pop_size": 0}, ValueError, "pop_size must be >="),
+    ({"n_obj": 3, "pop_size": 92.0}, TypeError, "pop_size must be an integer"),
+    ({"n_obj": 3, "operators": "defaults"}, ValueError, "operators must be one of 'paper', 'original'"),
+    ({"n_obj": 3, "operators": 1}, TypeError, "operators must be one of"),
+    ({"n_obj": 3, "no_such_option": 1}, TypeError, "no_such_option"),
 ])
-@pytest.mark.parametrize("name", CHECKED_FACTORIES)
-def test_factory_rejects_bad_n_obj_and_pop_size(name, kwargs, word):
-    with pytest.raises(ValueError, match=word):
+@pytest.mark.parametrize("name", NAMES)
+def test_factories_raise_the_same_errors_for_the_same_mistakes(name, kwargs, error, word):
+    with pytest.raises(error, match=word):
         _factory(name)(**kwargs)
+    with pytest.raises(error, match=word):           # the registry entry point says the same
+        make_algorithm(name, **kwargs)
+
+
+@pytest.mark.parametrize("name", DIRECTION_ALGORITHMS)
+def test_direction_factories_take_ref_dirs_of_n_obj_columns(name):
+    W = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1 / 3, 1 / 3, 1 / 3]])
+    alg = _factory(name)(n_obj=3, pop_size=8, ref_dirs=W)
+    np.testing.assert_array_equal(alg.ref_dirs, W)
+    with pytest.raises(ValueError, match="ref_dirs must have 4 columns"):
+        _factory(name)(n_obj=4, ref_dirs=W)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_operators_paper_original_and_explicit_settings(name):
+    module = import_module(ALGORITHMS[name].split(":")[0])
+    original = next(v for k, v in vars(module).items() if k.endswith("ORIGINAL_OPERATORS")
+                    and (k == "ORIGINAL_OPERATORS" or k.startswith(name.replace("-", "").upper())))
+
+    def settings(alg):
+        c, m = alg.mating.crossover, alg.mating.mutation
+        return (c.prob.value, c.eta.value, m.expected_mutations, m.eta.value)
+
+    assert settings(_factory(name)(n_obj=3)) == (1.0, 20.0, 0.5, 20.0) == (
+        PAPER_OPERATORS.crossover_prob, PAPER_OPERATORS.crossover_eta, PAPER_OPERATORS.mutation_rate,
+        PAPER_OPERATORS.mutation_eta)
+    assert settings(_factory(name)(n_obj=3, operators="Original")) == (
+        original.crossover_prob, original.crossover_eta, original.mutation_rate, original.mutation_eta)
+    mine = OperatorSettings(0.8, 15.0, 2.0, 25.0, source="test")
+    assert settings(_factory(name)(n_obj=3, operators=mine)) == (0.8, 15.0, 2.0, 25.0)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_initial_population_passes_through_the_survival(name):
+    # advance_after_initial_infill=True for all ten: the survival ranks the initial population before the
+    # first mating (BiGE alone used to skip it)
+    problem = get_problem("dtlz2", n_obj=3)
+    alg = _factory(name)(n_obj=3, pop_size=20)
+    assert alg.advance_after_initial_infill is True
+    calls = []
+    alg.survival = copy.deepcopy(alg.survival)        # pymoo's NSGA2 shares one default survival object
+    survive = alg.survival.do
+    alg.survival.do = lambda *a, **k: calls.append(len(a[1])) or survive(*a, **k)
+    alg.setup(problem, termination=("n_eval", 40), seed=0)
+    alg.next()                      # evaluates the initial population only
+    assert calls == [20] and alg.evaluator.n_eval == 20
+
+
+# ----------------------------------------------------------------------------- package seams
+
+
+@pytest.mark.parametrize("module", ["moo.molsp", "moo.indicators", "moo.algorithms", "moo.problems"])
+def test_generic_core_does_not_import_robustctl(module):
+    # moo's generic core must not import robustctl (issue 13); moo.problems loads the control problems lazily
+    code = (f"import sys, importlib, {module}\n"
+            "import moo.algorithms as A\n"
+            "[importlib.import_module(v.split(':')[0]) for v in A.ALGORITHMS.values()]\n"
+            "print(sorted(m for m in sys.modules if m == 'robustctl' or m.startswith('robustctl.')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]", out

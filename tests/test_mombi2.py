@@ -54,6 +54,16 @@ def test_asf_by_hand():
     np.testing.assert_allclose(got, expected, rtol=1e-12)
 
 
+def test_asf_zero_weights_with_three_objectives_by_hand():
+    # with more than two objectives a zero weight component stands for 1e-2 (1e-6 with two):
+    # x = (0.2, 0.01, 0.5): w = (1, 0, 0) -> max(0.2, 0.01 / 1e-2, 0.5 / 1e-2) = 50; w = (0.5, 0.5, 0) -> 50;
+    # w = (1/3, 1/3, 1/3) -> 1.5
+    W = np.array([[1.0, 0.0, 0.0], [0.5, 0.5, 0.0], [1 / 3, 1 / 3, 1 / 3]])
+    np.testing.assert_allclose(asf_matrix(np.array([[0.2, 0.01, 0.5]]), W), [[50.0, 50.0, 1.5]], rtol=1e-12)
+    np.testing.assert_allclose(asf_matrix(np.array([[0.2, 0.01, 0.5]]), W, zero=1e-6), [[5e5, 5e5, 1.5]],
+                               rtol=1e-12)
+
+
 def test_r2_ranking_by_hand():
     # w1 order: c(1) b(5e5) d(6e5) a(1e6, norm 1) e(1e6, norm 1.41) -> c1 b2 d3 a4 e5
     # w2 order: b(1) d(1.2) a(2, norm 1, index 0) c(2, norm 1, index 2) e(2) -> b1 d2 a3 c4 e5
@@ -77,8 +87,9 @@ def _r2_ranking_loop(F, W, ideal, nadir):
     Fn = (F - ideal) / (nadir - ideal)
     norms = [float(np.sqrt(sum(v * v for v in row))) for row in Fn]
     rank = [len(F) + 1] * len(F)
-    for w in W:
-        w = [wi if wi > 0 else 1e-6 for wi in w]
+    zero = 1e-6 if W.shape[1] == 2 else 1e-2         # the authors' wzero (EMO framework, utility.c)
+    for w_row in W:
+        w = [wi if wi > 0 else zero for wi in w_row]
         values = [max(row[i] / w[i] for i in range(len(w))) for row in Fn]
         order = sorted(range(len(F)), key=lambda n: (values[n], norms[n], n))
         for pos, n in enumerate(order, start=1):
@@ -111,7 +122,7 @@ def test_update_waits_for_a_full_record():
 
 def test_update_large_variance_sets_all_to_largest_candidate():
     # record of objective 1: 1, 1, 3 -> mean 5/3, variance (2*(2/3)^2 + (4/3)^2)/3 = 24/27 > 0.5
-    nadir, record, marks = update_reference_points(
+    nadir, record, _ = update_reference_points(
         np.ones(2), np.zeros(2), np.array([3.0, 2.0]), np.ones((2, 2)), np.zeros(2, int),
         alpha=0.5, epsilon=1e-3, record_size=3)
     np.testing.assert_array_equal(nadir, [3.0, 3.0])
@@ -155,6 +166,21 @@ def test_update_growth_and_halfway_rules():
     nadir, _, _ = update_reference_points(np.ones(2), np.zeros(2), cand, rec2, np.zeros(2, int),
                                           alpha=0.5, epsilon=1e-3, record_size=3)
     np.testing.assert_allclose(nadir, [1.4, 1.0])
+
+
+def test_update_stagnation_rule_reads_zero_variance_with_tolerance_epsilon():
+    # record of objective 2: 0.9, 0.9004, 0.9 -> variance 3.6e-8 < epsilon = 1e-3: stagnant, unmarked
+    # -> (1 + 0.9004) / 2; objective 1: 1.2, 1.25, 1.2 -> variance 5.6e-4 < 1e-3 as well, but the candidate
+    # 1.2 exceeds the nadir 1, so the growth rule comes first: 1.2 + 0.2
+    rec = np.array([[1.2, 0.9], [1.25, 0.9004]])
+    nadir, _, _ = update_reference_points(np.ones(2), np.zeros(2), np.array([1.2, 0.9]), rec, np.zeros(2, int),
+                                          alpha=0.5, epsilon=1e-3, record_size=3)
+    np.testing.assert_allclose(nadir, [1.4, 0.9502], rtol=1e-12)
+    # 0.85, 0.95, 0.9: a variance of 1.7e-3 > epsilon is not stagnation
+    rec = np.array([[1.0, 0.85], [1.0, 0.95]])
+    nadir, _, _ = update_reference_points(np.ones(2), np.zeros(2), np.array([1.0, 0.9]), rec, np.zeros(2, int),
+                                          alpha=0.5, epsilon=1e-3, record_size=3)
+    assert nadir[1] == 1.0
 
 
 def test_update_does_not_modify_inputs():

@@ -57,7 +57,8 @@ def test_plot_results_writes_every_figure(results, tmp_path):
     paths = plot_results(load_records(results), tmp_path, formats=("png", "pdf"))
     names = {p.name for p in paths}
     for key in ("zdt1", "dtlz2-m3"):
-        for stem in (f"hv_{key}", f"boxplots_{key}", *(f"cd_{key}_{i}" for i in ("igd", "sp", "hv", "pd", "spread"))):
+        cds = (f"cd_{key}_{i}" for i in ("igd", "sp", "hv", "pd", "spread", "igd_plus"))
+        for stem in (f"hv_{key}", f"boxplots_{key}", *cds):
             assert {f"{stem}.png", f"{stem}.pdf"} <= names
     assert "fronts_zdt1.png" in names                                  # one figure for two objectives
     assert "fronts_dtlz2-m3_nsga3.png" in names                         # a scatter matrix per MOEA

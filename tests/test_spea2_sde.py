@@ -58,11 +58,14 @@ def _pop(F, cv=None):
 
 
 def _reference_sd(F):
-    """Shifted distance by the case definition (Li et al. 2014, Sec. III): f_k(q') = f_k(p) if f_k(q) < f_k(p) else f_k(q)."""
+    """Shifted distance by the case definition (Li et al. 2014, Sec. III).
+
+    f_k(q') = f_k(p) if f_k(q) < f_k(p) else f_k(q).
+    """
     n = len(F)
     D = np.full((n, n), np.inf)
     for p, q in itertools.permutations(range(n), 2):
-        shifted = np.array([F[p, k] if F[q, k] < F[p, k] else F[q, k] for k in range(F.shape[1])])
+        shifted = np.array([max(F[q, k], F[p, k]) for k in range(F.shape[1])])
         D[p, q] = cdist(F[p][None], shifted[None])[0, 0]
     return D
 
@@ -143,7 +146,7 @@ def test_fitness_hand_example_raw_objectives():
     #   p2: to p1 (0,1/3), to p3 (0,2/3), to p0 (0,1)              -> sigma = 2/3, D = 3/8
     #   p3: to p1 0, to p0 (0,1/3), to p2 (3/7,0)                  -> sigma = 1/3, D = 3/7
     #   p4: all 0                                                  -> D = 1/2
-    fit_n, raw_n, dens_n = sde_fitness(F)
+    _, raw_n, dens_n = sde_fitness(F)
     np.testing.assert_array_equal(raw_n, raw)
     np.testing.assert_allclose(dens_n, [7 / 18, 3 / 8, 3 / 8, 3 / 7, 0.5], rtol=1e-14)
 
@@ -158,7 +161,7 @@ def test_fitness_matches_per_individual_reference():
         for normalize, G in [(False, F), (True, (F - lo) / (hi - lo))]:
             got = sde_fitness(F, normalize=normalize)
             want = _reference_fitness(F, G)
-            for g, w in zip(got, want):
+            for g, w in zip(got, want, strict=True):
                 np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-15)
 
 
@@ -166,7 +169,7 @@ def test_fitness_below_one_iff_nondominated():
     rng = np.random.default_rng(5)
     F = rng.random((40, 3))
     fit, raw, _ = sde_fitness(F)
-    dominated = np.array([np.any(np.all(F <= f, axis=1) & np.any(F < f, axis=1)) for f in F])
+    dominated = np.array([np.any(np.all(f >= F, axis=1) & np.any(f > F, axis=1)) for f in F])
     np.testing.assert_array_equal(fit < 1.0, ~dominated)
     np.testing.assert_array_equal(raw == 0, ~dominated)
 
@@ -242,6 +245,19 @@ def test_survival_fills_by_fitness_then_truncates():
     np.testing.assert_array_equal(out.get("F"), F[[1]])
     raw = SPEA2SDESurvival(normalize=False).do(problem, _pop(F), n_survive=2, random_state=np.random.default_rng(0))
     np.testing.assert_array_equal(raw.get("F"), F[[0, 1]])
+
+
+def test_normalisation_falls_back_to_the_whole_range_when_the_front_hardly_spans_an_objective():
+    # rows 0, 1 non-dominated with f2 = 2e-300, 1e-300; row 2 = (2, 1) dominated by both (raw fitness 1 + 1).
+    # By the front's f2 range (1e-300) alone row 2 would scale to 1e300 and its squared distances overflow
+    # (a RuntimeWarning, an error under the test settings). A front range below 1e-10 of the whole set's takes
+    # the whole set's (1), so f2 ~ (1e-300, 0, 1) and f1 = (0, 1, 2) / 1. Shifted distances (k = 1): row 0 sees
+    # row 1 at 1 and row 2 at sqrt 5 -> density 1/3; row 1 sees row 0 at 1e-300 -> 1/2; row 2 sees row 0 at 0.
+    F = np.array([[0.0, 2e-300], [1.0, 1e-300], [2.0, 1.0]])
+    fit, raw, density = sde_fitness(F)
+    np.testing.assert_array_equal(raw, [0, 0, 2])
+    np.testing.assert_allclose(density, [1 / 3, 1 / 2, 1 / 2], rtol=1e-12)
+    np.testing.assert_allclose(fit, [1 / 3, 1 / 2, 2.5], rtol=1e-12)
 
 
 def test_normalised_survival_is_invariant_to_objective_scaling():

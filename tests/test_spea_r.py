@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from moocore import is_nondominated
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 from pymoo.indicators.igd import IGD
@@ -20,6 +21,7 @@ from pymoo.problems import get_problem
 from pymoo.util.ref_dirs import get_reference_directions
 
 from moo.algorithms import make_algorithm
+from moo.algorithms._normalize import HyperplaneNormalization, front_bounds
 from moo.algorithms.spea_r import (
     SPEAR,
     NeighbourMatingSelection,
@@ -125,10 +127,10 @@ P1, P2, P3, Q, R, S = range(6)
 def test_environmental_selection_hand_population(n_survive, expected):
     surv = SPEARSurvival(DIRS5)
     out = surv.do(_Dummy(), _pop(HAND), n_survive=n_survive, random_state=np.random.default_rng(0))
-    got = {int(np.flatnonzero(np.all(HAND == f, axis=1))[0]) for f in out.get("F")}
+    got = {int(np.flatnonzero(np.all(f == HAND, axis=1))[0]) for f in out.get("F")}
     assert got == expected
     if n_survive == 6:
-        fit = dict(zip(map(tuple, out.get("F")), out.get("fitness")))
+        fit = dict(zip(map(tuple, out.get("F")), out.get("fitness"), strict=True))
         tb = math.atan(0.5)
         assert fit[tuple(HAND[Q])] == pytest.approx(_density(math.atan2(0.75, 0.25) - math.atan2(1.0, 0.5), tb))
         assert fit[tuple(HAND[R])] == pytest.approx(6.0 + _density(np.pi / 4 - math.atan2(0.6, 0.7), tb))
@@ -255,9 +257,10 @@ def test_runs_wrapped_in_molsp():
 # property test against a brute-force reference (plain Python loops, no code under test)
 # ---------------------------------------------------------------------------------------------
 
-def _brute_spea_r_survivors(F, n_survive, W):
+def _brute_spea_r_survivors(F, n_survive, W, Fn=None):
+    """The paper's selection by loops; angles from ``Fn`` when given, else the front's min/max normalisation."""
     n, M = F.shape
-    dom = [[all(x <= y for x, y in zip(F[i], F[j])) and any(x < y for x, y in zip(F[i], F[j]))
+    dom = [[all(x <= y for x, y in zip(F[i], F[j], strict=True)) and any(x < y for x, y in zip(F[i], F[j], strict=True))
             for j in range(n)] for i in range(n)]
     nd = [i for i in range(n) if not any(dom[j][i] for j in range(n))]
     lo = [min(F[i, m] for i in nd) for m in range(M)]
@@ -265,12 +268,12 @@ def _brute_spea_r_survivors(F, n_survive, W):
     rng = [hi[m] - lo[m] if hi[m] - lo[m] > 1e-10 else max(F[:, m]) - lo[m] for m in range(M)]
     rng = [r if r > 1e-10 else 1.0 for r in rng]
     norm = lambda v: math.sqrt(sum(x * x for x in v))  # noqa: E731
-    cosang = lambda u, v: sum(a * b for a, b in zip(u, v)) / (norm(u) * norm(v))  # noqa: E731
+    cosang = lambda u, v: sum(a * b for a, b in zip(u, v, strict=True)) / (norm(u) * norm(v))  # noqa: E731
     theta_bar = max(min(math.acos(min(1.0, cosang(W[i], W[j]))) for j in range(len(W)) if j != i)
                     for i in range(len(W)))
     niche, angle = [], []
     for i in range(n):
-        fn = [(F[i, m] - lo[m]) / rng[m] for m in range(M)]
+        fn = [(F[i, m] - lo[m]) / rng[m] for m in range(M)] if Fn is None else list(Fn[i])
         if norm(fn) == 0:
             niche.append(0)
             angle.append(0.0)
@@ -306,5 +309,29 @@ def test_survival_matches_brute_force_reference(seed, M, extra):
     n_survive = len(W)
     F = rng.random((n_survive + extra + 1, M)) ** rng.uniform(0.5, 3.0)
     F[:, 0] *= 10.0
-    got = set(SPEARSurvival(W).do(_Dummy(M), _pop(F), n_survive=n_survive, random_state=rng, return_indices=True))
+    got = set(SPEARSurvival(W, normalization="front").do(_Dummy(M), _pop(F), n_survive=n_survive,
+                                                          random_state=rng, return_indices=True))
     assert got == _brute_spea_r_survivors(F, n_survive, W)
+    # the default, hyperplane normalisation: the same rules on the objectives a fresh HyperplaneNormalization maps
+    # (its own checks are in test_theta_dea.py)
+    nd = np.flatnonzero(is_nondominated(F))
+    norm = HyperplaneNormalization(M)
+    norm.update(F, nondominated=nd)
+    got = set(SPEARSurvival(W).do(_Dummy(M), _pop(F), n_survive=n_survive, random_state=rng, return_indices=True))
+    assert got == _brute_spea_r_survivors(F, n_survive, W, Fn=norm.normalize(F))
+
+
+def test_hyperplane_normalisation_ignores_a_dominance_resistant_point():
+    # DTLZ1-like plane sum f = 0.5 (a Das-Dennis grid on it, lifted by 1e-6) plus one dominance-resistant point
+    # (1.0, 1e-9, 1e-9): non-dominated (its f2 = 1e-9 is the smallest), so the min/max of the non-dominated set
+    # ("front", the paper's reading) stretches f1's range to 1.0 and the directions near the f1 axis then see
+    # only such stragglers; the hyperplane through the extreme points keeps the true 0.5
+    W = get_reference_directions("das-dennis", 3, n_partitions=6)
+    F = np.vstack([0.5 * W + 1e-6, [[1.0, 1e-9, 1e-9]]])
+    nd = is_nondominated(F)
+    assert nd.all()
+    z_min, span = front_bounds(F, nd)
+    np.testing.assert_allclose(z_min + span, [1.0, 0.5, 0.5], atol=2e-6)
+    surv = SPEARSurvival(get_reference_directions("das-dennis", 3, n_partitions=4))
+    surv.do(_Dummy(3), _pop(F), n_survive=15, random_state=np.random.default_rng(0))
+    np.testing.assert_allclose(surv.norm.nadir_point, [0.5, 0.5, 0.5], atol=1e-5)

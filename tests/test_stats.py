@@ -133,6 +133,48 @@ def test_run_indicators_hand_computed():
     assert (ra.n_points, rb.n_points, ra.molsp, rb.molsp) == (3, 2, False, True)
 
 
+def test_run_indicators_igd_plus_hand_computed_and_against_pymoo():
+    from pymoo.indicators.igd_plus import IGDPlus
+
+    A = [[0.0, 2.0], [2.0, 0.0], [0.5, 1.0]]
+    B = [[1.0, 1.0], [0.0, 3.0]]
+    recs = [_record(A, 1), _record(B, 2, molsp=True), _record(np.zeros((0, 2)), 3)]
+    ra, rb, empty = run_indicators(recs)           # P* = A, as in the test above
+    # IGD+ of B: to (0,2) min(|(1,0)|, |(0,1)|) = 1; to (2,0) min(|(0,1)|, |(0,3)|) = 1;
+    # to (0.5,1) min(|(0.5,0)|, |(0,2)|) = 0.5 -> 2.5 / 3 (IGD is (1 + sqrt 2 + 0.5) / 3)
+    assert ra.igd_plus == 0.0 and rb.igd_plus == pytest.approx(2.5 / 3.0, rel=1e-12)
+    assert rb.igd_plus == pytest.approx(IGDPlus(np.array(A))(np.array(B)), rel=1e-12)
+    assert math.isnan(empty.igd_plus)
+    # a dominated reference point costs nothing: IGD+ 0 where IGD is not
+    r1, r2 = run_indicators([_record([[0.0, 0.0]], 1), _record([[1.0, 1.0]], 2)], {("toy", 2): np.array([[1.0, 1.0]])})
+    assert (r1.igd_plus, r2.igd_plus) == (0.0, 0.0) and r1.igd == pytest.approx(math.sqrt(2.0))
+    rng = np.random.default_rng(3)
+    F, R = rng.random((15, 3)), rng.random((40, 3))
+    rec = {"problem": "toy", "n_obj": 3, "algorithm": "a", "molsp": False, "seed": 0, "F": F.tolist(),
+           "hv_ref_point": [2.0] * 3}
+    got = run_indicators([rec], {("toy", 3): R})[0].igd_plus
+    assert got == pytest.approx(IGDPlus(R)(F), rel=1e-12)
+
+
+def test_igd_plus_in_the_tables_and_the_papers_five_alone():
+    runs = [_row("alg", False, s, igd_plus=v) for s, v in enumerate([1.0, 2.0, 3.0])] + \
+           [_row("alg", True, s, igd_plus=v) for s, v in enumerate([11.0, 12.0, 13.0])]
+    table = compare(runs)
+    c = {x.indicator: x for x in table}["igd_plus"]
+    assert (c.mean_plain, c.mean_molsp, c.better, c.significant) == (2.0, 12.0, "plain", True)   # lower is better
+    md = to_markdown(table)
+    assert "| MOEA | IGD | SP | HV | PD | Spread | IGD+ |" in md
+    assert "(lower IGD, SP, Spread, IGD+; higher HV, PD)" in md
+    assert "**2.0000E+00 ± 1.00E+00**^a,*" in next(line for line in md.splitlines() if line.startswith("| alg |"))
+    five = [x for x in table if x.indicator != "igd_plus"]
+    md5, tex5 = to_markdown(five), to_latex(five)
+    assert "| MOEA | IGD | SP | HV | PD | Spread |\n|---|---|---|---|---|---|" in md5 and "IGD+" not in md5
+    assert "(lower IGD, SP, Spread; higher HV, PD)" in md5                 # the legend of the paper's five
+    assert r"\begin{tabular}{lccccc}" in tex5 and "IGD+" not in tex5
+    # the other columns do not depend on IGD+ being there
+    assert md5.splitlines()[4] == " | ".join(md.splitlines()[4].split(" | ")[:6]) + " |"
+
+
 def test_run_indicators_small_and_empty_sets():
     recs = [_record([[1.0, 1.0]], 1), _record(np.zeros((0, 2)), 2), _record([[0.0, 2.0], [2.0, 0.0]], 3)]
     one, empty, two = run_indicators(recs)
@@ -372,7 +414,7 @@ def test_ranks_tables_marks_and_legend(tmp_path):
     tex = ranks_to_latex(results)
     assert r"\textbf{" in tex and "$^{n}$" in tex and r"\end{tabular}" in tex
     rows = list(csv.DictReader(io.StringIO(ranks_to_csv(results, tmp_path / "r.csv"))))
-    assert len(rows) == 5 * 6 and (tmp_path / "r.csv").exists()
+    assert len(rows) == len(INDICATORS) * 6 and (tmp_path / "r.csv").exists()
     igd_bad = next(r for r in rows if r["indicator"] == "igd" and r["variant"] == "bad")
     assert igd_bad["worse_than_best"] == "True" and float(igd_bad["mean_rank"]) > 5
 

@@ -421,3 +421,14 @@ def test_issue_12_booleans_in_the_lmi_syntheses_and_the_analysis():
         rc.hinf(m2, **kw, u_max="1")
     with pytest.raises(ValueError, match=r"^u_max must be > 0 for every entry, got \[1.0, -2.0\]"):
         rc.hinf(m2, **kw, u_max=[1.0, -2.0])
+
+
+@pytest.mark.parametrize("mu", [4.49e307, 1.7e308])
+def test_rlqr_mu_near_the_float_limit_is_finite_and_silent(mu):
+    """Hypothesis found an overflow warning in the reported lambda = (1 + alpha) mu ||H'H|| at mu = 4.49e307."""
+    plant = rc.Plant(0.5 * np.eye(2), np.eye(2), 0.1)
+    EF, EG = np.array([[0.3, 0.1]]), np.array([[1.0, 0.5]])
+    c = rc.rlqr(plant, EF, EG, mu, alpha=2.0)
+    ref = rc.rlqr(plant, EF, EG, np.inf, alpha=2.0)
+    assert np.isfinite(c.K).all() and c.info["lambda"] == np.inf
+    np.testing.assert_allclose(c.K, ref.K, rtol=1e-9)

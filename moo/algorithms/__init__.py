@@ -1,17 +1,45 @@
-"""Registry of the MOEAs by name.
+"""Registry of the MOEAs by name, and the one constructor shape they share.
 
 ``make_algorithm(name, n_obj=M)`` builds a configured pymoo algorithm with the
-paper's settings (population 92, SBX pc = 1 / eta 20, polynomial mutation
-pm = 0.5 / eta 20; see :mod:`moo.algorithms.operators`). Each entry points to
-a factory ``factory(*, n_obj, pop_size=92, **options) -> pymoo Algorithm``;
-modules are imported on first use.
+paper's settings; modules are imported on first use.
+
+Constructor shape (every entry of :data:`ALGORITHMS`; checked for each by
+``tests/test_moea_common.py``)::
+
+    factory(*, n_obj, pop_size=POP_SIZE, operators="paper", **options) -> pymoo GeneticAlgorithm
+
+* every argument is keyword-only and has the paper's default, except
+  ``n_obj`` (no default);
+* ``n_obj`` (>= 2) and ``pop_size`` (>= 4, default
+  :data:`~moo.algorithms.operators.POP_SIZE` = 92): ``TypeError`` if not an
+  integer (``bool`` refused), ``ValueError`` if too small; an unknown option
+  is a ``TypeError`` (Python's own);
+* ``operators``: ``"paper"`` (the reproduced study's SBX pc = 1 / eta 20 and
+  polynomial mutation with 0.5 expected mutated variables / eta 20, the same
+  for all ten), ``"original"`` (the algorithm's own paper, the constant
+  ``ORIGINAL_OPERATORS`` of its module, e.g. theta-DEA's SBX eta 30 and
+  pm = 1/n) or an :class:`~moo.algorithms.operators.OperatorSettings`;
+  another string is a ``ValueError``, another type a ``TypeError``;
+* the reference-direction algorithms (nsga3, theta-dea, mombi2, efr-rr,
+  spea-r) also take ``ref_dirs`` (default
+  :func:`~moo.algorithms.operators.reference_directions`: 91 directions for
+  3 objectives, 84 for 4), ``ValueError`` when its columns are not ``n_obj``;
+* options of the algorithm itself (theta-DEA's ``theta``, SPEA/R's
+  ``k_mating``, ...) are documented in its factory;
+* the returned algorithm passes its initial population through its survival
+  before the first mating (``advance_after_initial_infill=True``), so the
+  first mating sees ranked individuals, and its survival resets its state
+  when a run is set up.
 """
 
 from __future__ import annotations
 
 from importlib import import_module
 
-__all__ = ["ALGORITHMS", "make_algorithm"]
+from ._base import MIN_POP_SIZE
+from .operators import POP_SIZE
+
+__all__ = ["ALGORITHMS", "MIN_POP_SIZE", "POP_SIZE", "make_algorithm"]
 
 ALGORITHMS: dict[str, str] = {
     "nsga2": "moo.algorithms.nsga:make_nsga2",
@@ -27,19 +55,17 @@ ALGORITHMS: dict[str, str] = {
 }
 
 
-def make_algorithm(name: str, *, n_obj: int, pop_size: int = 92, **options):
+def make_algorithm(name: str, *, n_obj: int, pop_size: int = POP_SIZE, **options):
     """A pymoo algorithm by registry name, configured with the paper's defaults.
 
-    ``options`` are the factory's keyword arguments (each algorithm's own
-    parameters, documented in its module).
+    ``options`` are the factory's keyword arguments (``operators``, ``ref_dirs``
+    and each algorithm's own parameters, documented in its module); the
+    arguments are checked by the factory (the shape above: ``pop_size`` at
+    least :data:`MIN_POP_SIZE`).
     """
     key = name.lower() if isinstance(name, str) else name
     if key not in ALGORITHMS:
         raise ValueError(f"unknown algorithm {name!r}; valid: {', '.join(ALGORITHMS)}")
-    if not isinstance(n_obj, int) or n_obj < 2:
-        raise ValueError(f"n_obj must be an integer >= 2, got {n_obj!r}")
-    if not isinstance(pop_size, int) or pop_size < 4:
-        raise ValueError(f"pop_size must be an integer >= 4, got {pop_size!r}")
     module, func = ALGORITHMS[key].split(":")
     try:
         factory = getattr(import_module(module), func)

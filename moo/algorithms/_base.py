@@ -8,6 +8,10 @@
   a comparison function.
 - :func:`check_ref_dirs_fit`: reference directions must match the problem's
   number of objectives.
+- :func:`float_column`: a per-individual attribute read from a population,
+  with the entries never set filled in.
+- :func:`factory_arguments`, :func:`factory_ref_dirs`: the checks every
+  registry factory makes (the shape documented in :mod:`moo.algorithms`).
 """
 
 from __future__ import annotations
@@ -20,12 +24,52 @@ from pymoo.core.selection import Selection
 from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.util.display.multi import MultiObjectiveOutput
 
-from .operators import paper_crossover, paper_mutation
+from .._validation import check_choice, check_directions, check_int
+from .operators import (
+    OPERATOR_CHOICES,
+    PAPER_OPERATORS,
+    OperatorSettings,
+    paper_crossover,
+    paper_mutation,
+    reference_directions,
+    variation_operators,
+)
 
 if TYPE_CHECKING:
     from ._normalize import HyperplaneNormalization
 
-__all__ = ["BinaryTournament", "NormalizationForwarding", "check_ref_dirs_fit", "paper_operators"]
+__all__ = ["BinaryTournament", "MIN_POP_SIZE", "NormalizationForwarding", "check_ref_dirs_fit", "factory_arguments",
+           "factory_ref_dirs", "float_column", "paper_operators"]
+
+#: Smallest population a registry factory accepts.
+MIN_POP_SIZE = 4
+
+
+def factory_arguments(n_obj, pop_size, operators, original: OperatorSettings) -> tuple[int, int, dict]:
+    """Check the arguments every registry factory takes.
+
+    Returns ``n_obj`` and ``pop_size`` as ints and the ``crossover`` /
+    ``mutation`` keyword arguments of the chosen ``operators``: ``"paper"``
+    (:data:`~moo.algorithms.operators.PAPER_OPERATORS`), ``"original"``
+    (``original``, the algorithm's own paper) or an
+    :class:`~moo.algorithms.operators.OperatorSettings`. ``TypeError`` for
+    a value of the wrong kind, ``ValueError`` for one out of range.
+    """
+    n_obj = check_int(n_obj, "n_obj", 2)
+    pop_size = check_int(pop_size, "pop_size", MIN_POP_SIZE)
+    if not isinstance(operators, OperatorSettings):
+        operators = PAPER_OPERATORS if check_choice(operators, "operators", OPERATOR_CHOICES) == "paper" else original
+    return n_obj, pop_size, variation_operators(operators)
+
+
+def factory_ref_dirs(ref_dirs, n_obj: int, pop_size: int) -> np.ndarray:
+    """``ref_dirs`` checked against ``n_obj``, or the project's default directions when None."""
+    if ref_dirs is None:
+        return reference_directions(n_obj, pop_size)
+    W = check_directions(ref_dirs)
+    if W.shape[1] != n_obj:
+        raise ValueError(f"ref_dirs must have {n_obj} columns (n_obj), got shape {W.shape}")
+    return W
 
 
 def paper_operators(sampling=None, crossover=None, mutation=None, output=None) -> dict:
@@ -49,6 +93,18 @@ def check_ref_dirs_fit(ref_dirs, problem) -> None:
     """Raise ``ValueError`` unless ``ref_dirs`` has one column per objective of ``problem``."""
     if ref_dirs.shape[1] != problem.n_obj:
         raise ValueError(f"ref_dirs has {ref_dirs.shape[1]} columns but the problem has {problem.n_obj} objectives")
+
+
+def float_column(values, fill: float) -> np.ndarray:
+    """``values`` (``pop.get(name)``, one per individual) as float64 ``(n,)``, ``None`` entries as ``fill``.
+
+    pymoo stores an attribute never set on an individual as ``None`` (an object
+    array); a 2-D attribute such as ``CV`` gives its first column.
+    """
+    arr = np.asarray(values)
+    if arr.dtype == object:
+        arr = np.where(np.equal(arr, np.array(None)), fill, arr)
+    return arr.astype(float).reshape(len(arr), -1)[:, 0]
 
 
 class NormalizationForwarding:

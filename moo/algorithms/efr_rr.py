@@ -69,7 +69,7 @@ Readings where the paper leaves room
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 from pymoo.algorithms.base.genetic import GeneticAlgorithm
@@ -77,16 +77,23 @@ from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.selection.rnd import RandomSelection
 
-from .._validation import as_matrix, check_choice, check_int, check_positive_scalar
+from .._validation import as_matrix, check_choice, check_int, check_real
+from ._base import NormalizationForwarding, factory_arguments, factory_ref_dirs, paper_operators
 from ._normalize import HyperplaneNormalization
-from ._base import NormalizationForwarding, paper_operators
-from .operators import POP_SIZE, reference_directions
+from .operators import POP_SIZE, OperatorSettings
 
-__all__ = ["EFRRR", "EFRRRSurvival", "maximum_ranking", "make_efr_rr"]
+__all__ = ["EFRRR", "EFRRRSurvival", "maximum_ranking", "make_efr_rr", "ORIGINAL_OPERATORS"]
+
+#: EFR-RR's own settings (Yuan et al. 2016, TEVC 20(2), Sec. V, the same as the authors' theta-DEA:
+#: SBX pc = 1, eta_c = 30; polynomial mutation pm = 1/n, eta_m = 20).
+ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=30.0, mutation_rate=1.0, mutation_eta=20.0,
+                                      source="Yuan, Xu, Wang, Zhang & Yao (2016), Sec. V")
 
 _ZERO_WEIGHT = 1e-6
-_SCALARIZINGS = ("tchebycheff", "pbi")
-_MATINGS = ("random", "tournament")
+_Scalarizing = Literal["tchebycheff", "pbi"]
+_Mating = Literal["random", "tournament"]
+_SCALARIZINGS: tuple[_Scalarizing, ...] = get_args(_Scalarizing)
+_MATINGS: tuple[_Mating, ...] = get_args(_Mating)
 
 
 def perpendicular_distances(F: np.ndarray, W: np.ndarray) -> np.ndarray:
@@ -102,7 +109,7 @@ def maximum_ranking(
     ref_dirs: np.ndarray,
     *,
     n_neighbors: int = 2,
-    scalarizing: Literal["tchebycheff", "pbi"] = "tchebycheff",
+    scalarizing: _Scalarizing = "tchebycheff",
     theta: float = 5.0,
 ) -> np.ndarray:
     """Global ranks ``R_g`` of EFR-RR (maximum ranking with ranking restriction).
@@ -152,7 +159,7 @@ def maximum_ranking(
         Wz = np.where(W > 0, W, _ZERO_WEIGHT)
         g = np.max(F[:, None, :] / Wz[None, :, :], axis=2)          # (n, nw)
     else:
-        theta = check_positive_scalar(theta, "theta")
+        theta = check_real(theta, "theta", positive=True)
         d1 = F @ (W / np.linalg.norm(W, axis=1, keepdims=True)).T
         g = d1 + theta * d2
     g = np.where(member, g, np.inf)                                  # restriction
@@ -172,7 +179,7 @@ class EFRRRSurvival(NormalizationForwarding, Survival):
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, n_neighbors: int = 2,
-                 scalarizing: str = "tchebycheff", theta: float = 5.0):
+                 scalarizing: _Scalarizing = "tchebycheff", theta: float = 5.0):
         super().__init__(filter_infeasible=True)
         self.ref_dirs = np.asarray(ref_dirs, dtype=float)
         self.n_neighbors = n_neighbors
@@ -237,7 +244,7 @@ class EFRRR(GeneticAlgorithm):
     """
 
     def __init__(self, ref_dirs: np.ndarray, *, pop_size: int = POP_SIZE, n_neighbors: int = 2,
-                 scalarizing: str = "tchebycheff", theta: float = 5.0, mating: str = "random",
+                 scalarizing: _Scalarizing = "tchebycheff", theta: float = 5.0, mating: _Mating = "random",
                  sampling=None, crossover=None, mutation=None, eliminate_duplicates: bool = True,
                  output=None):
         ref_dirs = as_matrix(ref_dirs, "ref_dirs")
@@ -251,7 +258,7 @@ class EFRRR(GeneticAlgorithm):
             raise ValueError(f"n_neighbors must be <= the number of weight vectors "
                              f"({len(ref_dirs)}), got {n_neighbors}")
         scalarizing = check_choice(scalarizing, "scalarizing", _SCALARIZINGS)
-        theta = check_positive_scalar(theta, "theta")
+        theta = check_real(theta, "theta", positive=True)
         mating = check_choice(mating, "mating", _MATINGS)
         self.ref_dirs = ref_dirs
         self.n_neighbors = n_neighbors
@@ -272,17 +279,19 @@ class EFRRR(GeneticAlgorithm):
         self.survival.reset()
 
 
-def make_efr_rr(*, n_obj: int, pop_size: int = POP_SIZE, n_neighbors: int = 2,
-                scalarizing: Literal["tchebycheff", "pbi"] = "tchebycheff", theta: float = 5.0,
-                mating: Literal["random", "tournament"] = "random") -> EFRRR:
-    """EFR-RR with the paper's settings.
+def make_efr_rr(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+                n_neighbors: int = 2, scalarizing: _Scalarizing = "tchebycheff",
+                theta: float = 5.0, mating: _Mating = "random",
+                ref_dirs: np.ndarray | None = None) -> EFRRR:
+    """EFR-RR with the paper's settings; the shape of every factory (:mod:`moo.algorithms`).
 
-    Weight vectors from :func:`moo.algorithms.operators.reference_directions`
-    (91 for 3 objectives, 84 for 4), SBX and polynomial mutation as configured
-    in the paper, ``K = 2`` nearest weight vectors, normalised modified
-    Tchebycheff fitness, random mating.
+    Weight vectors ``ref_dirs``, by default
+    :func:`moo.algorithms.operators.reference_directions` (91 for 3
+    objectives, 84 for 4), SBX and polynomial mutation as configured in the
+    paper (``operators="original"``: :data:`ORIGINAL_OPERATORS`), ``K = 2``
+    nearest weight vectors, normalised modified Tchebycheff fitness, random
+    mating.
     """
-    n_obj = check_int(n_obj, "n_obj", 2)
-    pop_size = check_int(pop_size, "pop_size", 2)
-    return EFRRR(reference_directions(n_obj, pop_size), pop_size=pop_size, n_neighbors=n_neighbors,
-                 scalarizing=scalarizing, theta=theta, mating=mating)
+    n_obj, pop_size, variation = factory_arguments(n_obj, pop_size, operators, ORIGINAL_OPERATORS)
+    return EFRRR(factory_ref_dirs(ref_dirs, n_obj, pop_size), pop_size=pop_size, n_neighbors=n_neighbors,
+                 scalarizing=scalarizing, theta=theta, mating=mating, **variation)

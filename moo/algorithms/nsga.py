@@ -6,22 +6,39 @@ Deb & Jain (2014), IEEE TEVC 18(4), 577-601 (NSGA-III).
 
 from __future__ import annotations
 
+import numpy as np
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.algorithms.moo.nsga3 import NSGA3
 
-from .operators import POP_SIZE, paper_crossover, paper_mutation, reference_directions
+from ._base import factory_arguments, factory_ref_dirs
+from .operators import POP_SIZE, OperatorSettings
 
-__all__ = ["make_nsga2", "make_nsga3"]
+__all__ = ["make_nsga2", "make_nsga3", "NSGA2_ORIGINAL_OPERATORS", "NSGA3_ORIGINAL_OPERATORS"]
+
+#: NSGA-II's own settings (Deb et al. 2002, Sec. VI: SBX pc = 0.9, eta_c = 20; pm = 1/n, eta_m = 20).
+NSGA2_ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=0.9, crossover_eta=20.0, mutation_rate=1.0,
+                                            mutation_eta=20.0, source="Deb et al. (2002), Sec. VI")
+#: NSGA-III's own settings (Deb & Jain 2014, Table II: SBX pc = 1, eta_c = 30; pm = 1/n, eta_m = 20).
+NSGA3_ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=30.0, mutation_rate=1.0,
+                                            mutation_eta=20.0, source="Deb & Jain (2014), Table II")
 
 
-def make_nsga2(*, n_obj: int, pop_size: int = POP_SIZE) -> NSGA2:
-    """NSGA-II (binary tournament on rank and crowding, rank + crowding survival)."""
-    return NSGA2(pop_size=pop_size, crossover=paper_crossover(), mutation=paper_mutation(),
-                 eliminate_duplicates=True)
+def make_nsga2(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper") -> NSGA2:
+    """NSGA-II (binary tournament on rank and crowding, rank + crowding survival).
+
+    ``operators="original"``: :data:`NSGA2_ORIGINAL_OPERATORS`.
+    """
+    _, pop_size, variation = factory_arguments(n_obj, pop_size, operators, NSGA2_ORIGINAL_OPERATORS)
+    return NSGA2(pop_size=pop_size, eliminate_duplicates=True, **variation)
 
 
-def make_nsga3(*, n_obj: int, pop_size: int = POP_SIZE) -> NSGA3:
-    """NSGA-III with the directions of :func:`reference_directions` (91 for 3 objectives)."""
-    ref_dirs = reference_directions(n_obj, pop_size)
-    return NSGA3(ref_dirs=ref_dirs, pop_size=max(pop_size, len(ref_dirs)),
-                 crossover=paper_crossover(), mutation=paper_mutation(), eliminate_duplicates=True)
+def make_nsga3(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",
+               ref_dirs: np.ndarray | None = None) -> NSGA3:
+    """NSGA-III with ``ref_dirs``, by default :func:`~moo.algorithms.operators.reference_directions` (91 for M = 3).
+
+    The population is ``max(pop_size, len(ref_dirs))``; ``operators="original"``:
+    :data:`NSGA3_ORIGINAL_OPERATORS`.
+    """
+    n_obj, pop_size, variation = factory_arguments(n_obj, pop_size, operators, NSGA3_ORIGINAL_OPERATORS)
+    ref_dirs = factory_ref_dirs(ref_dirs, n_obj, pop_size)
+    return NSGA3(ref_dirs=ref_dirs, pop_size=max(pop_size, len(ref_dirs)), eliminate_duplicates=True, **variation)

@@ -1,4 +1,4 @@
-"""Problems by name: the paper's two control-design MOPs and the ZDT/DTLZ benchmarks.
+"""Problems by name: the paper's two control-design MOPs and the ZDT/DTLZ/WFG benchmarks.
 
 ``make_problem(name, n_obj=None)`` returns a pymoo :class:`~pymoo.core.problem.Problem`
 carrying two reference points:
@@ -21,13 +21,28 @@ forms (:func:`true_front_bounds`). ZDT5 is binary; it is offered as a
 real-coded relaxation (:class:`ZDT5Real`: each variable in [0, 1] stands for
 the bit ``x >= 0.5``) so that the real-coded operators of the registry apply.
 
+WFG1-9 (``n_obj`` objectives, default 3) are pymoo's, with the WFG toolkit's
+usual sizes: ``k = 2 (M - 1)`` position and ``l = 20`` distance variables (``k
+= 4`` for 2 objectives), ``z_i`` in ``[0, 2 i]``. Their true fronts span
+``f_m`` in ``[0, 2 m]`` (Huband et al. 2006, the scaling constants
+``S_m = 2 m``), except the degenerate WFG3, whose front is a line with
+``f_1 <= 2 (1/2)^(M-2)``, ``f_m <= 2 m (1/2)^(M-m)`` for ``1 < m < M`` and
+``f_M <= 2 M``; the reference points follow from these bounds as for DTLZ.
+pymoo's WFG1 lifts every point of its sampled front by about 0.09: its
+polynomial bias ``y^0.02`` turns the rounding residue of an optimal distance
+variable (``1e-17`` instead of 0) into about 0.47, so its optimum as computed
+differs from the closed form; the bounds here are the closed-form ones.
+
 References
 ----------
 E. Zitzler, K. Deb and L. Thiele (2000), "Comparison of multiobjective
 evolutionary algorithms: empirical results", Evol. Comput. 8(2), 173-195;
 K. Deb, L. Thiele, M. Laumanns and E. Zitzler (2005), "Scalable test problems
 for evolutionary multiobjective optimization", in Evolutionary Multiobjective
-Optimization, Springer, 105-145.
+Optimization, Springer, 105-145;
+S. Huband, P. Hingston, L. Barone and L. While (2006), "A review of
+multiobjective test problems and a scalable test problem toolkit", IEEE TEVC
+10(5), 477-506.
 """
 
 from __future__ import annotations
@@ -36,7 +51,7 @@ from importlib import import_module
 
 import numpy as np
 from pymoo.core.problem import Problem
-from pymoo.problems.many import dtlz
+from pymoo.problems.many import dtlz, wfg
 from pymoo.problems.multi import zdt
 from scipy.optimize import minimize_scalar
 
@@ -48,9 +63,11 @@ _ZDT = {f"zdt{i}": getattr(zdt, f"ZDT{i}") for i in range(1, 7)}
 _DTLZ = {f"dtlz{i}": getattr(dtlz, f"DTLZ{i}") for i in range(1, 8)}
 _DTLZ_K = {"dtlz1": 5, "dtlz7": 20}          # others: 10
 _MAX_DTLZ_OBJ = 15
+_WFG = {f"wfg{i}": getattr(wfg, f"WFG{i}") for i in range(1, 10)}
+_WFG_L = 20
 
 #: Every name :func:`make_problem` accepts.
-PROBLEMS: tuple[str, ...] = (*_CONTROL, *_ZDT, *_DTLZ)
+PROBLEMS: tuple[str, ...] = (*_CONTROL, *_ZDT, *_DTLZ, *_WFG)
 
 #: Relative margin of the ZDT/DTLZ reference points beyond the nadir.
 REF_MARGIN = 0.1
@@ -71,7 +88,7 @@ def _dtlz7_hump() -> tuple[float, float]:
 
 
 def true_front_bounds(name: str, n_obj: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Ideal and nadir points of the true Pareto front of a ZDT/DTLZ problem (closed forms).
+    """Ideal and nadir points of the true Pareto front of a ZDT/DTLZ/WFG problem (closed forms).
 
     ZDT1/2/4/5: [0, 0], [1, 1] (ZDT5 normalised as in pymoo); ZDT3: f1 in
     [0, 0.8518], f2 in [-0.7734, 1]; ZDT6: f1 in [0.2808, 1] (the minimum of
@@ -80,8 +97,15 @@ def true_front_bounds(name: str, n_obj: int | None = None) -> tuple[np.ndarray, 
     ``[c^(M-2), c^(M-2), c^(M-3), ..., c, 1]``, ``c = 1/sqrt(2)``; DTLZ7: f_i
     (i < M) in [0, x*], f_M in [2 (M - (M-1) h(x*)), 2M], with x* ~ 0.8594 the
     maximiser of ``h(x) = x/2 (1 + sin 3 pi x)`` on the front's last segment.
+    WFG: 0 and ``2 m`` (WFG3: the line's ends, see the module docstring).
     """
     key = name.lower()
+    if key in _WFG:
+        M = 3 if n_obj is None else n_obj
+        nadir = 2.0 * np.arange(1, M + 1)
+        if key == "wfg3" and M > 2:
+            nadir[:-1] *= 0.5 ** (M - np.maximum(np.arange(1, M), 2))
+        return np.zeros(M), nadir
     if key in _ZDT:
         if key == "zdt3":
             # f2 = 1 - sqrt(f1) - f1 sin(10 pi f1) on the front's last segment [0.8233, 0.8518]
@@ -111,7 +135,7 @@ def true_front_bounds(name: str, n_obj: int | None = None) -> tuple[np.ndarray, 
         nadir = np.full(M, x_star)
         nadir[-1] = 2.0 * M
         return ideal, nadir
-    raise ValueError(f"true_front_bounds knows ZDT and DTLZ problems only, got {name!r}")
+    raise ValueError(f"true_front_bounds knows ZDT, DTLZ and WFG problems only, got {name!r}")
 
 
 def make_problem(name: str, n_obj: int | None = None, *, setup: str | None = None) -> Problem:
@@ -121,10 +145,11 @@ def make_problem(name: str, n_obj: int | None = None, *, setup: str | None = Non
     ----------
     name : str
         One of :data:`PROBLEMS` (case-insensitive): ``generic``, ``applied``,
-        ``zdt1`` ... ``zdt6``, ``dtlz1`` ... ``dtlz7``.
+        ``zdt1`` ... ``zdt6``, ``dtlz1`` ... ``dtlz7``, ``wfg1`` ... ``wfg9``.
     n_obj : int, optional
-        Number of objectives. DTLZ: 2 to 15, default 3. The others have a fixed
-        number (generic 3, applied 4, ZDT 2); giving another one is an error.
+        Number of objectives. DTLZ and WFG: 2 to 15, default 3. The others have
+        a fixed number (generic 3, applied 4, ZDT 2); giving another one is an
+        error.
     setup : str, optional
         ``applied`` only: ``"ours"`` (default) or ``"authors"``
         (:class:`~moo.problems.applied.AppliedRLQRProblem`).
@@ -169,7 +194,11 @@ def make_problem(name: str, n_obj: int | None = None, *, setup: str | None = Non
         M = 3 if n_obj is None else int(n_obj)
         if not 2 <= M <= _MAX_DTLZ_OBJ:
             raise ValueError(f"n_obj must be between 2 and {_MAX_DTLZ_OBJ} for {key}, got {M}")
-        problem = _DTLZ[key](n_var=M + _DTLZ_K.get(key, 10) - 1, n_obj=M)
+        if key in _WFG:
+            k = 4 if M == 2 else 2 * (M - 1)
+            problem = _WFG[key](n_var=k + _WFG_L, n_obj=M, k=k, l=_WFG_L)
+        else:
+            problem = _DTLZ[key](n_var=M + _DTLZ_K.get(key, 10) - 1, n_obj=M)
         ideal, nadir = true_front_bounds(key, M)
     ref = nadir + REF_MARGIN * (nadir - ideal)
     problem.hv_ref_point = ref

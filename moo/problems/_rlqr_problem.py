@@ -33,8 +33,9 @@ from pymoo.core.problem import Problem
 
 import robustctl as rc
 from robustctl.batchsim import BACKENDS
+from robustctl.validation import check_positive_scalar
 
-from .._validation import as_float_array, as_matrix, check_int, check_positive_scalar
+from .._validation import as_float_array, as_matrix, check_int
 
 __all__ = ["RLQRTuningProblem", "penalise"]
 

@@ -48,10 +48,15 @@ class Model:
         return self.mu.shape[0]
 
     def lam(self) -> np.ndarray:
-        """``lambda`` per design (0 without uncertainty, ``inf`` at ``mu = inf``)."""
+        """``lambda`` per design (0 without uncertainty, ``inf`` at ``mu = inf``).
+
+        Reported only (the recursion uses ``lam_inv``, computed from ``1 / mu``):
+        where ``(1 + alpha) mu ||H'H||`` exceeds the float range, ``inf``.
+        """
         if self.h_norm2 == 0.0:
             return np.zeros_like(self.mu)
-        return (1.0 + self.alpha) * self.mu * self.h_norm2
+        with np.errstate(over="ignore"):
+            return (1.0 + self.alpha) * self.mu * self.h_norm2
 
     def select(self, mask: np.ndarray) -> Model:
         """The designs selected by the boolean ``mask`` (or index array)."""
