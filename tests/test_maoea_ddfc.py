@@ -162,6 +162,18 @@ def test_tournament_rule_hand_case():
     assert tournament_winners(F, fc, a, b).tolist() == [0, 0, 3, 3, 2, 1]
 
 
+def test_tournament_treats_fc_below_its_resolution_as_equal():
+    # DTLZ4's x^100 gives boundary points normalised objectives such as 1e-50 or 1e-100, so FC ~ 1e-50 and
+    # ~ 1e-100: both are "on the boundary" and the comparison must not decide (it made the point of a rare
+    # region lose every tournament). Below 1e-6 the first drawn wins, in both orders; above, the smaller FC.
+    F = np.array([[1.0, 1e-100, 0.0], [0.1, 1e-50, 0.9], [0.5, 0.5, 0.5]])   # mutually non-dominated
+    fc = np.array([1e-100, 1e-50, 0.3])
+    a = np.array([0, 1, 1, 2])
+    b = np.array([1, 0, 2, 1])
+    assert tournament_winners(F, fc, a, b).tolist() == [0, 1, 1, 1]
+    assert tournament_winners(F, np.array([0.0, 2e-6, 0.3]), np.array([1]), np.array([0])).tolist() == [0]
+
+
 # ----------------------------------------------------------------------------- survival
 class _Dummy(Problem):
     def __init__(self):

@@ -64,9 +64,19 @@ Readings where the paper leaves room
   depend on the units of the objectives (the paper's control MOPs have
   objectives of very different scales); PlatEMO translates by the ideal point
   only.
-* The roulette probability ``1/FC`` uses ``max(FC, 1e-6)`` so that a solution
-  with ``FC = 0`` gets a large but finite weight; ``"best"`` breaks FC ties by
-  the smaller DD, then by population index.
+* Resolution of FC. The paper compares FC values without saying how close to
+  zero they may be told apart. FC is the smallest normalised objective up to a
+  factor of at most ``M``, so on a problem such as DTLZ4, whose ``x^100`` puts
+  normalised objectives of ``1e-50`` to ``1e-300`` on the boundary of the
+  front, a comparison at full precision ranks boundary points by digits that
+  carry no information. Here FC values below ``1e-6`` compare as equal, in
+  the mating tournament (the first drawn wins, i.e. a random one) as in the
+  environmental selection (the roulette weight ``1/max(FC, 1e-6)`` is finite
+  for ``FC = 0``; ``"best"`` breaks FC ties by the smaller DD, then by
+  population index). PlatEMO's ``CalFC`` floors FC at ``1e-6`` the same way
+  (in raw units; ours are normalised). Measured on DTLZ4 (3 objectives,
+  10000 evaluations, paper operators, seeds 0-29): 13 collapsed runs with
+  the floor in the tournament, 20 without it (see below).
 * A solution exactly at the ideal point (``sum f~ = 0``) is projected to the
   simplex centre ``1/M``.
 * Coincident projections (distance 0) give ``DD = inf``: a duplicated
@@ -78,15 +88,28 @@ Readings where the paper leaves room
 
 Behaviour worth knowing
 -----------------------
-DTLZ4 (3 objectives): most runs lose a region of the front in the first
-generations (9 of 10 under the Deb & Jain budget, 14 of 20 at the paper's
-setting; NSGA-III 0 and 5). DTLZ4's ``x^100`` places nearly all of a random
-population near the axes and edges, where some normalised objective is close
-to 0 and so is FC; in each DD/FC tournament the roulette on ``1/FC`` then all
-but always picks such a point over the rare one from an empty region, and
-polynomial mutation cannot bring the region back (it needs ``x >= 0.97``).
-Computing FC on the translated objectives without normalisation (PlatEMO's
-reading) gave the same count (14 of 20).
+DTLZ4 (3 objectives, population 92) loses a region of the front in part of
+the runs, mostly in the first five generations (13 of 30 at the paper's
+setting of 10000 evaluations, seeds 0-29; pymoo's NSGA-III 6 of the same
+30; 9 of 10 under the Deb & Jain budget of 600 generations, NSGA-III 0).
+``x^100`` leaves a random population about ``92 x 0.03 = 2.8`` points with
+``x_1 > 0.97`` (and as many with ``x_2 > 0.97``), the only ones away from the
+``f_1`` axis; when these few are also poorly converged they are dominated and
+drop out at the front cut, before the DD/FC rule sees them (10 runs, first
+six generations: 173 such points lost beyond the last front, 5 lost and 62
+kept within it). The runs that lose a region are mostly those whose initial
+population holds at most one such point, for NSGA-III as well. Once a region
+is lost the variable that leads to it is driven to 0 (a smaller, if
+meaningless, ``f_i`` of ``1e-300`` dominates ``1e-100``), and polynomial
+mutation cannot bring it back to ``x >= 0.97``.
+
+Before FC got its resolution (see "Readings") 20 of the 30 runs lost a
+region, also with favourable initial populations: the one point of a region
+whose smallest normalised objective was ``1e-50`` lost every mating
+tournament against the axis points' ``1e-100`` and never became a parent
+(seed 10, first 40 generations: the points with ``x_1 > 0.97``, 56
+individual-generations in the population, were picked as parents 0 times;
+with the resolution they are picked 927 times out of 1460).
 """
 
 from __future__ import annotations
@@ -122,6 +145,7 @@ __all__ = [
 ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=1.0, crossover_eta=20.0, mutation_rate=1.0, mutation_eta=20.0,
                                       source="Cheng, Yen & Zhang (2015), Sec. V")
 
+#: Resolution of FC (normalised units): smaller values compare as equal (see "Readings").
 _FC_FLOOR = 1e-6
 _CandidateChoice = Literal["roulette", "best"]
 _CHOICES: tuple[_CandidateChoice, ...] = get_args(_CandidateChoice)
@@ -197,6 +221,7 @@ def select_by_dd_fc(
     fc = np.asarray(fc, dtype=float)
     if fc.shape != (c,):
         raise ValueError(f"fc must have shape ({c},) (one per candidate), got shape {fc.shape}")
+    fc = np.maximum(fc, _FC_FLOOR)                        # below the resolution FC values tie
     n_select = check_int(n_select, "n_select", 0)
     if n_select > c:
         raise ValueError(f"n_select must be <= the number of candidates ({c}), got {n_select}")
@@ -229,7 +254,7 @@ def select_by_dd_fc(
                 win = tour[np.argmin(fc[tour])]           # FC ties: smaller DD, then index
             else:
                 assert random_state is not None           # checked above for "roulette"
-                cum = np.cumsum(1.0 / np.maximum(fc[tour], _FC_FLOOR))
+                cum = np.cumsum(1.0 / fc[tour])
                 pos = np.searchsorted(cum, random_state.random() * cum[-1], side="right")
                 win = tour[min(pos, len(tour) - 1)]
             picked[step] = win
@@ -275,10 +300,12 @@ def tournament_winners(F: np.ndarray, fc: np.ndarray, a: np.ndarray, b: np.ndarr
     """Winners of the binary tournaments ``a[t]`` vs ``b[t]`` (MaOEA-DDFC mating rule).
 
     ``a[t]`` wins if it Pareto-dominates ``b[t]``, or if neither dominates and
-    ``fc[a[t]] <= fc[b[t]]``; otherwise ``b[t]`` wins.
+    ``fc[a[t]] <= fc[b[t]]``; otherwise ``b[t]`` wins. FC values below
+    ``1e-6`` compare as equal (so ``a[t]``, the first drawn, wins between two
+    such solutions; see the module's "Readings").
     """
     F = np.asarray(F, dtype=float)
-    fc = np.asarray(fc, dtype=float)
+    fc = np.maximum(np.asarray(fc, dtype=float), _FC_FLOOR)
     a = np.asarray(a, dtype=np.int64)
     b = np.asarray(b, dtype=np.int64)
     a_better = np.any(F[a] < F[b], axis=1)
