@@ -244,8 +244,10 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
         ``"recursion"`` (default) redoes them with the plain recursion from
         ``P0``, so ``max_iter`` also decides which slowly converging designs
         are flagged ``"not converged"``; ``"newton"`` first refines the doubling
-        result by Newton's method (a few Stein equations; about 20 times
-        cheaper on such designs and closer to the fixed point) and uses the
+        result by Newton's method (a few Stein equations; on the truck's
+        ill-conditioned designs about 2.5 times cheaper than the compiled
+        recursion, 20 times cheaper than the numpy one, and closer to the
+        fixed point) and uses the
         recursion only where that misses the test too. The acceptance test is
         the same; ``"newton"`` also accepts designs whose recursion would need
         more than ``max_iter`` steps.
