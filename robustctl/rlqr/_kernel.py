@@ -24,7 +24,12 @@ Same arithmetic, same rules:
   below :data:`~robustctl.rlqr._steady.DIVERGED` in magnitude, or NaN), after
   at most ``max_iter`` steps.
 
-Compilation: ``cache=True``, ``nogil=True`` (:func:`robustctl._simkernel._jit`).
+Compilation: ``cache=True``, ``nogil=True`` (:func:`robustctl._simkernel._jit`),
+one entry point (:func:`_recursion`; a single step is ``max_iter = 1``), so
+one compilation: about 6 s on a fresh clone (2-core machine at load 3.5;
+slice assignments cost twice that to compile and are written as loops), then
+0.03-0.06 s to load from the cache in each new process once numba is loaded
+(the simulation kernel loads it too).
 """
 
 from __future__ import annotations
@@ -78,6 +83,21 @@ def _lu_solve(A, b):
 
 
 @_jit
+def _fill(A, value):
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            A[i, j] = value
+
+
+@_jit
+def _copy(A, out):
+    """``out[i, j] = A[i, j]`` over ``out``'s shape."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            out[i, j] = A[i, j]
+
+
+@_jit
 def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc):
     """One step ``P -> (Pn, K, L)`` for one design (``li = lambda^-1``); the rest are work arrays.
 
@@ -94,12 +114,12 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
                 M[i, j] = (1.0 if i == j else 0.0) + s
                 Lc[i, j] = P[i, j]
         if not _lu_solve(M, Lc):
-            Lc[:, :] = np.nan
+            _fill(Lc, np.nan)
         for i in range(n):
             for j in range(n):
                 Pt[i, j] = 0.5 * (Lc[i, j] + Lc[j, i])
     else:
-        Pt[:, :] = P
+        _copy(P, Pt)
     for a in range(m):                                  # kkt = [[R + G'Pt G, EG'], [EG, -li I]]
         for j in range(n):                              # sol = -[G'Pt F; EF]
             s = 0.0
@@ -125,15 +145,15 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
         for j in range(n):
             sol[m + r, j] = -EF[r, j]
     if not _lu_solve(kkt, sol):
-        sol[:, :] = np.nan
-    K[:, :] = sol[:m]
+        _fill(sol, np.nan)
+    _copy(sol, K)
     for i in range(n):                                  # Lc = F + G K
         for j in range(n):
             s = 0.0
             for a in range(m):
                 s += G[i, a] * K[a, j]
             Lc[i, j] = F[i, j] + s
-    L[:, :] = Lc
+    _copy(Lc, L)
     if soft:                                            # L = (I + S P)^-1 Lc
         for i in range(n):
             for j in range(n):
@@ -142,7 +162,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
                     s += S[i, t] * P[t, j]
                 M[i, j] = (1.0 if i == j else 0.0) + s
         if not _lu_solve(M, L):
-            L[:, :] = np.nan
+            _fill(L, np.nan)
     # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt
     for i in range(n):
         for a in range(m):
@@ -187,15 +207,6 @@ def _work(n, m, l):
 
 
 @_jit
-def _steps(P, F, G, Q, R, EF, EG, S, lam_inv, soft, Pn, K, L):
-    """:func:`_step` for every design ``b`` of ``P`` (B, n, n) into ``Pn``, ``K``, ``L``."""
-    n, m = G.shape
-    Pt, M, GP, kkt, sol, Lc = _work(n, m, EF.shape[1])
-    for b in range(P.shape[0]):
-        _step(P[b], F, G, Q, R, EF[b], EG[b], S[b], lam_inv[b], soft, Pn[b], K[b], L[b], Pt, M, GP, kkt, sol, Lc)
-
-
-@_jit
 def _healthy(P, bound):
     for i in range(P.shape[0]):
         for j in range(P.shape[1]):
@@ -205,17 +216,21 @@ def _healthy(P, bound):
 
 
 @_jit
-def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, tiny, iterations, active):
-    """The recursion from ``P`` (B, n, n, overwritten with the result) for every design."""
+def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, tiny, K, L, iterations, active):
+    """The recursion from ``P`` (B, n, n, overwritten with the result) for every design.
+
+    ``K``, ``L`` (B, m, n), (B, n, n) receive those of each design's last step (one entry point
+    for the recursion and the single step, ``max_iter = 1``: the kernel is compiled once).
+    """
     n, m = G.shape
     Pt, M, GP, kkt, sol, Lc = _work(n, m, EF.shape[1])
-    Pn, K, L = np.empty((n, n)), np.empty((m, n)), np.empty((n, n))
+    Pn = np.empty((n, n))
     for b in range(P.shape[0]):
         Pb = P[b]
         it, act = 0, True
         while act and it < max_iter:
             it += 1
-            _step(Pb, F, G, Q, R, EF[b], EG[b], S[b], lam_inv[b], soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
+            _step(Pb, F, G, Q, R, EF[b], EG[b], S[b], lam_inv[b], soft, Pn, K[b], L[b], Pt, M, GP, kkt, sol, Lc)
             num, den = 0.0, 0.0
             for i in range(n):
                 for j in range(n):
@@ -223,7 +238,7 @@ def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, ti
                     den += Pn[i, j] * Pn[i, j]
             den = np.sqrt(den)
             change = np.sqrt(num) / (tiny if den < tiny else den)   # NaN stays NaN, as np.maximum
-            Pb[:, :] = Pn
+            _copy(Pn, Pb)
             act = not change < tol and _healthy(Pn, bound)
         iterations[b] = it
         active[b] = act
@@ -234,13 +249,21 @@ def _args(d: Model):
     return tuple(np.array(a, dtype=float, order="C") for a in (d.F, d.G, d.Q, d.R, d.EF, d.EG, d.S, d.lam_inv))
 
 
+def _run(d: Model, P: np.ndarray, tol: float, max_iter: int, diverged: float):
+    """:func:`_recursion` from ``P`` (B, n, n): ``(P, K, L, iterations, active)``."""
+    B, (n, m) = d.size, d.G.shape
+    P = np.array(np.broadcast_to(P, (B, n, n)), dtype=float, order="C")
+    K, L = np.empty((B, m, n)), np.empty((B, n, n))
+    iterations, active = np.zeros(B, dtype=np.int64), np.ones(B, dtype=bool)
+    _recursion(P, *_args(d), bool(d.soft), float(tol), int(max_iter), float(diverged), _TINY, K, L,
+               iterations, active)
+    return P, K, L, iterations, active
+
+
 def kkt_step(P: np.ndarray, d: Model) -> Step:
     """:func:`robustctl.rlqr._step.kkt_step`, compiled: one step for every design of ``d``."""
-    P = np.array(P, dtype=float, order="C")
-    B, (n, m) = P.shape[0], d.G.shape
-    Pn, K, L = np.empty_like(P), np.empty((B, m, n)), np.empty_like(P)
-    _steps(P, *_args(d), bool(d.soft), Pn, K, L)
-    return Step(Pn, K, L)
+    P, K, L, _, _ = _run(d, P, 0.0, 1, np.inf)
+    return Step(P, K, L)
 
 
 def recursion(d: Model, P0: np.ndarray, tol: float, max_iter: int, diverged: float):
@@ -250,8 +273,5 @@ def recursion(d: Model, P0: np.ndarray, tol: float, max_iter: int, diverged: flo
     Returns ``(P, iterations, active)``; ``active`` True where the design was
     still moving after ``max_iter`` steps.
     """
-    B = d.size
-    P = np.array(np.broadcast_to(P0, (B, *np.shape(P0)[-2:])), dtype=float, order="C")
-    iterations, active = np.zeros(B, dtype=np.int64), np.ones(B, dtype=bool)
-    _recursion(P, *_args(d), bool(d.soft), float(tol), int(max_iter), float(diverged), _TINY, iterations, active)
+    P, _, _, iterations, active = _run(d, P0, tol, max_iter, diverged)
     return P, iterations.astype(int), active
