@@ -54,22 +54,16 @@ def _numpy_recursion(d, P0, tol, max_iter, diverged):
     return P, iterations, ~settled        # settled implies healthy, so ~active & healthy(P) == settled
 
 
-@pytest.fixture
-def numpy_path(monkeypatch):
-    """Run steady_state's recursion and its evaluation with the numpy reference (the code before the kernel)."""
-    monkeypatch.setattr(kernel, "recursion", _numpy_recursion)
-    monkeypatch.setattr(kernel, "kkt_step", kkt_step)
-
-
 def _rel(a, b):
     with np.errstate(all="ignore"):
         return np.linalg.norm(a - b, axis=(-2, -1)) / np.linalg.norm(b, axis=(-2, -1))
 
 
-def _generic(z, mu=None, H=np.ones((3, 1))):
+def _generic(z, mu=None):
     plant = rc.Plant(GENERIC_F, GENERIC_G, 1.0)
     mu = 10 ** np.sqrt(z[:, 4]) if mu is None else mu
-    return build(plant, z[:, None, :3], z[:, None, 3:4], mu, Q=None, R=None, H=H, alpha=0.1, batch=True)
+    return build(plant, z[:, None, :3], z[:, None, 3:4], mu, Q=None, R=None, H=np.ones((3, 1)), alpha=0.1,
+                 batch=True)
 
 
 def _random(rng, B, n=4, m=2, l=1, mu_range=(-1, 8), H=True):

@@ -237,7 +237,7 @@ def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, ti
                     num += (Pn[i, j] - Pb[i, j]) ** 2
                     den += Pn[i, j] * Pn[i, j]
             den = np.sqrt(den)
-            change = np.sqrt(num) / (tiny if den < tiny else den)   # NaN stays NaN, as np.maximum
+            change = np.sqrt(num) / (tiny if den < tiny else den)  # noqa: FURB136 (NaN stays NaN, as np.maximum)
             _copy(Pn, Pb)
             act = not change < tol and _healthy(Pn, bound)
         iterations[b] = it
