@@ -5,8 +5,8 @@ compiled loop, what :func:`robustctl.rlqr._step.kkt_step` and
 :func:`robustctl.rlqr._steady.recursion` compute with stacked numpy calls
 (those stay the reference the tests compare with). On the small systems of
 the MOPs (``n = 3``, ``m = l = 1``) numpy's cost is its per-call overhead,
-about 80 us per step whatever the batch; the kernel takes a few microseconds
-for the whole batch.
+about 75 us per step whatever the batch; the kernel takes about 1 us per
+design and step (``benchmarks/bench_rlqr.py``).
 
 Same arithmetic, same rules:
 
