@@ -15,12 +15,11 @@ warm-up that imports cvxpy). BLAS threads are pinned to 1 unless the
 environment says otherwise (on a shared 2-core machine multithreaded BLAS
 makes the Riccati timings erratic).
 
-Last lines: the truck polytope with the steering limit, robust H-infinity
-for a norm-bounded payload model against the polytopic design
-(:func:`robust_vs_polytopic`), and the truck with the weights of the
-authors' code given unscaled against the same channels scaled by hand
-(:func:`units`: the synthesis scales them inside, so both are the same
-problem for the solver).
+Last lines: the truck polytope with the steering limit, and the truck with
+the weights of the authors' code given unscaled against the same channels
+scaled by hand (:func:`units`: the synthesis scales them inside, so both are
+the same problem for the solver). Robust against polytopic H-infinity on the
+truck is in ``bench_analysis.py``.
 
 Usage: python benchmarks/bench_hinf.py [--sizes 4 10 20] [--reps 3] [--seeds 5]
 """
@@ -72,43 +71,6 @@ def truck_case(reps: int):
                                   u_max=STEER_LIMIT, w_energy=1.0), reps)
 
 
-def robust_vs_polytopic(reps: int) -> dict:
-    """Robust H-infinity for a norm-bounded payload model against the polytopic design, on the truck.
-
-    Polytopic: ``vertices`` at 0, 100, 200 and 300 % overload (ZOH plants).
-    Robust: the mid plant ``(P0 + P300) / 2`` with ``[dF dG] = H Delta [EF
-    EG]`` from the SVD of ``(P300 - P0) / 2`` (rank 2: the two dynamic rows),
-    so ``Delta = delta I`` spans the segment between the extreme payloads
-    and every ``||Delta|| <= 1`` is covered. Both without input bound, Bw = G
-    (steering disturbance), z = (rho, theta, alpha). Each design's level is
-    checked on the ZOH plants at 0..300 % (13 points) with linfnorm.
-    """
-    import control
-
-    from robustctl import NormBounded
-    from robustctl.models.truck import truck_plant
-
-    lo, hi = truck_plant(0.0), truck_plant(300.0)
-    vertices = [truck_plant(k) for k in (0.0, 100.0, 200.0, 300.0)]
-    mid = Plant(0.5 * (lo.F + hi.F), 0.5 * (lo.G + hi.G), lo.dt)
-    U, sv, Vt = np.linalg.svd(0.5 * np.hstack([hi.F - lo.F, hi.G - lo.G]))
-    r = int(np.sum(sv > 1e-12 * sv[0]))
-    EFG = np.sqrt(sv[:r])[:, None] * Vt[:r]
-    unc = NormBounded(U[:, :r] * np.sqrt(sv[:r]), EFG[:, :4], EFG[:, 4:])
-    Cz = np.array([[0.0, 0, 1, 0], [0, 0, 0, 1], [0, 0, 0, 0]])
-    Dzu = np.array([[0.0], [0.0], [1.0]])
-    Bw = lo.G
-    poly, t_poly = best_time(lambda: hinf(vertices[0], Bw=Bw, Cz=Cz, Dzu=Dzu, vertices=vertices[1:]), reps)
-    rob, t_rob = best_time(lambda: hinf(mid, Bw=Bw, Cz=Cz, Dzu=Dzu, uncertainty=unc), reps)
-
-    def worst(K):
-        return max(float(control.linfnorm(control.ss(p.F + p.G @ K, Bw, Cz + Dzu @ K, np.zeros((3, 1)), p.dt),
-                                           tol=1e-10)[0]) for p in (truck_plant(k) for k in np.linspace(0, 300, 13)))
-
-    return dict(t_poly=t_poly, t_rob=t_rob, gamma_poly=poly.gamma, gamma_rob=rob.gamma, worst_poly=worst(poly.K),
-                worst_rob=worst(rob.K), rank=r)
-
-
 def units(reps: int) -> dict:
     """The truck with ``Q = diag(1, 1, 25000, 100)``, ``R = 33535``, ``Bw = ones``: unscaled vs ``z / sqrt(r)``."""
     from robustctl.models.truck import authors_weights, truck_plant
@@ -155,11 +117,6 @@ def main(argv=None) -> None:
     ctrl, t_truck = truck_case(args.reps)
     print(f"truck (n=4, m=1, 4 payload vertices, |alpha| <= 0.45 rad): {t_truck:.3f} s, "
           f"gamma = {ctrl.gamma:.6g}, guaranteed max |alpha| = {ctrl.info['u_bound'][0]:.4f} rad")
-    rb = robust_vs_polytopic(args.reps)
-    print(f"truck, robust (norm-bounded payload, rank {rb['rank']}) vs polytopic (4 vertices), no input bound: "
-          f"time {rb['t_rob']:.3f} s vs {rb['t_poly']:.3f} s (ratio {rb['t_rob'] / rb['t_poly']:.2f}); "
-          f"gamma {rb['gamma_rob']:.5g} vs {rb['gamma_poly']:.5g}; worst linfnorm on 0..300 % "
-          f"{rb['worst_rob']:.5g} vs {rb['worst_poly']:.5g}")
     un = units(args.reps)
     print(f"truck, authors' weights (R = 33535, Bw = ones), unscaled vs z / sqrt(r) by hand: time {un['t_raw']:.3f} s "
           f"vs {un['t_hand']:.3f} s (ratio {un['t_raw'] / un['t_hand']:.2f}); gamma_opt {un['gamma_raw']:.10g} vs "

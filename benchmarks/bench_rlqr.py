@@ -14,12 +14,24 @@ calls on the same plant. Three batches:
 * ``92``: one population (92 designs) and one design per call, for the fixed
   cost of a call.
 
+Then the plain recursion alone (``robustctl.rlqr._steady.recursion``, the
+fallback of designs the doubling leaves unsettled), the compiled kernel
+(``robustctl.rlqr._kernel``, what ``rlqr_gains`` runs) against the numpy
+reference in the same process, best of ``--repeat`` interleaved:
+
+* the generic MOP's fallback designs (``z`` uniform in its search space,
+  those on which the doubling misses the acceptance test; ``max_iter=50``)
+  in calls of 2 designs (a generic NSGA-II run makes about 65 such calls of
+  1-2 designs) and all in one call;
+* the ``ill`` truck designs above, ``max_iter=2000``.
+
     python benchmarks/bench_rlqr.py [--repeat 5]
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import time
 
 import control
@@ -27,6 +39,11 @@ import numpy as np
 
 import robustctl as rc
 from robustctl.models.truck import lqr_weights, truck_plant
+from robustctl.rlqr._model import build
+from robustctl.rlqr._step import kkt_step
+
+steady = importlib.import_module("robustctl.rlqr._steady")   # robustctl.rlqr is also a function's name
+kernel = importlib.import_module("robustctl.rlqr._kernel")
 
 
 def best_of(fn, repeat: int) -> float:
@@ -80,6 +97,51 @@ def main() -> None:
     t1, r1 = run("one design per call", EF[:1], EG[:1], mu[:1])
     print(f"  per call: 92 designs {t92 * 92e3:.3f} ms, 1 design {t1 * 1e3:.3f} ms "
           f"(fixed cost ~ {r1:.1f} dlqr calls)")
+    recursion_rows(args.repeat, build(plant, *ill, Q=Q, R=R, H=H, alpha=0.1, batch=True), Q)
+
+
+def generic_fallback_designs(count: int):
+    """The generic MOP's designs on which the doubling misses the acceptance test (its model, weights)."""
+    from moo.problems.generic import GenericRLQRProblem
+
+    p = GenericRLQRProblem()
+    EF, EG, mu = p.decode(np.random.default_rng(1).uniform(p.xl, p.xu, (count, p.n_var)))
+    d = build(p.plant, EF, EG, mu, Q=p.Q, R=p.R, H=p.H, alpha=p.alpha, batch=True)
+    with np.errstate(all="ignore"):
+        X, _, settled = steady.doubling(d, steady.DOUBLING_TOL)
+        ev = steady.evaluate(X, d, kkt_step)
+    return d.select(settled & steady.healthy(ev.P) & ~ev.accepted(steady.DEFAULT_TOL)), p.max_iter
+
+
+def recursion_rows(repeat: int, ill, Q_ill) -> None:
+    """The plain recursion: compiled kernel against the numpy reference, interleaved in one process."""
+    tol = steady.DEFAULT_TOL
+    d, max_iter = generic_fallback_designs(3000)
+    pairs = [d.select(np.arange(i, i + 2)) for i in range(0, d.size - 1, 2)]
+    cases = [(f"generic fallback, calls of 2 designs ({len(pairs)} calls)", pairs, np.eye(3), max_iter),
+             (f"generic fallback, {d.size} designs in one call", [d], np.eye(3), max_iter),
+             (f"truck ill, {ill.size} designs in one call", [ill], Q_ill, 2000)]
+    print(f"plain recursion (tol {tol:g}): compiled kernel vs numpy reference, best of {repeat}")
+    for label, batches, P0, cap in cases:
+        def compiled(batches=batches, P0=P0, cap=cap):
+            for b in batches:
+                kernel.recursion(b, P0, tol, cap, steady.DIVERGED)
+
+        def numpy(batches=batches, P0=P0, cap=cap):
+            with np.errstate(all="ignore"):
+                for b in batches:
+                    steady.recursion(b, kkt_step, P0, tol, cap)
+
+        compiled()                                                 # loads (or compiles) the kernel
+        t_c, t_n = [], []
+        for _ in range(repeat):
+            t_c.append(best_of(compiled, 1))
+            t_n.append(best_of(numpy, 1))
+        c, n = min(t_c) / len(batches), min(t_n) / len(batches)
+        steps = sum(int(kernel.recursion(b, P0, tol, cap, steady.DIVERGED)[1].sum()) for b in batches)
+        print(f"  {label:52s} kernel {c * 1e6:9.1f} us/call  numpy {n * 1e6:9.1f} us/call  ratio {c / n:6.4f} "
+              f"({steps} design-steps: kernel {c * len(batches) / steps * 1e6:.2f} us, "
+              f"numpy {n * len(batches) / steps * 1e6:.2f} us per design-step)")
 
 
 if __name__ == "__main__":

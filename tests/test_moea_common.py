@@ -170,7 +170,8 @@ def test_initial_population_passes_through_the_survival(name):
 # ----------------------------------------------------------------------------- package seams
 
 
-@pytest.mark.parametrize("module", ["moo.molsp", "moo.indicators", "moo.algorithms", "moo.problems"])
+@pytest.mark.parametrize("module", ["moo.molsp", "moo.indicators", "moo.algorithms", "moo.problems", "moo.runner",
+                                    "moo.experiment", "moo.stats", "moo.store", "moo.executors", "moo.plots"])
 def test_generic_core_does_not_import_robustctl(module):
     # moo's generic core must not import robustctl (issue 13); moo.problems loads the control problems lazily
     code = (f"import sys, importlib, {module}\n"

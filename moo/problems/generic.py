@@ -101,7 +101,7 @@ class GenericRLQRProblem(RLQRTuningProblem):
         design the doubling leaves unsettled (default 50, against the
         library's 10000); a design not converged by then counts as not
         computable (``2 * penalty``). Slowly converging designs cost up to
-        seconds per batch (MO-LSP's mutants produce many) and are worthless
+        10000 recursion steps each (MO-LSP's mutants produce many) and are worthless
         here: of 12000 sampled designs (uniform, and around the slow region
         MO-LSP's mutants reach), the 6844 stable ones all converged within 10
         steps, none of the 521 that needed more than 300 steps was stable on

@@ -121,6 +121,22 @@ def recursion(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter
     return P, iterations, ~active & healthy(P)
 
 
+def plain(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter: int):
+    """:func:`recursion` and the :func:`evaluate` of its result: ``(iterations, settled, Evaluation)``.
+
+    With :func:`~robustctl.rlqr._step.kkt_step` both run in the compiled kernel
+    (:mod:`robustctl.rlqr._kernel`, the same step and stopping rule; the numpy
+    :func:`recursion` is the reference its tests compare with). The kernel is
+    imported here, so that numba is loaded only when a recursion runs.
+    """
+    if step is kkt_step:
+        from . import _kernel
+        X, iterations, active = _kernel.recursion(d, P0, tol, max_iter, DIVERGED)
+        return iterations, ~active & healthy(X), evaluate(X, d, _kernel.kkt_step)
+    X, iterations, settled = recursion(d, step, P0, tol, max_iter)
+    return iterations, settled, evaluate(X, d, step)
+
+
 def doubling(d: Model, tol: float):
     """Stabilising solution of the steady-state RLQR Riccati equation by doubling.
 
@@ -229,9 +245,9 @@ def steady_state(d: Model, P0: np.ndarray, tol: float, max_iter: int, *, acceler
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         if accelerate:
             X, iterations, settled = doubling(d, min(DOUBLING_RATIO * tol, DOUBLING_TOL))
+            ev = evaluate(X, d, step)
         else:
-            X, iterations, settled = recursion(d, step, P0, tol, max_iter)
-        ev = evaluate(X, d, step)
+            iterations, settled, ev = plain(d, step, P0, tol, max_iter)
 
         def missed():
             return np.flatnonzero(settled & healthy(ev.P) & ~ev.accepted(tol))
@@ -241,8 +257,8 @@ def steady_state(d: Model, P0: np.ndarray, tol: float, max_iter: int, *, acceler
             ev.put(sub, refined)
             iterations[sub] += evaluations
         if accelerate and (sub := missed()).size:
-            X, steps, settled[sub] = recursion(d.select(sub), step, P0, tol, max_iter)
-            ev.put(sub, evaluate(X, d.select(sub), step))
+            steps, settled[sub], redone = plain(d.select(sub), step, P0, tol, max_iter)
+            ev.put(sub, redone)
             iterations[sub] += steps
     diverged = ~healthy(ev.P) | ~np.isfinite(ev.K).all(axis=(1, 2))
     reason = np.full(d.size, "ok", dtype="<U13")

@@ -1,0 +1,277 @@
+"""Compiled (numba) kernels of the RLQR step and of the plain recursion.
+
+:func:`kkt_step` and :func:`recursion` compute, design by design in one
+compiled loop, what :func:`robustctl.rlqr._step.kkt_step` and
+:func:`robustctl.rlqr._steady.recursion` compute with stacked numpy calls
+(those stay the reference the tests compare with). On the small systems of
+the MOPs (``n = 3``, ``m = l = 1``) numpy's cost is its per-call overhead,
+about 75 us per step whatever the batch; the kernel takes about 1 us per
+design and step (``benchmarks/bench_rlqr.py``).
+
+Same arithmetic, same rules:
+
+* the step is the penalty/KKT form of the package docstring, with the same
+  operations in the same order (``Pt = sym((I + P S)^-1 P)`` only when the
+  batch is ``soft``, the KKT solve, ``L = (I + S P)^-1 Lc``,
+  ``P = sym(Q + K'RK + lambda^-1 nu'nu + Lc' Pt Lc)``); only the rounding of
+  the sums and the solves differs from numpy/LAPACK (a few ulps per step);
+* the solves are LU with partial pivoting (as LAPACK's ``getrf``: the first
+  largest pivot, multipliers scaled by the pivot's reciprocal); an exactly
+  zero pivot is a singular system and gives NaN for that solve's result of
+  that design only, as :func:`robustctl.rlqr._step.solve` does;
+* the recursion stops a design when one step changes ``P`` by less than
+  ``tol`` (relative Frobenius norm) or ``P`` is not healthy (an entry not
+  below :data:`~robustctl.rlqr._steady.DIVERGED` in magnitude, or NaN), after
+  at most ``max_iter`` steps.
+
+Compilation: ``cache=True``, ``nogil=True`` (:func:`robustctl._simkernel._jit`),
+one entry point (:func:`_recursion`; a single step is ``max_iter = 1``), so
+one compilation: about 6 s on a fresh clone (2-core machine at load 3.5;
+slice assignments cost twice that to compile and are written as loops), then
+0.03-0.06 s to load from the cache in each new process once numba is loaded
+(the simulation kernel loads it too).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._simkernel import _jit
+from ._model import Model
+from ._step import Step
+
+__all__ = ["kkt_step", "recursion"]
+
+_TINY = np.finfo(float).tiny
+
+
+@_jit
+def _lu_solve(A, b):
+    """Solve ``A x = b`` in place (``A`` (k, k) becomes its LU factors, ``b`` (k, c) the solution).
+
+    Partial pivoting; returns False (and leaves ``b`` unspecified) when a pivot is exactly zero.
+    """
+    k, c = b.shape
+    for j in range(k):
+        p, big = j, abs(A[j, j])
+        for i in range(j + 1, k):
+            if abs(A[i, j]) > big:
+                p, big = i, abs(A[i, j])
+        if A[p, j] == 0.0:
+            return False
+        if p != j:
+            for q in range(k):
+                A[j, q], A[p, q] = A[p, q], A[j, q]
+            for q in range(c):
+                b[j, q], b[p, q] = b[p, q], b[j, q]
+        r = 1.0 / A[j, j]
+        for i in range(j + 1, k):
+            f = A[i, j] * r
+            A[i, j] = f
+            for q in range(j + 1, k):
+                A[i, q] -= f * A[j, q]
+            for q in range(c):
+                b[i, q] -= f * b[j, q]
+    for j in range(k - 1, -1, -1):
+        r = 1.0 / A[j, j]
+        for q in range(c):
+            s = b[j, q]
+            for t in range(j + 1, k):
+                s -= A[j, t] * b[t, q]
+            b[j, q] = s * r
+    return True
+
+
+@_jit
+def _fill(A, value):
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            A[i, j] = value
+
+
+@_jit
+def _copy(A, out):
+    """``out[i, j] = A[i, j]`` over ``out``'s shape."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            out[i, j] = A[i, j]
+
+
+@_jit
+def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc):
+    """One step ``P -> (Pn, K, L)`` for one design (``li = lambda^-1``); the rest are work arrays.
+
+    ``Pt``, ``Lc`` (n, n), ``M`` (n, max(n, m)), ``GP`` (m, n), ``kkt`` (m + l, m + l), ``sol`` (m + l, n).
+    """
+    n, m = G.shape
+    l = EF.shape[0]
+    if soft:                                            # Pt = sym((I + P S)^-1 P)
+        for i in range(n):
+            for j in range(n):
+                s = 0.0
+                for t in range(n):
+                    s += P[i, t] * S[t, j]
+                M[i, j] = (1.0 if i == j else 0.0) + s
+                Lc[i, j] = P[i, j]
+        if not _lu_solve(M, Lc):
+            _fill(Lc, np.nan)
+        for i in range(n):
+            for j in range(n):
+                Pt[i, j] = 0.5 * (Lc[i, j] + Lc[j, i])
+    else:
+        _copy(P, Pt)
+    for a in range(m):                                  # kkt = [[R + G'Pt G, EG'], [EG, -li I]]
+        for j in range(n):                              # sol = -[G'Pt F; EF]
+            s = 0.0
+            for i in range(n):
+                s += G[i, a] * Pt[i, j]
+            GP[a, j] = s
+        for c in range(m):
+            s = 0.0
+            for j in range(n):
+                s += GP[a, j] * G[j, c]
+            kkt[a, c] = R[a, c] + s
+        for r in range(l):
+            kkt[a, m + r] = EG[r, a]
+            kkt[m + r, a] = EG[r, a]
+        for j in range(n):
+            s = 0.0
+            for i in range(n):
+                s += GP[a, i] * F[i, j]
+            sol[a, j] = -s
+    for r in range(l):
+        for q in range(l):
+            kkt[m + r, m + q] = -li * (1.0 if r == q else 0.0)
+        for j in range(n):
+            sol[m + r, j] = -EF[r, j]
+    if not _lu_solve(kkt, sol):
+        _fill(sol, np.nan)
+    _copy(sol, K)
+    for i in range(n):                                  # Lc = F + G K
+        for j in range(n):
+            s = 0.0
+            for a in range(m):
+                s += G[i, a] * K[a, j]
+            Lc[i, j] = F[i, j] + s
+    _copy(Lc, L)
+    if soft:                                            # L = (I + S P)^-1 Lc
+        for i in range(n):
+            for j in range(n):
+                s = 0.0
+                for t in range(n):
+                    s += S[i, t] * P[t, j]
+                M[i, j] = (1.0 if i == j else 0.0) + s
+        if not _lu_solve(M, L):
+            _fill(L, np.nan)
+    # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt
+    for i in range(n):
+        for a in range(m):
+            s = 0.0
+            for c in range(m):
+                s += K[c, i] * R[c, a]
+            M[i, a] = s
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for a in range(m):
+                s += M[i, a] * K[a, j]
+            v = 0.0
+            for r in range(l):
+                v += sol[m + r, i] * sol[m + r, j]
+            Pn[i, j] = (Q[i, j] + s) + li * v
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for t in range(n):
+                s += Lc[t, i] * Pt[t, j]
+            M[i, j] = s
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for t in range(n):
+                s += M[i, t] * Lc[t, j]
+            Pn[i, j] += s
+    for i in range(n):
+        for j in range(i + 1, n):
+            v = 0.5 * (Pn[i, j] + Pn[j, i])
+            Pn[i, j] = v
+            Pn[j, i] = v
+        Pn[i, i] = 0.5 * (Pn[i, i] + Pn[i, i])
+
+
+@_jit
+def _work(n, m, l):
+    """Work arrays of :func:`_step`: ``Pt, M, GP, kkt, sol, Lc``."""
+    return (np.empty((n, n)), np.empty((n, max(n, m))), np.empty((m, n)), np.empty((m + l, m + l)),
+            np.empty((m + l, n)), np.empty((n, n)))
+
+
+@_jit
+def _healthy(P, bound):
+    for i in range(P.shape[0]):
+        for j in range(P.shape[1]):
+            if not abs(P[i, j]) < bound:
+                return False
+    return True
+
+
+@_jit
+def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, tiny, K, L, iterations, active):
+    """The recursion from ``P`` (B, n, n, overwritten with the result) for every design.
+
+    ``K``, ``L`` (B, m, n), (B, n, n) receive those of each design's last step (one entry point
+    for the recursion and the single step, ``max_iter = 1``: the kernel is compiled once).
+    """
+    n, m = G.shape
+    Pt, M, GP, kkt, sol, Lc = _work(n, m, EF.shape[1])
+    Pn = np.empty((n, n))
+    for b in range(P.shape[0]):
+        Pb = P[b]
+        it, act = 0, True
+        while act and it < max_iter:
+            it += 1
+            _step(Pb, F, G, Q, R, EF[b], EG[b], S[b], lam_inv[b], soft, Pn, K[b], L[b], Pt, M, GP, kkt, sol, Lc)
+            num, den = 0.0, 0.0
+            for i in range(n):
+                for j in range(n):
+                    num += (Pn[i, j] - Pb[i, j]) ** 2
+                    den += Pn[i, j] * Pn[i, j]
+            den = np.sqrt(den)
+            change = np.sqrt(num) / (tiny if den < tiny else den)  # noqa: FURB136 (NaN stays NaN, as np.maximum)
+            _copy(Pn, Pb)
+            act = not change < tol and _healthy(Pn, bound)
+        iterations[b] = it
+        active[b] = act
+
+
+def _args(d: Model):
+    """The model's arrays as C-contiguous, writable float64 arrays (one compiled signature)."""
+    return tuple(np.array(a, dtype=float, order="C") for a in (d.F, d.G, d.Q, d.R, d.EF, d.EG, d.S, d.lam_inv))
+
+
+def _run(d: Model, P: np.ndarray, tol: float, max_iter: int, diverged: float):
+    """:func:`_recursion` from ``P`` (B, n, n): ``(P, K, L, iterations, active)``."""
+    B, (n, m) = d.size, d.G.shape
+    P = np.array(np.broadcast_to(P, (B, n, n)), dtype=float, order="C")
+    K, L = np.empty((B, m, n)), np.empty((B, n, n))
+    iterations, active = np.zeros(B, dtype=np.int64), np.ones(B, dtype=bool)
+    _recursion(P, *_args(d), bool(d.soft), float(tol), int(max_iter), float(diverged), _TINY, K, L,
+               iterations, active)
+    return P, K, L, iterations, active
+
+
+def kkt_step(P: np.ndarray, d: Model) -> Step:
+    """:func:`robustctl.rlqr._step.kkt_step`, compiled: one step for every design of ``d``."""
+    P, K, L, _, _ = _run(d, P, 0.0, 1, np.inf)
+    return Step(P, K, L)
+
+
+def recursion(d: Model, P0: np.ndarray, tol: float, max_iter: int, diverged: float):
+    """The plain recursion with :func:`kkt_step` from ``P0`` for every design of ``d``.
+
+    ``diverged``: ``P`` is not healthy once an entry reaches it in magnitude.
+    Returns ``(P, iterations, active)``; ``active`` True where the design was
+    still moving after ``max_iter`` steps.
+    """
+    P, _, _, iterations, active = _run(d, P0, tol, max_iter, diverged)
+    return P, iterations.astype(int), active
