@@ -34,13 +34,14 @@ Readings (see PAPER_NOTES.md):
   collapsed runs, 8 of MOEA/IGD-NS's 11, 7 of SPEA2+SDE's 10 and 8 of BiGE's
   11 (bounded SBX; the other 16 seeds: 1, 3, 3, 3). With such rates an
   independent implementation's 0 collapses in 5 runs is no contradiction
-  (probability 0.1-0.4 per algorithm, and its algorithms share the seeds'
-  initial populations too). Clipping turns a child of such a point that
+  (probability 0.1-0.4 per algorithm at the rates below, and its algorithms
+  share the seeds' initial populations too). Clipping turns a child of such a point that
   overshoots the bound into an exact corner (``x = 1``: the other objectives
   are ``6e-17 (1 + g)``), which is non-dominated and holds the region; the
   bound-aware form never reaches the bound. Collapsed runs out of 30 (seeds
   0-29, 10000 evaluations, paper operators), bounded / clipped: NSGA-III 6 /
-  5, MOEA/IGD-NS 11 / 7, MaOEA-DDFC 13 / 10, SPEA2+SDE 10 / 12, BiGE 11 / 6.
+  5, MOEA/IGD-NS 11 / 7, MaOEA-DDFC 13 / 10, SPEA2+SDE 10 / 12, BiGE 11 / 6;
+  with PlatEMO's own defaults (clipped SBX, ``pm = 1/n``) 6, 7, 9, 9 and 5.
   Given 600 generations (Deb & Jain's budget) NSGA-III regains a lost region
   (0 of 10 runs collapsed); MOEA/IGD-NS, MaOEA-DDFC and SPEA2+SDE do not.
 * Reference directions: Das & Dennis with 12 divisions for 3 objectives
