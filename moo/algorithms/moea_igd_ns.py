@@ -70,8 +70,8 @@ Behaviour worth knowing
   paper's setting (seeds 0-29; pymoo's NSGA-III 6), 8 of 10 under the Deb &
   Jain budget (NSGA-III 0). The shared cause, measured, is in
   :mod:`moo.algorithms.operators` (DTLZ4's few points off the axis are
-  dominated in the first generations; the seeds that start with at most one
-  of them fail). Most of these points are lost at the front cut (10 runs,
+  dominated in the first generations; most collapsed runs start with at
+  most one of them). Most of these points are lost at the front cut (10 runs,
   first six generations: 160 beyond the last front); of the 93 that reach the
   last front IGD-NS deletes 37, as its rule deletes first the
   non-contributing solution farthest from the archive (the second term of
