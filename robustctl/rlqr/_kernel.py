@@ -1,8 +1,8 @@
 """Compiled (numba) kernels of the RLQR step and of the plain recursion.
 
 :func:`kkt_step` and :func:`recursion` compute, design by design in one
-compiled loop, what :func:`robustctl.rlqr._step.kkt_step` and
-:func:`robustctl.rlqr._steady.recursion` compute with stacked numpy calls
+compiled loop, what ``robustctl.rlqr._step.kkt_step`` and
+``robustctl.rlqr._steady.recursion`` compute with stacked numpy calls
 (those stay the reference the tests compare with). On the small systems of
 the MOPs (``n = 3``, ``m = l = 1``) numpy's cost is its per-call overhead,
 about 75 us per step whatever the batch; the kernel takes about 1 us per
@@ -18,14 +18,14 @@ Same arithmetic, same rules:
 * the solves are LU with partial pivoting (as LAPACK's ``getrf``: the first
   largest pivot, multipliers scaled by the pivot's reciprocal); an exactly
   zero pivot is a singular system and gives NaN for that solve's result of
-  that design only, as :func:`robustctl.rlqr._step.solve` does;
+  that design only, as ``robustctl.rlqr._step.solve`` does;
 * the recursion stops a design when one step changes ``P`` by less than
   ``tol`` (relative Frobenius norm) or ``P`` is not healthy (an entry not
-  below :data:`~robustctl.rlqr._steady.DIVERGED` in magnitude, or NaN), after
+  below ``robustctl.rlqr._steady.DIVERGED`` in magnitude, or NaN), after
   at most ``max_iter`` steps.
 
-Compilation: ``cache=True``, ``nogil=True`` (:func:`robustctl._simkernel._jit`),
-one entry point (:func:`_recursion`; a single step is ``max_iter = 1``), so
+Compilation: ``cache=True``, ``nogil=True`` (``robustctl._simkernel._jit``),
+one entry point (``_recursion``; a single step is ``max_iter = 1``), so
 one compilation: about 6 s on a fresh clone (2-core machine at load 3.5;
 slice assignments cost twice that to compile and are written as loops), then
 0.03-0.06 s to load from the cache in each new process once numba is loaded
@@ -201,7 +201,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
 
 @_jit
 def _work(n, m, l):
-    """Work arrays of :func:`_step`: ``Pt, M, GP, kkt, sol, Lc``."""
+    """Work arrays of ``_step``: ``Pt, M, GP, kkt, sol, Lc``."""
     return (np.empty((n, n)), np.empty((n, max(n, m))), np.empty((m, n)), np.empty((m + l, m + l)),
             np.empty((m + l, n)), np.empty((n, n)))
 
@@ -250,7 +250,7 @@ def _args(d: Model):
 
 
 def _run(d: Model, P: np.ndarray, tol: float, max_iter: int, diverged: float):
-    """:func:`_recursion` from ``P`` (B, n, n): ``(P, K, L, iterations, active)``."""
+    """``_recursion`` from ``P`` (B, n, n): ``(P, K, L, iterations, active)``."""
     B, (n, m) = d.size, d.G.shape
     P = np.array(np.broadcast_to(P, (B, n, n)), dtype=float, order="C")
     K, L = np.empty((B, m, n)), np.empty((B, n, n))
@@ -261,7 +261,7 @@ def _run(d: Model, P: np.ndarray, tol: float, max_iter: int, diverged: float):
 
 
 def kkt_step(P: np.ndarray, d: Model) -> Step:
-    """:func:`robustctl.rlqr._step.kkt_step`, compiled: one step for every design of ``d``."""
+    """The numpy ``robustctl.rlqr._step.kkt_step``, compiled: one step for every design of ``d``."""
     P, K, L, _, _ = _run(d, P, 0.0, 1, np.inf)
     return Step(P, K, L)
 
