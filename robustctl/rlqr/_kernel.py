@@ -98,6 +98,28 @@ def _copy(A, out):
 
 
 @_jit
+def _eye_plus_product(A, B, out):
+    """``out = I + A B`` (A (k, t), B (t, k)) into ``out[:k, :k]``."""
+    for i in range(A.shape[0]):
+        for j in range(B.shape[1]):
+            s = 0.0
+            for t in range(A.shape[1]):
+                s += A[i, t] * B[t, j]
+            out[i, j] = (1.0 if i == j else 0.0) + s
+
+
+@_jit
+def _transposed_product(A, B, out):
+    """``out = A' B`` (A (t, i), B (t, j)) into ``out[:i, :j]``."""
+    for i in range(A.shape[1]):
+        for j in range(B.shape[1]):
+            s = 0.0
+            for t in range(A.shape[0]):
+                s += A[t, i] * B[t, j]
+            out[i, j] = s
+
+
+@_jit
 def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc):
     """One step ``P -> (Pn, K, L)`` for one design (``li = lambda^-1``); the rest are work arrays.
 
@@ -106,13 +128,8 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
     n, m = G.shape
     l = EF.shape[0]
     if soft:                                            # Pt = sym((I + P S)^-1 P)
-        for i in range(n):
-            for j in range(n):
-                s = 0.0
-                for t in range(n):
-                    s += P[i, t] * S[t, j]
-                M[i, j] = (1.0 if i == j else 0.0) + s
-                Lc[i, j] = P[i, j]
+        _eye_plus_product(P, S, M)
+        _copy(P, Lc)
         if not _lu_solve(M, Lc):
             _fill(Lc, np.nan)
         for i in range(n):
@@ -120,13 +137,9 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
                 Pt[i, j] = 0.5 * (Lc[i, j] + Lc[j, i])
     else:
         _copy(P, Pt)
+    _transposed_product(G, Pt, GP)                      # GP = G'Pt
     for a in range(m):                                  # kkt = [[R + G'Pt G, EG'], [EG, -li I]]
-        for j in range(n):                              # sol = -[G'Pt F; EF]
-            s = 0.0
-            for i in range(n):
-                s += G[i, a] * Pt[i, j]
-            GP[a, j] = s
-        for c in range(m):
+        for c in range(m):                              # sol = -[G'Pt F; EF]
             s = 0.0
             for j in range(n):
                 s += GP[a, j] * G[j, c]
@@ -155,21 +168,11 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
             Lc[i, j] = F[i, j] + s
     _copy(Lc, L)
     if soft:                                            # L = (I + S P)^-1 Lc
-        for i in range(n):
-            for j in range(n):
-                s = 0.0
-                for t in range(n):
-                    s += S[i, t] * P[t, j]
-                M[i, j] = (1.0 if i == j else 0.0) + s
+        _eye_plus_product(S, P, M)
         if not _lu_solve(M, L):
             _fill(L, np.nan)
     # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt
-    for i in range(n):
-        for a in range(m):
-            s = 0.0
-            for c in range(m):
-                s += K[c, i] * R[c, a]
-            M[i, a] = s
+    _transposed_product(K, R, M)
     for i in range(n):
         for j in range(n):
             s = 0.0
@@ -179,12 +182,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
             for r in range(l):
                 v += sol[m + r, i] * sol[m + r, j]
             Pn[i, j] = (Q[i, j] + s) + li * v
-    for i in range(n):
-        for j in range(n):
-            s = 0.0
-            for t in range(n):
-                s += Lc[t, i] * Pt[t, j]
-            M[i, j] = s
+    _transposed_product(Lc, Pt, M)
     for i in range(n):
         for j in range(n):
             s = 0.0
