@@ -54,7 +54,7 @@ from typing import Literal
 
 import numpy as np
 
-from ._validation import as_batch, as_float_array, check_positive_scalar
+from ._validation import as_batch, as_float_array, check_choice, check_positive_scalar
 
 __all__ = ["SimulationResult", "LinearSimulator", "simulate_linear", "check_gains", "DEFAULT_BOUND", "BACKENDS"]
 
@@ -144,11 +144,8 @@ class SimulationResult:
 
     def state_mse(self, target: Literal["reference", "zero"] = "reference") -> np.ndarray:
         """Mean squared error of every state in the plant's order, shape (B, S, n) (see :meth:`mse`)."""
-        if target == "reference":
-            return self.sq_error_sum / self.T
-        if target == "zero":
-            return self.sq_state_sum / self.T
-        raise ValueError(f"target must be 'reference' or 'zero', got {target!r}")
+        check_choice(target, "target", ("reference", "zero"))
+        return (self.sq_error_sum if target == "reference" else self.sq_state_sum) / self.T
 
     @property
     def states(self) -> np.ndarray:
@@ -172,8 +169,7 @@ def check_gains(K, n: int, nan_gains: str = "raise") -> tuple[np.ndarray, np.nda
 
     ``nan_gains="raise"`` rejects non-finite gains, ``"flag"`` zeroes and reports them.
     """
-    if nan_gains not in ("raise", "flag"):
-        raise ValueError(f"nan_gains must be 'raise' or 'flag', got {nan_gains!r}")
+    check_choice(nan_gains, "nan_gains", ("raise", "flag"))
     arr = as_float_array(K, "K")
     if arr.ndim not in (2, 3) or 0 in arr.shape:
         raise ValueError(f"K must be an (m, n) gain or a non-empty (B, m, n) stack of gains, got shape {arr.shape}")

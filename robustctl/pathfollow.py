@@ -231,6 +231,7 @@ class PathFollowingResult(SimulationResult):
         linearisation of the model (second order in ``theta`` and
         ``kappa rho``), which accumulates along the route.
         """
+        check_choice(method, "method", ("path", "integrated"))
         self._need_trajectories()
         x = self.states
         rho, theta = x[..., 2], x[..., 3]
@@ -241,8 +242,6 @@ class PathFollowingResult(SimulationResult):
         if method == "path":
             return (path.X[: self.T] - rho * np.sin(h), path.Y[: self.T] + rho * np.cos(h),
                     h + theta)
-        if method != "integrated":
-            raise ValueError(f"method must be 'path' or 'integrated', got {method!r}")
         dt, v = path.dt, path.speed
 
         def integrate(rate, start):

@@ -58,7 +58,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 import scipy.linalg
 
-from .._validation import as_batch, check_positive_scalar
+from .._validation import as_batch, check_choice, check_positive_scalar
 from ..plant import Plant, _frozen
 
 __all__ = [
@@ -438,20 +438,19 @@ def algebraic_uncertainty(source: str = "printed", *, params: TruckParameters | 
     Eq. 1): ``EF = [6.85718e-4, -8.62010e-4, 0, -6.6666e-3]``,
     ``EG = [-6.66666e-3, -6.66666e-3]``. Both use ``(log10 mu)^2 = 81``.
     """
+    check_choice(source, "source", ("printed", "computed"))
     H = np.ones((4, 1))
     mu = 10.0 ** np.sqrt(PRINTED_LOG10_MU_SQ)
     if source == "printed":
         EF = np.array([PRINTED_EF])
         EG = np.array([PRINTED_EG])
-    elif source == "computed":
+    else:
         p = _params(params)
         F, G, _ = _discrete_batch(p, np.array([0.0, 2.0]))
         gF = F[0] - F[1]
         gG = G[0] - G[1]
         EF = (np.array([1.0, 1.0, 1.0, 0.1]) * gF[0])[None, :]
         EG = (np.array([0.1, 0.1]) * gG[0, 0])[None, :]
-    else:
-        raise ValueError(f"source must be 'printed' or 'computed', got {source!r}")
     return AlgebraicUncertainty(_frozen(H), _frozen(EF), _frozen(EG), float(mu), source)
 
 
