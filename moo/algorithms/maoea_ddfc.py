@@ -101,7 +101,15 @@ kept within it). The runs that lose a region are mostly those whose initial
 population holds at most one such point, for NSGA-III as well. Once a region
 is lost the variable that leads to it is driven to 0 (a smaller, if
 meaningless, ``f_i`` of ``1e-300`` dominates ``1e-100``), and polynomial
-mutation cannot bring it back to ``x >= 0.97``.
+mutation cannot bring it back to ``x >= 0.97``. pymoo's NSGA-III gets it back
+through its normalisation, which stretches the lost objective's tiny range to
+[0, 1]. The shared normalisation used here rejects the hyperplane (the lost
+objective has no extreme point left) and sets a range still below ``1e-10``
+to 1, so the lost objective's ``1e-100`` values stay 0 for DD and FC. With
+Blank et al.'s last fall-back (pymoo's, which keeps the tiny range) instead,
+seeds 0-9 at the paper's setting ran identically (5 collapsed), the lost
+objective ending at exactly 0 (``x^100`` underflows)
+(:mod:`moo.algorithms.operators`).
 
 Before FC got its resolution (see "Readings") 20 of the 30 runs lost a
 region, also with favourable initial populations: the one point of a region

@@ -76,8 +76,10 @@ Behaviour worth knowing
   last front IGD-NS deletes 37, as its rule deletes first the
   non-contributing solution farthest from the archive (the second term of
   Eq. 2; PlatEMO's implementation has the same rule). A lost region does not
-  come back: its variable is driven to 0 (NSGA-III regains it within 600
-  generations).
+  come back: its variable is driven to 0. pymoo's NSGA-III regains it within
+  600 generations because its normalisation stretches the lost objective's
+  tiny range (``1e-30``) to [0, 1]; IGD-NS's raw distances (the paper's) see
+  nothing there (measured in :mod:`moo.algorithms.operators`).
 * 5 objectives, DTLZ1 / DTLZ3 (Deb & Jain budget): no convergence (dense-front
   IGD 5.5x / 40x NSGA-III's, ``benchmarks/results/protocol_dense_m5.md``).
   From about generation 100 all ``2N`` candidates are non-dominated, so the

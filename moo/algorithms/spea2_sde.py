@@ -75,7 +75,14 @@ points off the axis are dominated in the first generations, and SPEA2 fills
 the archive by raw fitness (Zitzler et al. 2001, Sec. 3.2), so they go first
 (10 runs, first six generations: 252 lost from the later fronts, 35 from the
 front that is cut); a lost region does not come back (its variable is driven
-to 0).
+to 0). pymoo's NSGA-III gets it back because its normalisation stretches
+the lost objective's tiny range to [0, 1] and gives the points with its
+largest values niches of their own; the normalisation here stretches the same
+way, but the shifted density makes such a point, worse than its neighbours in
+that objective alone, look crowded: with ``b = (0.6, 0.8, 0)`` and
+``c = (0.6, 0.79, 1e-30)`` (normalised ``f_3`` 0 and 1) ``sd(c, b) = 0.01``
+in ``f_2``'s units while ``sd(b, c) = 1``, so truncation removes ``c`` first
+(:mod:`moo.algorithms.operators`).
 """
 
 from __future__ import annotations
