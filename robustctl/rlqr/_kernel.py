@@ -270,7 +270,6 @@ def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
             if not _lu_solve(W, sol):
                 _fill(sol, np.nan)
             _transposed_product(a, h, AH)                 # h_new = sym(h + (a'h) WA)
-            num, den = 0.0, 0.0
             for i in range(n):
                 for j in range(n):
                     s = 0.0
@@ -283,6 +282,7 @@ def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
                     hn[i, j] = v
                     hn[j, i] = v
             ok = _healthy(hn, bound)
+            num, den = 0.0, 0.0
             for i in range(n):
                 for j in range(n):
                     num += (hn[i, j] - h[i, j]) ** 2
