@@ -98,6 +98,7 @@ def main() -> None:
     print(f"  per call: 92 designs {t92 * 92e3:.3f} ms, 1 design {t1 * 1e3:.3f} ms "
           f"(fixed cost ~ {r1:.1f} dlqr calls)")
     recursion_rows(args.repeat, build(plant, *ill, Q=Q, R=R, H=H, alpha=0.1, batch=True), Q)
+    doubling_rows(args.repeat, plant, Q, R, H, rng)
 
 
 def generic_fallback_designs(count: int):
@@ -142,6 +143,25 @@ def recursion_rows(repeat: int, ill, Q_ill) -> None:
         print(f"  {label:52s} kernel {c * 1e6:9.1f} us/call  numpy {n * 1e6:9.1f} us/call  ratio {c / n:6.4f} "
               f"({steps} design-steps: kernel {c * len(batches) / steps * 1e6:.2f} us, "
               f"numpy {n * len(batches) / steps * 1e6:.2f} us per design-step)")
+
+
+def doubling_rows(repeat: int, plant, Q, R, H, rng) -> None:
+    """The doubling steps: compiled kernel against the numpy reference from the same standard form."""
+    print(f"doubling steps (tol {steady.DOUBLING_TOL:g}): compiled kernel vs numpy reference, best of {repeat}")
+    for B in (92, 2000):
+        d = build(plant, *designs(rng, B, False), Q=Q, R=R, H=H, alpha=0.1, batch=True)
+        A, Gs, Hs = steady.standard_form(d)
+        active = steady.healthy(Hs) & steady.healthy(Gs)
+        args = (A, Gs, Hs, steady.DOUBLING_TOL)
+        kernel.doubling(*args, steady.DOUBLING_MAX_STEPS, steady.DIVERGED, active)     # loads (or compiles) it
+        t_c, t_n = [], []
+        for _ in range(repeat):
+            t_c.append(best_of(lambda: kernel.doubling(*args, steady.DOUBLING_MAX_STEPS, steady.DIVERGED,
+                                                       active), 3))
+            t_n.append(best_of(lambda: steady.doubling_loop(*args, active), 3))
+        c, n = min(t_c), min(t_n)
+        print(f"  truck, {B:4d} designs in one call  kernel {c * 1e6 / B:7.2f} us/design  "
+              f"numpy {n * 1e6 / B:7.2f} us/design  ratio {c / n:6.4f}")
 
 
 if __name__ == "__main__":

@@ -64,7 +64,6 @@ import moocore
 import numpy as np
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
-from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 
 from moo._validation import check_int
@@ -146,23 +145,26 @@ class RunResult:
                 f"hv={self.hv:.6g}, {self.wall_time:.2f} s)")
 
 
-def _front(algorithm) -> tuple[np.ndarray, np.ndarray]:
-    """Objectives and decisions of the non-dominated set of population + ``opt``.
+def _front(algorithm, decisions: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """Objectives and decisions (None unless ``decisions``) of the non-dominated set of population + ``opt``.
 
     Only individuals with finite objectives (and feasible ones, for constrained
     problems) count; of duplicate objective vectors the first is kept.
     """
-    pool = algorithm.pop if algorithm.opt is None else Population.merge(algorithm.pop, algorithm.opt)
-    F = np.asarray(pool.get("F"), dtype=float)
-    X = np.asarray(pool.get("X"), dtype=float)
+    parts = [pop for pop in (algorithm.pop, algorithm.opt) if pop is not None and len(pop)]
+
+    def stacked(key: str) -> np.ndarray:                        # Population.merge(...).get(key), without the merge
+        return np.concatenate([np.asarray(pop.get(key), dtype=float).reshape(len(pop), -1) for pop in parts])
+
+    F = stacked("F")
     keep = np.all(np.isfinite(F), axis=1)
     if algorithm.problem.has_constraints():
-        keep &= np.asarray(pool.get("FEAS"), dtype=bool).ravel()
-    F, X = F[keep], X[keep]
+        keep &= stacked("FEAS").astype(bool).ravel()
+    F, X = F[keep], stacked("X")[keep] if decisions else None
     if len(F) == 0:
         return F, X
     nd = moocore.is_nondominated(F, keep_weakly=False)
-    return F[nd], X[nd]
+    return F[nd], None if X is None else X[nd]
 
 
 class _HVHistory(Callback):
@@ -173,7 +175,7 @@ class _HVHistory(Callback):
 
     def notify(self, algorithm):
         n_eval = algorithm.evaluator.n_eval
-        F, _ = _front(algorithm)
+        F, _ = _front(algorithm, decisions=False)
         hv = hypervolume(F, self.ref_point) if len(F) else 0.0
         self.rows.append((n_eval, hv))
         if self.progress is not None:

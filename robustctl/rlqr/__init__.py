@@ -60,11 +60,12 @@ nearly equal ``EG`` entries has ``P ~ 1e15`` and a doubling result about
 first refined by Newton's method (``fallback="newton"``): ``f``'s derivative
 at ``P`` is ``X -> L' X L``, so each Newton (Kleinman-Hewer) step is one
 Stein equation ``X = L' X L + f(P) - P``, solved by Smith's doubling.
-The plain recursion (and the evaluation of its result) runs in a compiled
-numba kernel (:mod:`robustctl.rlqr._kernel`: the same step, operation for
-operation, and the same stopping rule; numpy's per-call overhead, about
-80 us a step on the MOPs' small systems, made it the cost of the fallback);
-the numpy recursion is the reference its tests compare with.
+The doubling steps, the plain recursion and the evaluation of their results
+run in a compiled numba kernel (:mod:`robustctl.rlqr._kernel`: the same
+steps, operation for operation, and the same stopping rules; numpy's
+per-call overhead, about 80 us a step on the MOPs' small systems, made the
+recursion the cost of the fallback and the doubling a fifth of a MOP
+evaluation); the numpy loops are the references its tests compare with.
 
 ``lambda`` with no uncertainty. With ``H = 0`` the bound ``lambda >
 ||mu H'H|| = 0`` leaves ``lambda`` free, but any finite ``lambda > 0`` adds a

@@ -1,12 +1,13 @@
-"""Compiled (numba) kernels of the RLQR step and of the plain recursion.
+"""Compiled (numba) kernels of the RLQR step, the plain recursion and the doubling steps.
 
-:func:`kkt_step` and :func:`recursion` compute, design by design in one
-compiled loop, what ``robustctl.rlqr._step.kkt_step`` and
-``robustctl.rlqr._steady.recursion`` compute with stacked numpy calls
-(those stay the reference the tests compare with). On the small systems of
-the MOPs (``n = 3``, ``m = l = 1``) numpy's cost is its per-call overhead,
-about 75 us per step whatever the batch; the kernel takes about 1 us per
-design and step (``benchmarks/bench_rlqr.py``).
+:func:`kkt_step`, :func:`recursion` and :func:`doubling` compute, design by
+design in one compiled loop, what ``robustctl.rlqr._step.kkt_step``,
+``robustctl.rlqr._steady.recursion`` and ``robustctl.rlqr._steady.doubling_loop``
+compute with stacked numpy calls (those stay the references the tests
+compare with). On the small systems of the MOPs (``n = 3`` or 4, ``m = l = 1``
+or 2) numpy's cost is its per-call overhead, about 75 us per step whatever
+the batch; the kernel takes about 1 us per design and recursion step and
+0.4 us per design and doubling step (``benchmarks/bench_rlqr.py``).
 
 Same arithmetic, same rules:
 
@@ -15,6 +16,8 @@ Same arithmetic, same rules:
   batch is ``soft``, the KKT solve, ``L = (I + S P)^-1 Lc``,
   ``P = sym(Q + K'RK + lambda^-1 nu'nu + Lc' Pt Lc)``); only the rounding of
   the sums and the solves differs from numpy/LAPACK (a few ulps per step);
+  the doubling step is that of ``doubling_loop``, with ``(I + Gs H)^-1 [A, Gs]``
+  by the same LU;
 * the solves are LU with partial pivoting (as LAPACK's ``getrf``: the first
   largest pivot, multipliers scaled by the pivot's reciprocal); an exactly
   zero pivot is a singular system and gives NaN for that solve's result of
@@ -22,12 +25,14 @@ Same arithmetic, same rules:
 * the recursion stops a design when one step changes ``P`` by less than
   ``tol`` (relative Frobenius norm) or ``P`` is not healthy (an entry not
   below ``robustctl.rlqr._steady.DIVERGED`` in magnitude, or NaN), after
-  at most ``max_iter`` steps.
+  at most ``max_iter`` steps; the doubling likewise with its own ``tol``
+  (on ``H``) and ``max_steps``.
 
 Compilation: ``cache=True``, ``nogil=True`` (``robustctl._simkernel._jit``),
-one entry point (``_recursion``; a single step is ``max_iter = 1``), so
-one compilation: about 6 s on a fresh clone (2-core machine at load 3.5;
-slice assignments cost twice that to compile and are written as loops), then
+two entry points (``_recursion``, whose single step is ``max_iter = 1``, and
+``_doubling``), each compiled once: about 6 s and 5 s on a fresh clone
+(2-core machine at load 1.5-3.5; slice assignments cost twice that to
+compile and are written as loops), then
 0.03-0.06 s to load from the cache in each new process once numba is loaded
 (the simulation kernel loads it too).
 """
@@ -40,7 +45,7 @@ from .._simkernel import _jit
 from ._model import Model
 from ._step import Step
 
-__all__ = ["kkt_step", "recursion"]
+__all__ = ["doubling", "kkt_step", "recursion"]
 
 _TINY = np.finfo(float).tiny
 
@@ -240,6 +245,90 @@ def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, ti
             act = not change < tol and _healthy(Pn, bound)
         iterations[b] = it
         active[b] = act
+
+
+@_jit
+def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
+    """The doubling loop of ``robustctl.rlqr._steady.doubling`` for every ``active`` design.
+
+    ``A``, ``Gs``, ``H`` (B, n, n) are overwritten with each design's last iterate; per step
+    ``W = I + Gs H``, ``[WA, WG] = W^-1 [A, Gs]``, ``H <- sym(H + (A'H) WA)``, ``A <- A WA``,
+    ``Gs <- sym(Gs + (A WG) A')``, until ``H`` changes by less than ``tol`` or is not healthy.
+    """
+    n = H.shape[1]
+    W, sol, AH, AW, hn = np.empty((n, n)), np.empty((n, 2 * n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
+    for b in range(H.shape[0]):
+        a, g, h = A[b], Gs[b], H[b]
+        k = 0
+        while active[b] and k < max_steps:
+            k += 1
+            _eye_plus_product(g, h, W)
+            for i in range(n):
+                for j in range(n):
+                    sol[i, j] = a[i, j]
+                    sol[i, n + j] = g[i, j]
+            if not _lu_solve(W, sol):
+                _fill(sol, np.nan)
+            _transposed_product(a, h, AH)                 # h_new = sym(h + (a'h) WA)
+            for i in range(n):
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += AH[i, t] * sol[t, j]
+                    hn[i, j] = h[i, j] + s
+            for i in range(n):
+                for j in range(i, n):
+                    v = 0.5 * (hn[i, j] + hn[j, i])
+                    hn[i, j] = v
+                    hn[j, i] = v
+            ok = _healthy(hn, bound)
+            num, den = 0.0, 0.0
+            for i in range(n):
+                for j in range(n):
+                    num += (hn[i, j] - h[i, j]) ** 2
+                    den += hn[i, j] * hn[i, j]
+            den = np.sqrt(den)
+            change = np.sqrt(num) / (tiny if den < tiny else den) if ok else np.inf  # noqa: FURB136
+            for i in range(n):                            # AW = a WG, then g = sym(g + AW a'), a = a WA
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += a[i, t] * sol[t, n + j]
+                    AW[i, j] = s
+            for i in range(n):
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += AW[i, t] * a[j, t]
+                    W[i, j] = g[i, j] + s
+            for i in range(n):
+                for j in range(n):
+                    g[i, j] = 0.5 * (W[i, j] + W[j, i])
+            for i in range(n):
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += a[i, t] * sol[t, j]
+                    AW[i, j] = s
+            _copy(AW, a)
+            _copy(hn, h)
+            steps[b] += 1
+            settled[b] |= change < tol
+            active[b] = change >= tol and ok
+
+
+def doubling(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, max_steps: int, diverged: float,
+             active: np.ndarray):
+    """The doubling loop of ``robustctl.rlqr._steady.doubling``, compiled, from ``(A, Gs, H)`` (B, n, n).
+
+    ``active``: the designs to iterate (the others are returned as given, 0 steps).
+    Returns ``(H, steps, settled)`` as the numpy loop does.
+    """
+    A, Gs, H = (np.array(x, dtype=float, order="C") for x in (A, Gs, H))
+    steps, settled = np.zeros(H.shape[0], dtype=np.int64), np.zeros(H.shape[0], dtype=bool)
+    _doubling(A, Gs, H, float(tol), int(max_steps), float(diverged), _TINY, steps, settled,
+              np.array(active, dtype=bool))
+    return H, steps.astype(int), settled
 
 
 def _args(d: Model):

@@ -121,13 +121,20 @@ def recursion(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter
     return P, iterations, ~active & healthy(P)
 
 
+def _compiled(step: StepFunction) -> StepFunction:
+    """The compiled kernel's step for the numpy KKT step (the same step); any other step as it is."""
+    if step is kkt_step:
+        from . import _kernel
+        return _kernel.kkt_step
+    return step
+
+
 def plain(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter: int):
     """:func:`recursion` and the :func:`evaluate` of its result: ``(iterations, settled, Evaluation)``.
 
     With :func:`~robustctl.rlqr._step.kkt_step` both run in the compiled kernel
     (:mod:`robustctl.rlqr._kernel`, the same step and stopping rule; the numpy
-    :func:`recursion` is the reference its tests compare with). The kernel is
-    imported here, so that numba is loaded only when a recursion runs.
+    :func:`recursion` is the reference its tests compare with).
     """
     if step is kkt_step:
         from . import _kernel
@@ -151,10 +158,18 @@ def doubling(d: Model, tol: float):
     solved by the structure-preserving doubling algorithm (Chu, Fan & Lin
     2005): ``H_k -> X`` quadratically. Returns ``(X, steps, settled)``;
     ``settled`` is False where ``H_k`` blew up or kept changing for
-    ``DOUBLING_MAX_STEPS`` doublings (no stabilising fixed point).
+    ``DOUBLING_MAX_STEPS`` doublings (no stabilising fixed point). The
+    standard form is built with numpy, the doubling steps run in the compiled
+    kernel (:func:`doubling_loop` is their numpy reference).
     """
+    from . import _kernel
+    A, Gs, H = standard_form(d)
+    return _kernel.doubling(A, Gs, H, tol, DOUBLING_MAX_STEPS, DIVERGED, healthy(H) & healthy(Gs))
+
+
+def standard_form(d: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(As, Gs, Qs)`` of :func:`doubling`'s standard form, for every design (B, n, n)."""
     B, l = d.EF.shape[:2]
-    n = d.F.shape[0]
     Rinv = np.linalg.inv(d.R)
     EGR = d.EG @ Rinv                                                  # (B, l, m)
     Gam = solve(d.lam_inv[:, None, None] * np.eye(l) + EGR @ d.EG.swapaxes(1, 2),
@@ -162,25 +177,36 @@ def doubling(d: Model, tol: float):
     A = d.F - d.G @ (EGR.swapaxes(1, 2) @ Gam @ d.EF)
     H = sym(d.Q + d.EF.swapaxes(1, 2) @ Gam @ d.EF)
     Gs = sym(d.G @ (Rinv - EGR.swapaxes(1, 2) @ Gam @ EGR) @ d.G.T + d.S)
+    return A, Gs, H
+
+
+def doubling_loop(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, active: np.ndarray):
+    """The doubling steps of :func:`doubling` from :func:`standard_form`, with stacked numpy calls.
+
+    The reference of the compiled loop (``robustctl.rlqr._kernel.doubling``, same
+    operations in the same order). Returns ``(H, steps, settled)``.
+    """
+    A, Gs, H, active = A.copy(), Gs.copy(), H.copy(), active.copy()
+    B, n = H.shape[:2]
     steps = np.zeros(B, dtype=int)
     settled = np.zeros(B, dtype=bool)
-    active = healthy(H) & healthy(Gs)
     eye = np.eye(n)
-    for _ in range(DOUBLING_MAX_STEPS):
-        if not active.any():
-            break
-        idx = slice(None) if active.all() else np.flatnonzero(active)  # no copies while all run
-        a, g, h = A[idx], Gs[idx], H[idx]
-        sol = solve(eye + g @ h, np.concatenate([a, g], axis=2))      # W^-1 [A, G]
-        WA, WG = sol[..., :n], sol[..., n:]
-        aT = a.swapaxes(1, 2)
-        h_new = sym(h + aT @ h @ WA)
-        ok = healthy(h_new)
-        change = np.where(ok, relchange(h_new, h), np.inf)
-        A[idx], Gs[idx], H[idx] = a @ WA, sym(g + a @ WG @ aT), h_new
-        steps[idx] += 1
-        settled[idx] |= change < tol
-        active[idx] &= (change >= tol) & ok
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for _ in range(DOUBLING_MAX_STEPS):
+            if not active.any():
+                break
+            idx = slice(None) if active.all() else np.flatnonzero(active)  # no copies while all run
+            a, g, h = A[idx], Gs[idx], H[idx]
+            sol = solve(eye + g @ h, np.concatenate([a, g], axis=2))      # W^-1 [A, G]
+            WA, WG = sol[..., :n], sol[..., n:]
+            aT = a.swapaxes(1, 2)
+            h_new = sym(h + aT @ h @ WA)
+            ok = healthy(h_new)
+            change = np.where(ok, relchange(h_new, h), np.inf)
+            A[idx], Gs[idx], H[idx] = a @ WA, sym(g + a @ WG @ aT), h_new
+            steps[idx] += 1
+            settled[idx] |= change < tol
+            active[idx] &= (change >= tol) & ok
     return H, steps, settled
 
 
@@ -245,7 +271,7 @@ def steady_state(d: Model, P0: np.ndarray, tol: float, max_iter: int, *, acceler
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         if accelerate:
             X, iterations, settled = doubling(d, min(DOUBLING_RATIO * tol, DOUBLING_TOL))
-            ev = evaluate(X, d, step)
+            ev = evaluate(X, d, _compiled(step))
         else:
             iterations, settled, ev = plain(d, step, P0, tol, max_iter)
 
