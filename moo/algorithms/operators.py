@@ -59,7 +59,8 @@ Readings (see PAPER_NOTES.md):
   generations than 10000 evaluations give (NSGA-III: 4 of seeds 0-9
   collapsed at the paper's setting). The others: BiGE's min/max
   normalisation (its paper's) stretches the same way, and BiGE gets regions
-  back under the same budget (0 of 10); SPEA2+SDE's stretches too, but the
+  back under the same budget (seeds 0-9: 0 collapsed; 5 with ranges
+  ``<= 1e-6`` left unstretched); SPEA2+SDE's stretches too, but the
   shifted density makes a point that is worse in one objective look crowded
   (a neighbour better in ``f_3`` is shifted onto it), so the raised points
   are truncated first; MOEA/IGD-NS measures raw distances (its paper's), in
@@ -67,9 +68,7 @@ Readings (see PAPER_NOTES.md):
   normalisation, which sets a range still below ``1e-10`` to 1, so nothing
   is stretched (with Blank et al.'s last fall-back instead, seeds 0-9 of
   DDFC at the paper's setting ran identically, 5 collapsed, the lost
-  objective ending at exactly 0 as ``x^100`` underflows). BiGE with ranges
-  ``<= 1e-6`` left unstretched (seeds 0-9, 600 generations) collapses in 5
-  of 10 runs instead of 0, the same mechanism. None of these is a departure
+  objective ending at exactly 0 as ``x^100`` underflows). None of these is a departure
   from the algorithm's paper.
 * Reference directions: Das & Dennis with 12 divisions for 3 objectives
   (91 directions). For 4 objectives the paper is silent and 92 directions are
