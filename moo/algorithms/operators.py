@@ -56,8 +56,8 @@ Readings (see PAPER_NOTES.md):
   every range still ``<= 1e-6`` set to 1 (no stretch, nothing else changed)
   4 of the 5 never do (4 collapsed). The stretch is pymoo's, not Deb & Jain's
   (whose worst published run here is a collapse), and it needs more
-  generations than 10000 evaluations give (NSGA-III: 4 of seeds 0-9
-  collapsed at the paper's setting). The others: BiGE's min/max
+  generations than 10000 evaluations give (NSGA-III at the paper's setting:
+  the same 4 of seeds 0-9 collapsed with and without it). The others: BiGE's min/max
   normalisation (its paper's) stretches the same way, and BiGE gets regions
   back under the same budget (seeds 0-9: 0 collapsed; 5 with ranges
   ``<= 1e-6`` left unstretched); SPEA2+SDE's stretches too, but the
