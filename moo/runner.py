@@ -145,27 +145,33 @@ class RunResult:
                 f"hv={self.hv:.6g}, {self.wall_time:.2f} s)")
 
 
-def _front(algorithm, decisions: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-    """Objectives and decisions (None unless ``decisions``) of the non-dominated set of population + ``opt``.
+def _stacked(algorithm, key: str) -> np.ndarray:
+    """``Population.merge(pop, opt).get(key)`` as float rows, read by attribute and without the merge."""
+    parts = [pop for pop in (algorithm.pop, algorithm.opt) if pop is not None and len(pop)]
+    return np.concatenate([np.asarray([getattr(ind, key) for ind in pop], dtype=float).reshape(len(pop), -1)
+                           for pop in parts])
+
+
+def _front_rows(algorithm) -> tuple[np.ndarray, np.ndarray]:
+    """Objectives of the non-dominated set of population + ``opt``, and their rows in :func:`_stacked`.
 
     Only individuals with finite objectives (and feasible ones, for constrained
     problems) count; of duplicate objective vectors the first is kept.
     """
-    parts = [pop for pop in (algorithm.pop, algorithm.opt) if pop is not None and len(pop)]
-
-    def stacked(key: str) -> np.ndarray:       # Population.merge(...).get(key) by attribute, without the merge
-        return np.concatenate([np.asarray([getattr(ind, key) for ind in pop], dtype=float).reshape(len(pop), -1)
-                               for pop in parts])
-
-    F = stacked("F")
+    F = _stacked(algorithm, "F")
     keep = np.all(np.isfinite(F), axis=1)
     if algorithm.problem.has_constraints():
-        keep &= stacked("FEAS").astype(bool).ravel()
-    F, X = F[keep], stacked("X")[keep] if decisions else None
-    if len(F) == 0:
-        return F, X
-    nd = moocore.is_nondominated(F, keep_weakly=False)
-    return F[nd], None if X is None else X[nd]
+        keep &= _stacked(algorithm, "FEAS").astype(bool).ravel()
+    rows = np.flatnonzero(keep)
+    if rows.size:
+        rows = rows[moocore.is_nondominated(F[rows], keep_weakly=False)]
+    return F[rows], rows
+
+
+def _front(algorithm) -> tuple[np.ndarray, np.ndarray]:
+    """Objectives and decisions of the non-dominated set of population + ``opt`` (see :func:`_front_rows`)."""
+    F, rows = _front_rows(algorithm)
+    return F, _stacked(algorithm, "X")[rows]
 
 
 class _HVHistory(Callback):
@@ -176,7 +182,7 @@ class _HVHistory(Callback):
 
     def notify(self, algorithm):
         n_eval = algorithm.evaluator.n_eval
-        F, _ = _front(algorithm, decisions=False)
+        F, _ = _front_rows(algorithm)
         hv = hypervolume(F, self.ref_point) if len(F) else 0.0
         self.rows.append((n_eval, hv))
         if self.progress is not None:
