@@ -96,6 +96,7 @@ from pymoo.termination.max_eval import MaximumFunctionCallTermination
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from ._validation import as_matrix
+from .algorithms._base import objectives
 
 if TYPE_CHECKING:
     from pymoo.core.evaluator import Evaluator
@@ -326,7 +327,7 @@ class MOLSP(_SurvivalHost):
         pop, problem = self.pop, self.problem
         stats = {"n_candidates": 0, "n_mutants": 0, "n_survived": 0}
         self.data["molsp"] = stats
-        keep = np.all(np.isfinite(np.asarray(pop.get("F"), dtype=float)), axis=1)
+        keep = np.all(np.isfinite(objectives(pop)), axis=1)
         if problem.has_constraints():
             keep &= np.asarray(pop.get("FEAS"), dtype=bool).ravel()
         pool = pop[np.flatnonzero(keep)]
@@ -341,7 +342,7 @@ class MOLSP(_SurvivalHost):
         xl = np.full(n_var, -np.inf) if xl is None else xl
         xu = np.full(n_var, np.inf) if xu is None else xu
         X = np.asarray(pool.get("X"), dtype=float)
-        mutants_X = propose(X, pool.get("F"), xl, xu, self.molsp_ref_point, self.random_state,
+        mutants_X = propose(X, objectives(pool), xl, xu, self.molsp_ref_point, self.random_state,
                             self.molsp_max_leaders)
         stats["n_candidates"] = len(mutants_X)
         if remaining is not None:

@@ -153,8 +153,9 @@ def _front(algorithm, decisions: bool = True) -> tuple[np.ndarray, np.ndarray | 
     """
     parts = [pop for pop in (algorithm.pop, algorithm.opt) if pop is not None and len(pop)]
 
-    def stacked(key: str) -> np.ndarray:                        # Population.merge(...).get(key), without the merge
-        return np.concatenate([np.asarray(pop.get(key), dtype=float).reshape(len(pop), -1) for pop in parts])
+    def stacked(key: str) -> np.ndarray:       # Population.merge(...).get(key) by attribute, without the merge
+        return np.concatenate([np.asarray([getattr(ind, key) for ind in pop], dtype=float).reshape(len(pop), -1)
+                               for pop in parts])
 
     F = stacked("F")
     keep = np.all(np.isfinite(F), axis=1)

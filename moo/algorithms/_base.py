@@ -9,7 +9,8 @@
 - :func:`check_ref_dirs_fit`: reference directions must match the problem's
   number of objectives.
 - :func:`float_column`: a per-individual attribute read from a population,
-  with the entries never set filled in.
+  with the entries never set filled in; :func:`objectives`: the objective
+  vectors of a population, read by attribute.
 - :func:`factory_arguments`, :func:`factory_ref_dirs`: the checks every
   registry factory makes (the shape documented in :mod:`moo.algorithms`).
 """
@@ -105,6 +106,15 @@ def float_column(values, fill: float) -> np.ndarray:
     if arr.dtype == object:
         arr = np.where(np.equal(arr, np.array(None)), fill, arr)
     return arr.astype(float).reshape(len(arr), -1)[:, 0]
+
+
+def objectives(pop) -> np.ndarray:
+    """``pop.get("F")`` as float64, read as ``Individual.F`` (the same array, several times faster).
+
+    ``Population.get`` looks each attribute up through ``Individual.get``; on the
+    small problems of the paper that lookup was a tenth of a survival's time.
+    """
+    return np.array([ind.F for ind in pop], dtype=float)
 
 
 class NormalizationForwarding:

@@ -163,7 +163,7 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import as_objectives, check_int
-from ._base import BinaryTournament, factory_arguments, paper_operators
+from ._base import BinaryTournament, factory_arguments, objectives, paper_operators
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = ["BiGE", "BiGESurvival", "bige_estimation", "make_bige", "niche_radius", "ORIGINAL_OPERATORS"]
@@ -242,7 +242,7 @@ class BiGESurvival(Survival):
         self._nds = NonDominatedSorting()
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
-        F = pop.get("F").astype(np.float64, copy=False)
+        F = objectives(pop)
         n, m = F.shape
         if n_survive is None:
             n_survive = n
@@ -282,7 +282,7 @@ def _bige_tournament(pop, P, random_state=None, **kwargs):
     if P.shape[1] != 2:
         raise ValueError(f"BiGE uses a binary tournament, got tournaments of size {P.shape[1]}")
     rng = random_state if random_state is not None else np.random.default_rng()
-    F = pop.get("F").astype(np.float64, copy=False)
+    F = objectives(pop)
     n, m = F.shape
     cv = pop.get("CV")
     cv = np.zeros(n) if cv is None else np.asarray(cv, dtype=np.float64).reshape(n, -1)[:, 0]

@@ -78,7 +78,7 @@ from pymoo.core.survival import Survival
 from pymoo.operators.selection.rnd import RandomSelection
 
 from .._validation import as_matrix, check_choice, check_int, check_real
-from ._base import NormalizationForwarding, factory_arguments, factory_ref_dirs, paper_operators
+from ._base import NormalizationForwarding, factory_arguments, factory_ref_dirs, objectives, paper_operators
 from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, OperatorSettings
 
@@ -188,7 +188,7 @@ class EFRRRSurvival(NormalizationForwarding, Survival):
         self.norm = HyperplaneNormalization(self.ref_dirs.shape[1])
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         self.norm.update(F)
         rank = maximum_ranking(self.normalize(F), self.ref_dirs, n_neighbors=self.n_neighbors,
                                scalarizing=self.scalarizing, theta=self.theta)

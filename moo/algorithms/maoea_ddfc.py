@@ -132,7 +132,7 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import as_matrix, check_choice, check_int
-from ._base import NormalizationForwarding, factory_arguments, paper_operators
+from ._base import NormalizationForwarding, factory_arguments, objectives, paper_operators
 from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, OperatorSettings
 
@@ -284,7 +284,7 @@ class DDFCSurvival(NormalizationForwarding, Survival):
         self.norm = HyperplaneNormalization(n_obj)
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         if n_survive is None:
             n_survive = len(pop)
         fronts, rank = NonDominatedSorting().do(F, return_rank=True, n_stop_if_ranked=n_survive)
@@ -333,7 +333,7 @@ class DDFCMatingSelection(Selection):
 
     def _do(self, problem, pop, n_select, n_parents, *args, random_state=None, algorithm=None,
             **kwargs):
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         survival = getattr(algorithm, "survival", None)
         if isinstance(survival, DDFCSurvival) and survival.nadir_point is not None:
             fc = favorable_convergence(survival.normalize(F))

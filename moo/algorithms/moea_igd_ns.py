@@ -104,7 +104,7 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
 from .._validation import check_int
-from ._base import factory_arguments, paper_operators
+from ._base import factory_arguments, objectives, paper_operators
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -337,13 +337,13 @@ class IGDNSSurvival(Survival):
     def _update_archive(self, pop, random_state) -> Population:
         """Merge ``pop`` into the archive and update it by :func:`update_archive`; returns the new archive."""
         merged = pop if self.archive is None else Population.merge(self.archive, pop)
-        keep = update_archive(merged.get("F").astype(float), self.archive_size, random_state=random_state)
+        keep = update_archive(objectives(merged), self.archive_size, random_state=random_state)
         self.archive = merged[keep]
         return self.archive
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
         archive = self._update_archive(pop, random_state)
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         fronts = NonDominatedSorting().do(F, n_stop_if_ranked=n_survive)
         selected: list[np.ndarray] = []
         n_sel = 0
@@ -352,7 +352,7 @@ class IGDNSSurvival(Survival):
                 selected.append(front)
                 n_sel += len(front)
             else:
-                kept = reduce_by_igd_ns(F[front], archive.get("F").astype(float), n_survive - n_sel)
+                kept = reduce_by_igd_ns(F[front], objectives(archive), n_survive - n_sel)
                 selected.append(front[kept])
                 n_sel += len(kept)
             if n_sel >= n_survive:

@@ -112,7 +112,7 @@ from pymoo.core.survival import Survival
 from pymoo.operators.selection.tournament import TournamentSelection
 
 from .._validation import check_directions, check_int, check_real
-from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, float_column, paper_operators
+from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, float_column, objectives, paper_operators
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -305,7 +305,7 @@ class R2RankingSurvival(Survival):
         self.marks = np.zeros(self.weights.shape[1], dtype=int)
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         if F.shape[1] != self.weights.shape[1]:
             raise ValueError(f"the problem has {F.shape[1]} objectives but the weights have "
                              f"{self.weights.shape[1]} columns")

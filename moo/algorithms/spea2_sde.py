@@ -93,7 +93,7 @@ from pymoo.core.survival import Survival
 from pymoo.termination.default import DefaultMultiObjectiveTermination
 
 from .._validation import as_float_array, as_objectives
-from ._base import BinaryTournament, factory_arguments, float_column, paper_operators
+from ._base import BinaryTournament, factory_arguments, float_column, objectives, paper_operators
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -321,7 +321,7 @@ class SPEA2SDESurvival(Survival):
         self.normalize = bool(normalize)
 
     def _do(self, problem, pop, *args, n_survive=None, random_state=None, **kwargs):
-        F = pop.get("F").astype(np.float64, copy=False)
+        F = objectives(pop)
         n = len(pop)
         if n_survive is None:
             n_survive = n
@@ -351,7 +351,7 @@ def _sde_tournament(pop, P, random_state=None, **kwargs):
     if np.any(np.isnan(fit[feasible])):
         # feasible individuals not ranked by the survival (e.g. a user-supplied population):
         # rank the feasible ones now, as the survival does
-        fit[feasible] = sde_fitness(pop.get("F")[feasible])[0]
+        fit[feasible] = sde_fitness(objectives(pop)[feasible])[0]
     a, b = P[:, 0], P[:, 1]
     coin = rng.random(len(P)) < 0.5
     infeasible = ~(feasible[a] & feasible[b])

@@ -116,7 +116,7 @@ from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
 from .._validation import check_choice, check_directions, check_int
-from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, paper_operators
+from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, objectives, paper_operators
 from ._normalize import HyperplaneNormalization, front_bounds
 from .operators import POP_SIZE, OperatorSettings
 from .theta_dea import finite_first, select_by_fronts, theta_nondominated_ranks
@@ -249,7 +249,7 @@ class SPEARSurvival(Survival):
         return self.norm.normalize(F)
 
     def _do(self, problem, pop, n_survive=None, random_state=None, **kwargs):
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         if F.shape[1] != self.ref_dirs.shape[1]:
             raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has "
                              f"{self.ref_dirs.shape[1]} columns")
@@ -285,7 +285,7 @@ class NeighbourMatingSelection(Selection):
         first = random_permutations(int(np.ceil(n_select / n)), n, random_state=random_state)[:n_select]
         if n == 1:
             return np.stack([first, first], axis=1)
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         finite = np.all(np.isfinite(F), axis=1)
         Fn = np.full_like(F, np.inf)                                 # non-finite rows: infinitely far
         if finite.any():

@@ -90,7 +90,14 @@ from pymoo.util.misc import random_permutations
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from .._validation import check_directions, check_int, check_real
-from ._base import NormalizationForwarding, check_ref_dirs_fit, factory_arguments, factory_ref_dirs, paper_operators
+from ._base import (
+    NormalizationForwarding,
+    check_ref_dirs_fit,
+    factory_arguments,
+    factory_ref_dirs,
+    objectives,
+    paper_operators,
+)
 from ._normalize import HyperplaneNormalization
 from .operators import POP_SIZE, OperatorSettings
 
@@ -192,7 +199,7 @@ def finite_first(survive, problem, pop, n_survive: int, random_state):
     placed on a reference direction; they are ranked behind every finite one
     (in population order) and only survive when the finite ones are too few.
     """
-    finite = np.all(np.isfinite(pop.get("F")), axis=1)
+    finite = np.all(np.isfinite(objectives(pop)), axis=1)
     good, bad = np.flatnonzero(finite), np.flatnonzero(~finite)
     if len(good) == 0:
         return pop[bad[:n_survive]]
@@ -244,7 +251,7 @@ class ThetaSurvival(NormalizationForwarding, Survival):
         self.norm = HyperplaneNormalization(self.ref_dirs.shape[1])
 
     def _do(self, problem, pop, n_survive=None, random_state=None, **kwargs):
-        F = pop.get("F").astype(float)
+        F = objectives(pop)
         if F.shape[1] != self.ref_dirs.shape[1]:
             raise ValueError(f"the population has {F.shape[1]} objectives but ref_dirs has "
                              f"{self.ref_dirs.shape[1]} columns")
