@@ -202,27 +202,28 @@ def build(task: Task):
     return problem, make_algorithm(task.algorithm, n_obj=task.n_obj, pop_size=pop_size, **options), termination
 
 
+def dense_score(problem: str, n_obj: int, F: np.ndarray, n_pop: int) -> tuple[float, float, bool, bool]:
+    """Dense-front IGD, mean distance to the front (NaN for WFG), *failed* and *collapsed* of a final set ``F``."""
+    igd_dense = float(moocore.igd(F, ref=dense_front(problem, n_obj)))
+    failed = igd_dense > FAIL_FACTOR * even_igd(problem, n_obj, n_pop)
+    if problem.startswith("wfg"):
+        return igd_dense, np.nan, failed, False
+    dist = float(np.mean(front_distance(problem, F)))
+    return igd_dense, dist, failed, failed and dist < ON_FRONT_TOL
+
+
 def run_task(task: Task) -> Result:
     problem, algorithm, termination = build(task)
     c0 = time.process_time()
     res = minimize(problem, algorithm, termination, seed=task.seed)
     cpu = time.process_time() - c0
     F = np.asarray(res.F, dtype=float)
-    dense = dense_front(task.problem, task.n_obj)
-    igd_dense = float(moocore.igd(F, ref=dense))
     igd_targets = np.nan
     if task.part == "protocol":
         igd_targets = float(moocore.igd(F, ref=on_front(task.problem, protocol_directions(task.n_obj))))
-    if task.problem.startswith("wfg"):
-        dist = np.nan
-        failed = igd_dense > FAIL_FACTOR * even_igd(task.problem, task.n_obj, len(res.pop))
-        collapsed = False
-    else:
-        dist = float(np.mean(front_distance(task.problem, F)))
-        failed = igd_dense > FAIL_FACTOR * even_igd(task.problem, task.n_obj, len(res.pop))
-        collapsed = failed and dist < ON_FRONT_TOL
-    return Result(task, igd_targets, igd_dense, float(moocore.igd_plus(F, ref=dense)), dist, bool(failed),
-                  bool(collapsed), cpu)
+    igd_dense, dist, failed, collapsed = dense_score(task.problem, task.n_obj, F, len(res.pop))
+    return Result(task, igd_targets, igd_dense, float(moocore.igd_plus(F, ref=dense_front(task.problem, task.n_obj))),
+                  dist, bool(failed), bool(collapsed), cpu)
 
 
 def tasks_for(args: argparse.Namespace) -> list[Task]:
