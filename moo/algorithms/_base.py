@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from ._normalize import HyperplaneNormalization
 
 __all__ = ["BinaryTournament", "MIN_POP_SIZE", "NormalizationForwarding", "check_ref_dirs_fit", "factory_arguments",
-           "factory_ref_dirs", "float_column", "paper_operators"]
+           "factory_ref_dirs", "float_column", "objectives", "paper_operators"]
 
 #: Smallest population a registry factory accepts.
 MIN_POP_SIZE = 4
