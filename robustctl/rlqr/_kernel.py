@@ -103,25 +103,35 @@ def _copy(A, out):
 
 
 @_jit
-def _eye_plus_product(A, B, out):
-    """``out = I + A B`` (A (k, t), B (t, k)) into ``out[:k, :k]``."""
+def _product(A, B, out):
+    """``out = A B`` (A (i, t), B (t, j); views such as ``A.T`` too) into ``out[:i, :j]``."""
     for i in range(A.shape[0]):
         for j in range(B.shape[1]):
             s = 0.0
             for t in range(A.shape[1]):
                 s += A[i, t] * B[t, j]
-            out[i, j] = (1.0 if i == j else 0.0) + s
+            out[i, j] = s
 
 
 @_jit
-def _transposed_product(A, B, out):
-    """``out = A' B`` (A (t, i), B (t, j)) into ``out[:i, :j]``."""
-    for i in range(A.shape[1]):
+def _eye_plus_product(A, B, out):
+    """``out = I + A B`` (A (k, t), B (t, k)) into ``out[:k, :k]``."""
+    _product(A, B, out)
+    for i in range(A.shape[0]):
         for j in range(B.shape[1]):
-            s = 0.0
-            for t in range(A.shape[0]):
-                s += A[t, i] * B[t, j]
-            out[i, j] = s
+            out[i, j] = (1.0 if i == j else 0.0) + out[i, j]
+
+
+@_jit
+def _relchange(new, old, tiny):
+    """``||new - old||_F / max(||new||_F, tiny)`` (NaN stays NaN)."""
+    num, den = 0.0, 0.0
+    for i in range(new.shape[0]):
+        for j in range(new.shape[1]):
+            num += (new[i, j] - old[i, j]) ** 2
+            den += new[i, j] * new[i, j]
+    den = np.sqrt(den)
+    return np.sqrt(num) / (tiny if den < tiny else den)  # noqa: FURB136 (NaN stays NaN, as np.maximum)
 
 
 @_jit
@@ -142,7 +152,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
                 Pt[i, j] = 0.5 * (Lc[i, j] + Lc[j, i])
     else:
         _copy(P, Pt)
-    _transposed_product(G, Pt, GP)                      # GP = G'Pt
+    _product(G.T, Pt, GP)                               # GP = G'Pt
     for a in range(m):                                  # kkt = [[R + G'Pt G, EG'], [EG, -li I]]
         for c in range(m):                              # sol = -[G'Pt F; EF]
             s = 0.0
@@ -177,7 +187,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
         if not _lu_solve(M, L):
             _fill(L, np.nan)
     # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt
-    _transposed_product(K, R, M)
+    _product(K.T, R, M)
     for i in range(n):
         for j in range(n):
             s = 0.0
@@ -187,7 +197,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
             for r in range(l):
                 v += sol[m + r, i] * sol[m + r, j]
             Pn[i, j] = (Q[i, j] + s) + li * v
-    _transposed_product(Lc, Pt, M)
+    _product(Lc.T, Pt, M)
     for i in range(n):
         for j in range(n):
             s = 0.0
@@ -234,13 +244,7 @@ def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, ti
         while act and it < max_iter:
             it += 1
             _step(Pb, F, G, Q, R, EF[b], EG[b], S[b], lam_inv[b], soft, Pn, K[b], L[b], Pt, M, GP, kkt, sol, Lc)
-            num, den = 0.0, 0.0
-            for i in range(n):
-                for j in range(n):
-                    num += (Pn[i, j] - Pb[i, j]) ** 2
-                    den += Pn[i, j] * Pn[i, j]
-            den = np.sqrt(den)
-            change = np.sqrt(num) / (tiny if den < tiny else den)  # noqa: FURB136 (NaN stays NaN, as np.maximum)
+            change = _relchange(Pn, Pb, tiny)
             _copy(Pn, Pb)
             act = not change < tol and _healthy(Pn, bound)
         iterations[b] = it
@@ -269,47 +273,27 @@ def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
                     sol[i, n + j] = g[i, j]
             if not _lu_solve(W, sol):
                 _fill(sol, np.nan)
-            _transposed_product(a, h, AH)                 # h_new = sym(h + (a'h) WA)
+            _product(a.T, h, AH)                          # h_new = sym(h + (a'h) WA)
+            _product(AH, sol[:, :n], hn)
             for i in range(n):
                 for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += AH[i, t] * sol[t, j]
-                    hn[i, j] = h[i, j] + s
+                    hn[i, j] = h[i, j] + hn[i, j]
             for i in range(n):
                 for j in range(i, n):
                     v = 0.5 * (hn[i, j] + hn[j, i])
                     hn[i, j] = v
                     hn[j, i] = v
             ok = _healthy(hn, bound)
-            num, den = 0.0, 0.0
+            change = _relchange(hn, h, tiny) if ok else np.inf
+            _product(a, sol[:, n:], AW)                   # g = sym(g + (a WG) a')
+            _product(AW, a.T, W)
             for i in range(n):
                 for j in range(n):
-                    num += (hn[i, j] - h[i, j]) ** 2
-                    den += hn[i, j] * hn[i, j]
-            den = np.sqrt(den)
-            change = np.sqrt(num) / (tiny if den < tiny else den) if ok else np.inf  # noqa: FURB136
-            for i in range(n):                            # AW = a WG, then g = sym(g + AW a'), a = a WA
-                for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += a[i, t] * sol[t, n + j]
-                    AW[i, j] = s
-            for i in range(n):
-                for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += AW[i, t] * a[j, t]
-                    W[i, j] = g[i, j] + s
+                    W[i, j] = g[i, j] + W[i, j]
             for i in range(n):
                 for j in range(n):
                     g[i, j] = 0.5 * (W[i, j] + W[j, i])
-            for i in range(n):
-                for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += a[i, t] * sol[t, j]
-                    AW[i, j] = s
+            _product(a, sol[:, :n], AW)                   # a = a WA
             _copy(AW, a)
             _copy(hn, h)
             steps[b] += 1
