@@ -180,3 +180,17 @@ def test_generic_core_does_not_import_robustctl(module):
             "print(sorted(m for m in sys.modules if m == 'robustctl' or m.startswith('robustctl.')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]", out
+
+
+def test_objectives_by_attribute_equal_population_get():
+    """``moo.algorithms._base.objectives`` (read as ``Individual.F``) is ``Population.get("F")``, bit for bit."""
+    from pymoo.core.population import Population
+
+    from moo.algorithms._base import objectives
+
+    res = minimize(get_problem("dtlz2"), make_algorithm("nsga2", n_obj=3), ("n_eval", 400), seed=2)
+    pop = Population.merge(res.pop, res.opt)
+    F = objectives(pop)
+    assert F.dtype == np.float64 and F.shape == (len(pop), 3)
+    np.testing.assert_array_equal(F, pop.get("F"))
+    assert objectives(pop[:0]).shape == pop[:0].get("F").shape
