@@ -186,24 +186,21 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
         _eye_plus_product(S, P, M)
         if not _lu_solve(M, L):
             _fill(L, np.nan)
-    # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt
+    # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt; Pt, last read
+    # for Lc'Pt, then takes (Lc'Pt) Lc
     _product(K.T, R, M)
+    _product(M[:, :m], K, Pn)
     for i in range(n):
         for j in range(n):
-            s = 0.0
-            for a in range(m):
-                s += M[i, a] * K[a, j]
             v = 0.0
             for r in range(l):
                 v += sol[m + r, i] * sol[m + r, j]
-            Pn[i, j] = (Q[i, j] + s) + li * v
+            Pn[i, j] = (Q[i, j] + Pn[i, j]) + li * v
     _product(Lc.T, Pt, M)
+    _product(M[:, :n], Lc, Pt)
     for i in range(n):
         for j in range(n):
-            s = 0.0
-            for t in range(n):
-                s += M[i, t] * Lc[t, j]
-            Pn[i, j] += s
+            Pn[i, j] += Pt[i, j]
     for i in range(n):
         for j in range(i + 1, n):
             v = 0.5 * (Pn[i, j] + Pn[j, i])
