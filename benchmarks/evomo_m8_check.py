@@ -24,6 +24,15 @@ module looks up (as ``/work/evomo-check/run_evomo.py`` did):
     SPEA/R with N offspring per generation (the first child of each of its N
     pairs) instead of EvoMO's 2N: the evaluation budget of Deb & Jain and ours.
 
+``--ours name:problem:seeds[:variant]`` runs the registry's algorithm under
+``bench_protocol``'s protocol with EvoMO's ingredients (``+``-joined) put into
+the objects it builds, never into library code: ``clipped-sbx`` (evox's SBX
+form, :class:`~moo.algorithms.operators.ClippedSBX`), ``evomo-norm`` (SPEA/R's
+min/max of the non-dominated set, skipped when one range is below 5 % of the
+largest), ``2n-offspring`` (2N offspring per generation), ``2x-gens`` (twice the
+generations: EvoMO's evaluations with N offspring), ``tournament`` (EFR-RR's
+rank tournament).
+
 ``score`` takes the non-dominated set of each final population, recomputes
 its objectives from ``X`` with the project's problem, and scores it with
 ``bench_protocol``'s functions: IGD to the 156 targets, the median distance to
@@ -127,6 +136,8 @@ def build_ours(bp, name: str, problem: str, seed: int, variant: str):
             algorithm.survival._normalized = evomo_normalization
         elif part == "raw":              # no normalisation at all
             algorithm.survival._normalized = lambda F, nondominated: F
+        elif part == "2x-gens":          # twice Deb & Jain's generations: EvoMO's evaluations with N offspring
+            termination = ("n_gen", 2 * termination[1])
         elif part == "tournament":       # EvoMO's EFR-RR mating: binary tournament on the rank
             from moo.algorithms.efr_rr import RankTournament
 
