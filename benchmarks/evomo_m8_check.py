@@ -3,7 +3,7 @@
 Two halves, two environments (neither imports the other's code; final populations go through ``.npz``):
 
     # EvoMO's algorithm, from the separate EvoMO venv (evomo 0.3.1, evox 1.4.0, torch CPU):
-    /work/evomo-venv/bin/python benchmarks/evomo_m8_check.py run --algorithm spear --problem dtlz3 \
+    <evomo-venv>/bin/python benchmarks/evomo_m8_check.py run --algorithm spear --problem dtlz3 \
         --seeds 0-4 [--variant shipped|n-offspring] [--operators protocol|evomo] [--dtype float64] --out X.npz
     # score those files, and run ours on the same seed numbers, from the project's venv:
     .venv/bin/python benchmarks/evomo_m8_check.py score X.npz ... [--ours spea-r:dtlz3:0-4 ...] [--out md]
@@ -13,7 +13,7 @@ on EvoMO's DTLZ problems (``n_var = M + k - 1``, k = 10), population 156 (EvoMO'
 ``uniform_sampling(156, 8)`` gives the same 120 + 36 two-layer Das-Dennis set as
 Deb & Jain, zeros read as 1e-6), for Deb & Jain's generation count. Nothing of
 EvoMO is copied: an option swaps one ingredient by rebinding a name EvoMO's
-module looks up (as ``/work/evomo-check/run_evomo.py`` did):
+module looks up:
 
 ``--operators protocol`` (default)
     SBX pc = 1, eta_c = 30 and polynomial mutation 1/n per variable, eta_m = 20
