@@ -122,11 +122,11 @@ individual-generations in the population, were picked as parents 0 times;
 with the resolution they are picked 927 times out of 1460).
 
 DTLZ1 with 8 objectives (Deb & Jain budget: population 156, 750
-generations) converges slowly, and some runs not at all: over seeds 0-19, 7
-runs end with a median distance ``sum f - 0.5`` of 0.7-4.7 (dense-front IGD
-3.9-11x NSGA-III's; non-convergence, not a collapse), and in none is the
-median point within 0.01 of the front (NSGA-III 0.0006-0.02, theta-DEA
-0.00007-0.004, seeds 0-9). The reason is the method's: nothing but the
+generations) does not converge: over seeds 0-19 the median distance
+``sum f - 0.5`` of the final set is 0.4-4.7 in 16 runs and never below 0.01
+(NSGA-III 0.0006-0.02, theta-DEA 0.00007-0.004, seeds 0-9); the 7 runs that
+count as failed (dense-front IGD 3.9-11x NSGA-III's) are the far end of
+that, a non-convergence, not a collapse. The reason is the method's: nothing but the
 front cut pushes towards the front, and at 8 objectives the cut is weak
 (``benchmarks/ddfc_dtlz1_m8.py``; generations 10-200, seeds 0-9):
 
@@ -139,30 +139,31 @@ front cut pushes towards the front, and at 8 objectives the cut is weak
   mutually non-dominated parents, and the FC winner is the one nearer the
   front in 49 % of them, a coin toss (47 % at 3 objectives). DD is scale
   free by construction.
-* Convergence therefore comes from Pareto dominance: the front cut removes
-  the dominated 86 of the 312 merged solutions per generation (28 %); at 3
-  objectives 73 of 184 (40 %), and DTLZ1 converges there (median distance
-  0.001-0.006, seeds 0-4).
+* Convergence therefore comes from the front cut alone: it removes the
+  dominated 86 of the 312 merged solutions per generation (28 %; at 5
+  objectives 150 of 424, 35 %; at 3, 73 of 184, 40 %; DTLZ1 converges at
+  both, median distance 0.001-0.006 and 0.002-0.008, seeds 0-4), while the
+  DD/FC choice within the first front leaves the median ``sum f`` of the
+  survivors at 0.98 of the front's.
 * FC's boundary bias helps indirectly. Compared at full precision (before
   the resolution, see "Readings") the mating tournament prefers the parents
-  nearest a face of the simplex; the population gathers there (4.1 of the 8
-  objectives below ``1e-4`` of the point's sum, 2.6 with the resolution),
-  solutions sharing near-zero objectives are compared by dominance in the
-  others, and the cut removes more (102 instead of 86). With the resolution
-  62 % of the non-dominated tournaments are between two FC values below it
-  and go to a random winner. Seeds 0-19: no failed run with full precision,
-  7 with the resolution; even so full precision stays at 1.7x NSGA-III's
-  median IGD (median distance 0.005-0.5). The resolution is kept for DTLZ4
-  (13 of 30 collapsed runs with it, 20 without, see above).
+  nearest a face of the simplex; the population gathers there (4.5 of the 8
+  objectives below ``1e-4`` of the point's sum, 3.2 with the resolution) and
+  the cut removes more (102 instead of 86), plausibly because solutions
+  sharing near-zero objectives are compared by dominance in the others. With
+  the resolution 62 % of the non-dominated tournaments are between two FC
+  values below it and go to a random winner. Seeds 0-19: no failed run with
+  full precision, 7 with the resolution; even so full precision stays at
+  1.7x NSGA-III's median IGD (median distance 0.005-0.5). The resolution is
+  kept for DTLZ4 (13 of 30 collapsed runs with it, 20 without, see above).
 
-Ruled out as the cause (seeds 0-9): the shared normalisation (ranges up to
-440 in the first generations, the hyperplane rejected in 79 % of
-generations 10-200): with the true ideal point 0 and nadir 0.5 instead no
-run failed, but none converged either (median distance 0.004-0.5); FC in raw
-units translated by the ideal point (PlatEMO's ``CalFC``): 2 failed, median
-distance 0.04-1.8; overflow or underflow: FC is computed in ratio form and
-no run warned; the greedy choice (``candidate_choice="best"``): 4 of
-seeds 0-4 failed.
+Not the cause (seeds 0-9): the shared normalisation, although its estimate
+is poor here (ranges up to 460 in the first generations, the hyperplane
+rejected in 79 % of generations 10-200): with the true ideal point 0 and
+nadir 0.5 no run fails, but none converges either (median distance
+0.004-0.5; the cut is not larger, 88, and why it helps was not traced);
+overflow or underflow (FC is computed in ratio form; no run warned); the
+greedy FC choice (``candidate_choice="best"``: 6 of 10 fail).
 """
 
 from __future__ import annotations
