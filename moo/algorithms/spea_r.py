@@ -100,6 +100,19 @@ argument).
 * Individuals with a NaN or infinite objective rank behind all others in
   the survival (:func:`~moo.algorithms.theta_dea.finite_first`) and count
   as infinitely far in the mating; the paper assumes finite objectives.
+
+Behaviour worth knowing
+-----------------------
+At 8 objectives, under Deb & Jain's budget with their operators, 6 of 10
+DTLZ3 runs do not converge (``benchmarks/results/protocol_m8.md``). EvoMO's
+SPEA/R does not either when it is given the same number of evaluations (3 of
+10 fail); as shipped it converges because it makes ``2N`` offspring per
+generation (twice the evaluations) with a clipped SBX, and ours given both
+converges too (1.14-1.34x NSGA-III's published median; either alone does
+not). On DTLZ2 the points lie 3x farther from the front than NSGA-III's with
+pymoo's bound-aware SBX and 0.71x the published median with the clipped one
+(:class:`~moo.algorithms.operators.ClippedSBX`), which also helps NSGA-III
+(``benchmarks/evomo_m8_check.py``, ``benchmarks/results/evomo_m8_check.md``).
 """
 
 from __future__ import annotations
