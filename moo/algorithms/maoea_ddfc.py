@@ -76,7 +76,9 @@ Readings where the paper leaves room
   population index). PlatEMO's ``CalFC`` floors FC at ``1e-6`` the same way
   (in raw units; ours are normalised). Measured on DTLZ4 (3 objectives,
   10000 evaluations, paper operators, seeds 0-29): 13 collapsed runs with
-  the floor in the tournament, 20 without it (see below).
+  the floor in the tournament, 20 without it (see below). The floor costs
+  convergence on DTLZ1 at 8 objectives (7 of 20 runs fail with it, none
+  without; "Behaviour worth knowing").
 * A solution exactly at the ideal point (``sum f~ = 0``) is projected to the
   simplex centre ``1/M``.
 * Coincident projections (distance 0) give ``DD = inf``: a duplicated
@@ -118,6 +120,52 @@ tournament against the axis points' ``1e-100`` and never became a parent
 (seed 10, first 40 generations: the points with ``x_1 > 0.97``, 56
 individual-generations in the population, were picked as parents 0 times;
 with the resolution they are picked 927 times out of 1460).
+
+DTLZ1 with 8 objectives (Deb & Jain budget: population 156, 750
+generations) does not converge: over seeds 0-19 the median distance
+``sum f - 0.5`` of the final set is 0.4-4.7 in 16 runs and never below 0.01
+(NSGA-III 0.0006-0.02, theta-DEA 0.00007-0.004, seeds 0-9); the 7 runs that
+count as failed (dense-front IGD 3.9-11x NSGA-III's) are the far end of
+that, a non-convergence, not a collapse. The reason is the method's:
+nothing but the front cut pushes towards the front, and at 8 objectives the
+cut is weak (``benchmarks/ddfc_dtlz1_m8.py``; generations 10-200, seeds
+0-9):
+
+* FC ranks a solution by its direction more than by its distance. On DTLZ1
+  ``f = (1 + g) h / 2`` with ``sum h = 1``, and FC is homogeneous of degree
+  1, so ``FC(f) = (1 + g) FC(h) / 2``: the direction term ``FC(h)`` runs from
+  ``1/M^2`` at the simplex centre to 0 on its boundary, and both tournaments
+  compare solutions of *different* directions (two random parents; the ``L``
+  least crowded candidates). 99 % of the mating tournaments are between
+  mutually non-dominated parents, and the FC winner is the one nearer the
+  front in 49 % of them, a coin toss (47 % at 3 objectives). DD is scale
+  free by construction.
+* Convergence therefore comes from the front cut alone: it removes the
+  dominated 86 of the 312 merged solutions per generation (28 %; at 5
+  objectives 150 of 424, 35 %; at 3, 73 of 184, 40 %; DTLZ1 converges at
+  both, median distance 0.001-0.006 and 0.002-0.008, seeds 0-4), while the
+  DD/FC choice within the first front leaves the median ``sum f`` of the
+  survivors at 0.98 of the front's.
+* FC's boundary bias helps indirectly. Compared at full precision (before
+  the resolution, see "Readings") the mating tournament prefers the parents
+  nearest a face of the simplex; the population gathers there (4.5 of the 8
+  objectives below ``1e-4`` of the point's sum, 3.2 with the resolution) and
+  the cut removes more (102 instead of 86), plausibly because solutions
+  sharing near-zero objectives are compared by dominance in the others. With
+  the resolution 62 % of the non-dominated tournaments are between two FC
+  values below it and go to a random winner. Seeds 0-19: no failed run with
+  full precision, 7 with the resolution; even so full precision stays at
+  1.7x NSGA-III's median IGD (median distance 0.005-0.5). The resolution is
+  kept for DTLZ4 (13 of 30 collapsed runs with it, 20 without, see above).
+
+Not the root cause (seeds 0-9): the shared normalisation, although its
+estimate is poor here (ranges up to 460 in the first generations, the
+hyperplane rejected in 79 % of generations 10-200): with the true ideal
+point 0 and nadir 0.5 no run fails, but the runs stay at 1.6x NSGA-III's
+median IGD (median distance 0.004-0.5; the cut is not larger, 88, and why
+it helps was not traced); overflow or underflow (FC is computed in ratio
+form; no run warned). The greedy FC choice (``candidate_choice="best"``)
+is worse: 6 of 10 fail.
 """
 
 from __future__ import annotations
