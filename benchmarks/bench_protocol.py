@@ -249,6 +249,22 @@ def tasks_for(args: argparse.Namespace) -> list[Task]:
     return tasks
 
 
+def parse_seeds(text: str) -> list[int]:
+    """Seeds given as ``first-last`` or a comma-separated list."""
+    lo, _, hi = text.partition("-")
+    return list(range(int(lo), int(hi) + 1)) if hi else [int(s) for s in text.split(",")]
+
+
+def print_collapses(variants: list[str], seeds: list[int], run) -> None:
+    """Markdown rows of collapsed runs per variant; ``run(variant, seed)`` returns ``(dense IGD, collapsed)``."""
+    print("| variant | collapsed | seeds collapsed | median dense-front IGD |\n|---|---|---|---|")
+    for variant in variants:
+        rows = [(s, *run(variant, s)) for s in seeds]
+        hit = [s for s, _, c in rows if c]
+        print(f"| {variant} | {len(hit)} of {len(seeds)} | {', '.join(map(str, hit)) or '-'} | "
+              f"{np.median([r[1] for r in rows]):.4f} |", flush=True)
+
+
 def _fmt(x: float) -> str:
     return "-" if not np.isfinite(x) else f"{x:.3e}"
 

@@ -118,15 +118,9 @@ def main(argv: list[str] | None = None) -> int:
                     "crowding-mating+float32,evomo-ops+no-dedup+crowding-mating+float32")
     ap.add_argument("--algorithm", default="bige", help="a registry name (crowding-mating: bige only)")
     args = ap.parse_args(argv)
-    lo, _, hi = args.seeds.partition("-")
-    seeds = list(range(int(lo), int(hi) + 1)) if hi else [int(s) for s in args.seeds.split(",")]
+    seeds = bp.parse_seeds(args.seeds)
     print(f"{args.algorithm}, DTLZ4 (M = 3), population 92, {bp.PAPER_EVALS} evaluations, seeds {args.seeds}\n")
-    print("| variant | collapsed | seeds collapsed | median dense-front IGD |\n|---|---|---|---|")
-    for variant in args.variants.split(","):
-        rows = [(s, *run(variant, s, args.algorithm)) for s in seeds]
-        hit = [s for s, _, c in rows if c]
-        print(f"| {variant} | {len(hit)} of {len(seeds)} | {', '.join(map(str, hit)) or '-'} | "
-              f"{np.median([r[1] for r in rows]):.4f} |", flush=True)
+    bp.print_collapses(args.variants.split(","), seeds, lambda v, s: run(v, s, args.algorithm))
     return 0
 
 
