@@ -238,9 +238,11 @@ def as_rng(seed, name: str = "seed") -> np.random.Generator:
 
 
 def check_choice(value, name: str, choices: Collection[str]) -> str:
-    """One of the strings ``choices``."""
-    if not isinstance(value, str) or value not in choices:
-        raise ValueError(f"{name} must be one of {', '.join(repr(c) for c in choices)}, got {value!r}")
+    """One of the strings ``choices``, matched exactly (case-sensitive); a non-string is a TypeError."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be one of {', '.join(map(repr, choices))}, got {type(value).__name__}")
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value
 
 

@@ -373,6 +373,10 @@ def test_newton_fallback_keeps_failures_flagged():
         assert list(new.reason) == list(rec.reason)
     with pytest.raises(ValueError, match="fallback must be one of 'recursion', 'newton'"):
         rc.rlqr_gains(plant, EF, EG, mu, fallback="fast")
+    with pytest.raises(ValueError, match="got 'Newton'"):           # exact, case-sensitive
+        rc.rlqr_gains(plant, EF, EG, mu, fallback="Newton")
+    with pytest.raises(TypeError, match="fallback must be one of 'recursion', 'newton', got int"):
+        rc.rlqr_gains(plant, EF, EG, mu, fallback=1)
 
 
 # ---------------------------------------------------------------------------- uncertainty object, stabilisability
