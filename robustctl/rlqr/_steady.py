@@ -139,9 +139,10 @@ def plain(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter: in
     if step is kkt_step:
         from . import _kernel
         X, iterations, active = _kernel.recursion(d, P0, tol, max_iter, DIVERGED)
-        return iterations, ~active & healthy(X), evaluate(X, d, _kernel.kkt_step)
-    X, iterations, settled = recursion(d, step, P0, tol, max_iter)
-    return iterations, settled, evaluate(X, d, step)
+        settled = ~active & healthy(X)
+    else:
+        X, iterations, settled = recursion(d, step, P0, tol, max_iter)
+    return iterations, settled, evaluate(X, d, _compiled(step))
 
 
 def doubling(d: Model, tol: float):
