@@ -241,8 +241,7 @@ def _hinf(name: str, ts: TableSetup, note: str, *, vertices=(), uncertainty=None
         Bw = np.column_stack([[0.0, 0.0, HINF_RHO_IMPULSE, 0.0], Gk[0] * HINF_KAPPA_SCALE])
     else:
         Bw = H_ONES
-    Cz = np.vstack([np.sqrt(Q), np.zeros((1, 4))])                 # z = [sqrt(Q) x; sqrt(R) u]
-    Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+    Cz, Dzu = rc.lq_output(Q, R)                                   # z = [sqrt(Q) x; sqrt(R) u]
     bound = ours if input_bound is None else input_bound
     extra = dict(u_max=truck.STEER_LIMIT, w_energy=1.0) if bound else {}
     ctrl = rc.design("hinf", truck.truck_plant(0.0), Bw=Bw, Cz=Cz, Dzu=Dzu, vertices=list(vertices) or None,

@@ -31,6 +31,7 @@ from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, Ran
 from .h2 import H2Controller, h2
 from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .lqr import lqr
+from .performance import lq_output
 from .plant import Plant
 from .regions import ConicSector, Disk, HalfPlane
 from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
@@ -46,4 +47,5 @@ __all__ = [
 ]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
             "RobustStability", "CostBound", "HinfBound", "WorstCase"]
+__all__ += ["lq_output"]
 __version__ = "0.1.0"

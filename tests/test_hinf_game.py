@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from robustctl import InfeasibleError, NormBounded, Plant
+from robustctl import InfeasibleError, NormBounded, Plant, lq_output
 from robustctl.errors import ConvergenceError
 from robustctl.hinf_game import hinf_game, with_input_memory
 from robustctl.hinf_riccati import hinf_riccati, riccati_level
@@ -30,10 +30,7 @@ def _random_case(seed, n=4, m=2, q=2):
 
 
 def _performance(Q, R):
-    n, m = Q.shape[0], R.shape[0]
-    Cz = np.vstack([scipy.linalg.sqrtm(Q).real, np.zeros((m, n))])
-    Dzu = np.vstack([np.zeros((n, m)), scipy.linalg.sqrtm(R).real])
-    return Cz, Dzu
+    return lq_output(Q, R)
 
 
 @pytest.mark.parametrize("seed", range(4))

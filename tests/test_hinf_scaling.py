@@ -49,8 +49,7 @@ DETERMINED = {"optimum-certified", "optimum"}
 def authors_truck():
     """The truck with the weights of the authors' code: z = [sqrt(Q) x; sqrt(R) u], Bw = H = ones."""
     Q, R = np.diag([1.0, 1.0, 25000.0, 100.0]), np.array([[33535.0]])
-    return (truck.truck_plant(0.0), np.ones((4, 1)), np.vstack([np.sqrt(Q), np.zeros((1, 4))]),
-            np.vstack([np.zeros((4, 1)), np.sqrt(R)]))
+    return (truck.truck_plant(0.0), np.ones((4, 1)), *rc.lq_output(Q, R))
 
 
 def scaled(perf: dict, a: float, b: float, **kw) -> dict:

@@ -181,8 +181,8 @@ def test_authors_designs_use_the_codes_values():
     # game-Riccati bisection (hinf_riccati) on the same (scaled) channels gives the same optimal gain
     from robustctl.hinf_riccati import hinf_riccati
     s = 1 / np.sqrt(R[0, 0])
-    ref = hinf_riccati(plant, Bw=np.ones((4, 1)), Cz=s * np.vstack([np.sqrt(Q), np.zeros((1, 4))]),
-                       Dzu=s * np.vstack([np.zeros((4, 1)), np.sqrt(R)]), rtol=1e-6)
+    Cz, Dzu = rc.lq_output(Q, R)
+    ref = hinf_riccati(plant, Bw=np.ones((4, 1)), Cz=s * Cz, Dzu=s * Dzu, rtol=1e-6)
     np.testing.assert_allclose(d["Hinf"].K, ref.K, rtol=2e-3)
     assert "no input bound" in d["Hinf"].note
 

@@ -180,7 +180,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     >>> from robustctl.hinf_riccati import hinf_riccati
     >>> from robustctl.models.truck import truck_plant
     >>> plant = truck_plant(0.0)
-    >>> Bw, Cz, Dzu = plant.G, np.vstack([np.eye(4), np.zeros((1, 4))]), np.vstack([np.zeros((4, 1)), [[1.0]]])
+    >>> Bw, (Cz, Dzu) = plant.G, rc.lq_output(np.eye(4), 1.0)
     >>> ctrl = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
     >>> round(ctrl.gamma_opt, 4), round(ctrl.gamma / ctrl.gamma_opt - 1, 6), ctrl.is_stabilizing()
     (1.2547, 0.001, True)
