@@ -30,6 +30,7 @@ from .design import design
 from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, RankConditionError, RobustCtlError
 from .h2 import H2Controller, h2
 from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
+from .input_memory import InputMemoryFeedback
 from .lqr import lqr
 from .performance import lq_output
 from .plant import Plant
@@ -47,5 +48,5 @@ __all__ = [
 ]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
             "RobustStability", "CostBound", "HinfBound", "WorstCase"]
-__all__ += ["lq_output"]
+__all__ += ["lq_output", "InputMemoryFeedback"]
 __version__ = "0.1.0"

@@ -70,13 +70,16 @@ its code, https://github.com/barbosafilipe/robust_lqr (the authors' set-up).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from dataclasses import fields as dataclass_fields
+from typing import Any, Literal
 
 import numpy as np
 
 from ._validation import as_batch, as_float_array, check_bool, check_choice, check_positive_scalar
 from .batchsim import DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
+from .input_memory import InputMemoryFeedback
 from .models import truck as _truck
 from .path import LaneChange, ReferencePath, Straight
 
@@ -445,6 +448,53 @@ class PathFollowing:
             sim = sim.with_input_map(np.ones((1, m)))
         res = sim.run(K, keep_trajectories=keep_trajectories, nan_gains=nan_gains, backend=backend)
         return PathFollowingResult(**vars(res), path=self.path, overloads=self.overloads)
+
+    def run_laws(self, laws: Sequence[InputMemoryFeedback], *, keep_trajectories: bool = True,
+                 backend: Literal["numba", "numpy"] = "numba") -> PathFollowingResult:
+        """Simulate a list of one-row laws, static and with input memory mixed, in their order.
+
+        The static laws (``K_input`` None) run as one batch of :meth:`run`,
+        those with input memory as a second one (``run(K, K_input=...)``); the
+        result's batch axis follows ``laws``.
+
+        Parameters
+        ----------
+        laws : sequence of InputMemoryFeedback
+            Laws ``u[k] = K e[k] (+ K_input alpha[k-1])`` with one-row ``K``
+            (1, 4) on the steering angle.
+        keep_trajectories : bool
+            False keeps only the MSE sums.
+        backend : {"numba", "numpy"}
+            Compiled kernel (default) or the numpy reference.
+
+        Returns
+        -------
+        PathFollowingResult
+            As :meth:`run`, B = ``len(laws)``.
+        """
+        laws = list(laws)
+        if not laws or not all(isinstance(law, InputMemoryFeedback) for law in laws):
+            raise TypeError("laws must be a non-empty sequence of robustctl.InputMemoryFeedback")
+        static = [b for b, law in enumerate(laws) if law.K_input is None]
+        memory = [b for b, law in enumerate(laws) if law.K_input is not None]
+        parts = []
+        if static:
+            parts.append(self.run(np.stack([laws[b].K for b in static]), keep_trajectories=keep_trajectories,
+                                  backend=backend))
+        if memory:
+            parts.append(self.run(np.stack([laws[b].K for b in memory]),
+                                  K_input=np.stack([Ku for b in memory if (Ku := laws[b].K_input) is not None]),
+                                  keep_trajectories=keep_trajectories, backend=backend))
+        if len(parts) == 1:
+            return parts[0]
+        order = np.argsort(static + memory)                                  # back to the laws' order
+        stacked: dict[str, Any] = {}
+        for f in dataclass_fields(parts[0]):
+            a, b = getattr(parts[0], f.name), getattr(parts[1], f.name)
+            batched = f.name in ("errors", "inputs", "sq_error_sum", "sq_state_sum", "diverged", "diverged_step",
+                                 "saturated_steps")
+            stacked[f.name] = np.concatenate([a, b])[order] if batched and a is not None else a
+        return PathFollowingResult(**stacked)
 
     def _run_with_memory(self, K, K_input, keep, nan_gains, backend) -> PathFollowingResult:
         if self._given_map:
