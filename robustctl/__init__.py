@@ -15,6 +15,7 @@ True
 Sign convention everywhere: ``u = K x``.
 """
 
+from ._margins_report import MarginsReport, margins_report
 from .analysis import (
     CostBound,
     HinfBound,
@@ -48,5 +49,5 @@ __all__ = [
 ]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
             "RobustStability", "CostBound", "HinfBound", "WorstCase"]
-__all__ += ["lq_output", "InputMemoryFeedback"]
+__all__ += ["lq_output", "InputMemoryFeedback", "margins_report", "MarginsReport"]
 __version__ = "0.1.0"

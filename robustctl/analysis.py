@@ -844,3 +844,4 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     worst = A + H @ best_D @ E
     return WorstCase(_frozen(best_D), _radius(worst, discrete), not is_stable(worst, discrete=discrete), nominal,
                      obj.count)
+from ._margins_report import MarginsReport, margins_report  # noqa: E402, F401 (re-exported: the margins report)
