@@ -21,7 +21,8 @@
 4. The most frequent winner is ``z*``; its certified robust-stability margin
    (:func:`robustctl.robust_stability`) is reported: applied, against the
    payload polytope (0-300 %) and the appendix's norm-bounded model
-   (:func:`paper_repro.mse_table.margins`); generic, against the problem's
+   (:func:`robustctl.analysis.margins_report` with the models of
+   ``truck_margins.py``); generic, against the problem's
    true norm-bounded uncertainty ``H Delta [EF_true EG_true]``.
 
 ``--setup`` (applied problem only): ``ours`` (default) or ``authors``, the
@@ -53,9 +54,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-if __package__ in (None, ""):                      # run as a script: make the repository importable
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from truck_margins import truck_margins
 
 import robustctl as rc
 from moo.algorithms import ALGORITHMS
@@ -63,7 +62,6 @@ from moo.problems.applied import AppliedRLQRProblem
 from moo.problems.generic import GenericRLQRProblem
 from moo.problems.selection import DesignSelection, error_scales, select_design
 from moo.runner import run as run_moea
-from paper_repro.mse_table import Design, margins
 from robustctl.pathfollow import SETUPS
 
 DEFAULT_SIMS = {"generic": 1000, "applied": 200}
@@ -94,7 +92,8 @@ def winner_margins(problem, K: np.ndarray) -> dict[str, float | None]:
     if not np.all(np.isfinite(K)):
         return {}
     if isinstance(problem, AppliedRLQRProblem):
-        found = margins(Design("winner", K, ""))
+        steer = rc.InputMemoryFeedback(K.sum(axis=0, keepdims=True))       # alpha = u1 + ... + um
+        found = dict(truck_margins({"winner": steer}).results["winner"])
     else:
         unc = rc.NormBounded(problem.H, problem.EF_true, problem.EG_true)
         found = {"true norm-bounded uncertainty": rc.robust_stability((problem.plant, K), unc)}

@@ -17,7 +17,7 @@ the ANOVA/Tukey comparisons (:mod:`moo.stats`), and prints
    bold, ``^a`` a significant difference in its favour (Tukey HSD, 95 %),
    ``^*`` the best over the table);
 2. a cell-by-cell comparison with the paper's published table
-   (:mod:`paper_repro.paper_moea_values`), for ``generic`` and ``applied``;
+   (``paper_moea_values.py``), for ``generic`` and ``applied``;
 3. the mean Friedman ranks of all 20 variants per indicator (IGD+ too, as
    the library's statistics), with the Nemenyi critical difference
    (:func:`moo.stats.friedman`);
@@ -32,7 +32,7 @@ specified), so HV, IGD, PD magnitudes are not comparable. Compared per cell
 ``mean(MO-LSP) - mean(plain)``, and whether the difference is significant
 (the paper's "a" on either row; ours Tukey p < 0.05). Comparing signs, not
 "better" labels, sidesteps the paper's reading of SP (it bolds the larger SP,
-see :mod:`paper_repro.paper_moea_values`). The script counts the cells whose
+see ``paper_moea_values.py``). The script counts the cells whose
 direction agrees, and those whose direction and significance both agree.
 
 Defaults (5 runs, 2000 evaluations, all ten MOEAs, 2 workers) take a few
@@ -55,9 +55,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-if __package__ in (None, ""):                      # run as a script: make the repository importable
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from paper_moea_values import INDICATORS, PAPER_LABELS, PAPER_MOEA, paper_cell
 
 from moo.algorithms import ALGORITHMS
 from moo.executors import open_executor
@@ -76,7 +74,7 @@ from moo.stats import (
     to_markdown,
 )
 from moo.store import load_records
-from paper_repro.paper_moea_values import INDICATORS, PAPER_LABELS, PAPER_MOEA, paper_cell
+from moo.tables import markdown_table, write_csv
 
 
 @dataclass(frozen=True)
@@ -130,10 +128,7 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
         return ""
     algs = list(dict.fromkeys(c.algorithm for c in cells))
     by = {(c.algorithm, c.indicator): c for c in cells}
-    lines = [(f"MO-LSP effect, paper vs ours ({problem}): sign of mean(MO-LSP) - mean(plain), "
-              "sig = significant at 95 % (paper: mark 'a'; ours: Tukey p < 0.05); '=' agree, 'x' differ"), "",
-             "| MOEA | " + " | ".join(LABELS[n] for n in INDICATORS) + " |",
-             "|---|" + "---|" * len(INDICATORS)]
+    rows = []
     for alg in algs:
         cells_txt = []
         for name in INDICATORS:
@@ -144,7 +139,10 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
             tag = "=" if c.full_agreement else ("~" if c.direction_agrees else "x")
             cells_txt.append(f"paper {_effect(c.paper_sign, c.paper_significant)} / "
                              f"ours {_effect(c.our_sign, c.our_significant)} {tag}")
-        lines.append(f"| {PAPER_LABELS.get(alg, alg)} | " + " | ".join(cells_txt) + " |")
+        rows.append([PAPER_LABELS.get(alg, alg), *cells_txt])
+    lines = [(f"MO-LSP effect, paper vs ours ({problem}): sign of mean(MO-LSP) - mean(plain), "
+              "sig = significant at 95 % (paper: mark 'a'; ours: Tukey p < 0.05); '=' agree, 'x' differ"), "",
+             markdown_table(["MOEA", *(LABELS[n] for n in INDICATORS)], rows)]
     n = len(cells)
     nd = sum(c.direction_agrees for c in cells)
     nf = sum(c.full_agreement for c in cells)
@@ -161,11 +159,10 @@ def comparison_markdown(problem: str, cells: Sequence[CellAgreement]) -> str:
 
 
 def _agreement_csv(cells: Sequence[CellAgreement], path: Path) -> None:
-    rows = [("algorithm,indicator,paper_sign,paper_significant,our_sign,our_significant,our_p_tukey,"
-             "direction_agrees,full_agreement")]
-    rows += [f"{c.algorithm},{c.indicator},{c.paper_sign},{c.paper_significant},{c.our_sign},"
-             f"{c.our_significant},{c.our_p_tukey!r},{c.direction_agrees},{c.full_agreement}" for c in cells]
-    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    write_csv(["algorithm", "indicator", "paper_sign", "paper_significant", "our_sign", "our_significant",
+               "our_p_tukey", "direction_agrees", "full_agreement"],
+              ([c.algorithm, c.indicator, c.paper_sign, c.paper_significant, c.our_sign, c.our_significant,
+                repr(c.our_p_tukey), c.direction_agrees, c.full_agreement] for c in cells), path)
 
 
 def _parser() -> argparse.ArgumentParser:

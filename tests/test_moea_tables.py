@@ -6,10 +6,10 @@ import re
 from pathlib import Path
 
 import pytest
+from moea_tables import agreements, comparison_markdown, main
+from paper_moea_values import CORRECTIONS, INDICATORS, PAPER_MOEA, paper_cell
 
 from moo.stats import Comparison
-from paper_repro.moea_tables import agreements, comparison_markdown, main
-from paper_repro.paper_moea_values import CORRECTIONS, INDICATORS, PAPER_MOEA, paper_cell
 
 ALGS = ("nsga2", "nsga3", "theta-dea", "mombi2", "moea-igd-ns", "efr-rr", "maoea-ddfc", "spea-r",
         "spea2-sde", "bige")

@@ -7,12 +7,13 @@ import sys
 from pathlib import Path
 
 import control
+import mse_table
 import numpy as np
 import pytest
+from paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS, PAPER_MSE, paper_winner
+from truck_margins import truck_margins
 
 import robustctl as rc
-from paper_repro import mse_table
-from paper_repro.paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS, PAPER_MSE, paper_winner
 from robustctl.hinf_game import hinf_game
 from robustctl.models import truck
 from robustctl.path import default_route
@@ -244,7 +245,7 @@ def test_one_choice_at_a_time_switches_only_that_choice():
 
 def test_margins_of_a_design_match_the_analysis_engine():
     d = next(x for x in mse_table.design_controllers(setup="authors") if x.name == "LQR")
-    m = mse_table.margins(d)
+    m = truck_margins({d.name: d.law}).results[d.name]
     plant = truck.truck_plant(0.0)
     ref = rc.robust_stability((plant, d.K_steer), vertices=[truck.truck_plant(k) for k in (100.0, 200.0, 300.0)])
     assert m["polytope 0-300 %"].margin == pytest.approx(ref.margin, rel=1e-6)

@@ -9,6 +9,7 @@ quadratic form, and python-control's dlqr.
 import json
 
 import control
+import design_selection
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -30,7 +31,6 @@ from moo.problems.selection import (
     overload_from_delta,
     select_design,
 )
-from paper_repro import design_selection
 from robustctl.models import truck
 from robustctl.path import default_route
 from robustctl.simulate import simulate
