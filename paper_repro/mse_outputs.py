@@ -47,7 +47,7 @@ class Agreement:
 
 def agreement(mse: dict) -> Agreement:
     """Winners, pairwise order over the 6 pairs x 16 cells, and the 64 ours/paper ratios."""
-    cs = _compared(mse)
+    cs = compared_controllers(mse)
     if len(cs) < 2:
         raise ValueError(f"agreement needs at least two of the paper's controllers, got {cs}")
     winners, agree, pairs, by = 0, 0, 0, {}
@@ -68,12 +68,11 @@ def agreement(mse: dict) -> Agreement:
                      {o: float(np.median(v)) for o, v in by.items()})
 
 
-
 def _winner(values: dict[str, float]) -> str:
     return min(values, key=values.get)
 
 
-def _compared(mse: dict) -> list[str]:
+def compared_controllers(mse: dict) -> list[str]:
     """The paper's controllers present in ``mse`` (winners are taken among these, in both tables)."""
     return [c for c in CONTROLLERS if c in mse[OBJECTIVES[0]]]
 
@@ -96,7 +95,7 @@ def format_table(mse: dict, names: list[str], measure: str = "tracking") -> str:
                 paper = PAPER_MSE[obj].get(name, (None,) * 4)[i]
                 row += f"{mse[obj][name][i]:>12.4e}" + (f"{paper:>11.3e}" if paper is not None else f"{'':>11}")
             lines.append(row)
-        cs = _compared(mse)
+        cs = compared_controllers(mse)
         if not cs:
             continue
         ours = [_winner({c: mse[obj][c][i] for c in cs}) for i in range(4)]
@@ -106,8 +105,8 @@ def format_table(mse: dict, names: list[str], measure: str = "tracking") -> str:
                      + "".join(f"{f'{a}/{b}':>23}" for a, b in zip(ours, paper, strict=True)))
         lines.append("")
     lines.append(f"Best controller agrees with the paper in {agree} of 16 cells "
-                 f"(winners among {', '.join(_compared(mse))}).")
-    if len(_compared(mse)) == len(CONTROLLERS):
+                 f"(winners among {', '.join(compared_controllers(mse))}).")
+    if len(compared_controllers(mse)) == len(CONTROLLERS):
         lines.append("Agreement: " + agreement(mse).line() + ".")
     return "\n".join(lines)
 
@@ -118,7 +117,7 @@ def write_tables(out: Path, stem: str, mse: dict, names: list[str], *, latex: bo
               ([obj, name, ov, f"{mse[obj][name][i]:.10e}"]
                for obj in OBJECTIVES for name in names for i, ov in enumerate(OVERLOADS)),
               out / f"{stem}.csv", lineterminator="\r\n")
-    cs = _compared(mse) or names
+    cs = compared_controllers(mse) or names
     best = {obj: [_winner({c: mse[obj][c][i] for c in cs}) for i in range(4)] for obj in OBJECTIVES}
     rows = []
     for obj in OBJECTIVES:

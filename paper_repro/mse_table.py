@@ -88,6 +88,10 @@ Writes ``DIR/mse_table.csv`` (``objective,controller,overload,mse``),
 ``agreement.md``, ``margins.md``, ``margins.csv`` and, unless
 ``--no-figures``, ``response_<overload>.png`` (global position and steering)
 and ``errors_<overload>.png`` (the four error signals).
+
+The script's sibling modules: ``mse_designs.py`` (set-ups and designs),
+``mse_outputs.py`` (tables and agreement), ``mse_figures.py`` and
+``truck_margins.py`` (the models of the margins report).
 """
 
 from __future__ import annotations
@@ -104,8 +108,8 @@ from mse_designs import CHOICES, COURSES, TABLE_SETUPS, Design, TableSetup, get_
 from mse_figures import make_figures
 from mse_outputs import (
     Agreement,
-    _compared,
     agreement,
+    compared_controllers,
     format_table,
     winner_agreement,
     write_agreement,
@@ -138,7 +142,6 @@ def simulate_designs(designs: list[Design], ts: TableSetup, path, *, keep_trajec
     return sim.run_laws([d.law for d in designs], keep_trajectories=keep_trajectories, backend=backend)
 
 
-
 def table_for(ts: TableSetup, *, z=truck.RLQR_MOP_Z, uncertainty: str = "printed", measure: str = "tracking",
               duration: float | None = None, backend: str = "numba") -> dict:
     """The paper's four controllers in set-up ``ts``: ``{objective: {controller: (4,)}}`` (no outputs)."""
@@ -162,7 +165,6 @@ def compare_setups(*, duration: float | None = None, measure: str = "tracking", 
             rows.append((base_name, label, a))
             log(f"  {base_name:>7} | {label:<32} | {a.line()}")
     return rows
-
 
 
 # -- main ---------------------------------------------------------------------------------
@@ -243,7 +245,7 @@ def run(out: Path, *, setup: str | TableSetup = DEFAULT_SETUP, course: str | Non
     log(f"With {other} errors instead (mse_table_{other}.*): the best controller agrees with the "
         f"paper in {winner_agreement(tables[other])} of 16 cells.")
     log(limit_text(limit))
-    if len(_compared(mse)) == len(CONTROLLERS):
+    if len(compared_controllers(mse)) == len(CONTROLLERS):
         rows = [(ts.name, agreement(mse))]
         for name, other_ts in TABLE_SETUPS.items():
             if name != ts.name:
