@@ -1,6 +1,6 @@
 """Certified robust-stability margins of several controllers against named uncertainty models.
 
-:func:`margins_report` runs :func:`robustctl.analysis.robust_stability` for
+:func:`margins_report` runs :func:`robustctl.robust_stability` for
 every (controller, model) pair and returns a :class:`MarginsReport`, a small
 table with text, Markdown and CSV writers. A model is a norm-bounded
 uncertainty ``[dF dG] = H Delta [EF EG]`` (margin: the largest ``r`` with
