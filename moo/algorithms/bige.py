@@ -149,7 +149,7 @@ ours: single precision 2 of 30, the crowding-first tournament 2, both 0.
 EvoMO's other departures do not matter: clipped SBX, a mutation
 probability of ``1/n^2`` per variable (``pro_m = 1/n`` divided by ``n``
 again) and no duplicate elimination give 10 of 30 together. No defect
-here (``benchmarks/dtlz4_bige_ingredients.py``,
+here (``benchmarks/investigations/dtlz4_bige_ingredients.py``,
 ``benchmarks/results/dtlz4_bige_ingredients.md``).
 """
 

@@ -128,7 +128,7 @@ generations) does not converge: over seeds 0-19 the median distance
 count as failed (dense-front IGD 3.9-11x NSGA-III's) are the far end of
 that, a non-convergence, not a collapse. The reason is the method's:
 nothing but the front cut pushes towards the front, and at 8 objectives the
-cut is weak (``benchmarks/ddfc_dtlz1_m8.py``; generations 10-200, seeds
+cut is weak (``benchmarks/investigations/many_objectives_ddfc_dtlz1.py``; generations 10-200, seeds
 0-9):
 
 * FC ranks a solution by its direction more than by its distance. On DTLZ1

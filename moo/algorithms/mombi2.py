@@ -109,7 +109,7 @@ At 8 objectives under Deb & Jain's protocol (DTLZ2, population 156, the
 two-layer 120 + 36 directions, 500 generations) the IGD to the 156 targets is
 about 3.5x NSGA-III's published median although the points are on the front
 (median distance 2-4e-5). It is the ASF, not a defect (measured on seeds 0-2 by
-``benchmarks/mombi2_m8_placement.py``; ``benchmarks/results/protocol_m8.md``):
+``benchmarks/investigations/many_objectives_mombi2_placement.py``; ``benchmarks/results/protocol_m8.md``):
 every direction has exactly one final point nearest to it by angle, the first
 R2 rank is the whole population, and each point is the ASF winner of its own
 weight. But the ASF winner is not the point nearest the target:

@@ -27,7 +27,7 @@ Readings (see PAPER_NOTES.md):
   MOPs the form makes no significant difference (NSGA-II, NSGA-III,
   SPEA2+SDE, theta-DEA; 10 seeds; hypervolume rank-sum p 0.10-1.00), although
   the clipped form leaves up to 11 % of the final variables exactly on a
-  bound (``benchmarks/sbx_form_mops.py``).
+  bound (``benchmarks/investigations/operators_sbx_form_mops.py``).
 * DTLZ4 (3 objectives, population 92), measured. ``x^100`` leaves a random
   population about ``92 x 0.03 = 2.8`` points with ``x_1 > 0.97`` and as many
   with ``x_2 > 0.97``, the only ones away from the ``f_1`` axis. When these
@@ -54,7 +54,7 @@ Readings (see PAPER_NOTES.md):
   with PlatEMO's own defaults (clipped SBX, ``pm = 1/n``) 6, 7, 9, 9 and 5.
   Given 600 generations (Deb & Jain's budget) NSGA-III regains a lost region
   (0 of 10 runs collapsed); MOEA/IGD-NS, MaOEA-DDFC and SPEA2+SDE do not.
-  Why, measured (``benchmarks/dtlz4_regain.py``): once a region is lost,
+  Why, measured (``benchmarks/investigations/dtlz4_regain.py``): once a region is lost,
   its objective, say ``f_3``, is ``1e-30`` or less in every survivor; pymoo's
   normalisation (Blank, Deb & Roy 2019's fall-backs) then rejects the
   hyperplane and, the front's range being ``<= 1e-6``, divides ``f_3`` by the

@@ -73,7 +73,7 @@ budget (NSGA-III 0); ``normalize=False`` gives the same counts (10 and 8).
 Plain SPEA2 collapses as often at the paper's setting: this module with
 Euclidean distances in 8 of 30 runs, pymoo's ``SPEA2`` (an independent
 implementation) in 13 of 30, 10 with its normalisation; under the Deb & Jain
-budget 5 and 4 of 10 (``benchmarks/dtlz4_spea2_peer.py``). The
+budget 5 and 4 of 10 (``benchmarks/investigations/dtlz4_spea2_peer.py``). The
 shared cause, measured, is in :mod:`moo.algorithms.operators`: DTLZ4's few
 points off the axis are dominated in the first generations, and SPEA2 fills
 the archive by raw fitness (Zitzler et al. 2001, Sec. 3.2), so they go first

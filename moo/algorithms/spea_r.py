@@ -112,7 +112,7 @@ converges too (1.14-1.34x NSGA-III's published median; either alone does
 not). On DTLZ2 the points lie 3x farther from the front than NSGA-III's with
 pymoo's bound-aware SBX and 0.71x the published median with the clipped one
 (:class:`~moo.algorithms.operators.ClippedSBX`), which also helps NSGA-III
-(``benchmarks/evomo_m8_check.py``, ``benchmarks/results/evomo_m8_check.md``).
+(``benchmarks/investigations/many_objectives_evomo_check.py``, ``benchmarks/results/evomo_m8_check.md``).
 """
 
 from __future__ import annotations
