@@ -30,10 +30,14 @@ extensions = [
     "sphinx_gallery.gen_gallery",
     "apipages",
     "papertables",
+    "benchresults",
+    "myst_parser",                # the benchmark result files (Markdown) in validation/results/
 ]
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 
 root_doc = "index"
-exclude_patterns = ["_build", "_generated", "**.ipynb_checkpoints", "examples/README.rst"]
+exclude_patterns = ["_build", "_generated", "**.ipynb_checkpoints", "examples/README.rst", "README.md",
+                    "_intersphinx"]
 templates_path = ["_templates"]
 nitpicky = True
 
