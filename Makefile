@@ -49,4 +49,4 @@ docs: $(DSTAMP)
 	@echo "docs: open docs/_build/html/index.html"
 
 clean:
-	rm -rf $(VENV) out .pytest_cache docs/_build docs/api docs/auto_examples docs/_generated docs/sg_execution_times.rst
+	rm -rf $(VENV) out .pytest_cache docs/_build docs/api docs/auto_examples docs/_generated docs/validation/results docs/sg_execution_times.rst

@@ -24,15 +24,20 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.intersphinx",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",     # MathJax 3 shipped in _static/mathjax: no page loads maths from the network
     "sphinx.ext.viewcode",
     "numpydoc",
     "sphinx_gallery.gen_gallery",
     "apipages",
     "papertables",
+    "benchresults",
+    "myst_parser",                # the benchmark result files (Markdown) in validation/results/
 ]
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 
 root_doc = "index"
-exclude_patterns = ["_build", "_generated", "**.ipynb_checkpoints", "examples/README.rst"]
+exclude_patterns = ["_build", "_generated", "**.ipynb_checkpoints", "examples/README.rst", "README.md",
+                    "_intersphinx"]
 templates_path = ["_templates"]
 nitpicky = True
 

@@ -11,19 +11,12 @@ import numpy as np
 import pytest
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
-from pymoo.indicators.igd import IGD
-from pymoo.optimize import minimize
-from pymoo.problems import get_problem
-from pymoo.util.ref_dirs import get_reference_directions
 
-from moo.algorithms import make_algorithm
 from moo.algorithms._base import BinaryTournament
 from moo.algorithms.bige import (
-    BiGE,
     BiGESurvival,
     _bige_tournament,
     bige_estimation,
-    make_bige,
     niche_radius,
 )
 
@@ -240,39 +233,4 @@ def test_mating_selection_is_a_binary_tournament_with_replacement():
 
 # ----------------------------------------------------------------------------- whole runs
 
-def test_registry_and_factory():
-    alg = make_algorithm("bige", n_obj=3)
-    assert isinstance(alg, BiGE) and alg.pop_size == 92
 
-
-def test_dtlz2_igd_comparable_to_nsga3():
-    # 2000 evaluations, 3 objectives: measured IGD ~0.09 for both (NSGA-III 0.086 +- 0.006)
-    problem = get_problem("dtlz2", n_obj=3)
-    pf = problem.pareto_front(get_reference_directions("das-dennis", 3, n_partitions=30))
-    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 2000), seed=1)
-    ref = minimize(problem, make_algorithm("nsga3", n_obj=3), ("n_eval", 2000), seed=1)
-    ours, theirs = IGD(pf)(res.F), IGD(pf)(ref.F)
-    assert ours < 1.5 * theirs, (ours, theirs)
-    assert np.median(np.abs(np.linalg.norm(res.F, axis=1) - 1.0)) < 0.05
-
-
-def test_dtlz1_converges_to_the_linear_front():
-    # DTLZ1 (3 objectives, n_var 7): the front is sum f = 0.5. 30000 evaluations (~3.5 s): at 20000 a run can
-    # still sit on the local front sum f = 1 (seed 1 did once the initial population went through the survival)
-    problem = get_problem("dtlz1", n_obj=3)
-    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 30000), seed=1)
-    s = res.F.sum(axis=1)
-    assert abs(np.median(s) - 0.5) < 0.01, np.median(s)
-    assert np.mean(np.abs(s - 0.5) < 0.05) > 0.9
-    # not collapsed: each objective spans at least half of the front's range [0, 0.5]. BiGE keeps
-    # no extreme points on purpose (measured spans with this seed: 0.50, 0.50, 0.38)
-    assert np.all(res.F.max(axis=0) - res.F.min(axis=0) > 0.25)
-
-
-def test_constrained_problem_c2dtlz2():
-    # C2-DTLZ2: only regions of the unit sphere are feasible. 3000 evaluations: measured median
-    # | ||f|| - 1 | 0.005-0.013 over seeds 0-2; every survivor feasible.
-    problem = get_problem("c2dtlz2", n_obj=3)
-    res = minimize(problem, make_bige(n_obj=3), ("n_eval", 3000), seed=0)
-    assert np.all(res.pop.get("FEAS"))
-    assert np.median(np.abs(np.linalg.norm(res.F, axis=1) - 1.0)) < 0.03

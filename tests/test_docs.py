@@ -56,3 +56,25 @@ def test_api_index_links_every_package(html):
     text = (html / "api.html").read_text(encoding="utf-8")
     for page in ("api/robustctl.html", "api/moo.html"):
         assert page in text
+
+
+SCRIPT_SRC = re.compile(r"<script\b[^>]*\bsrc=\"([^\"]+)\"", re.IGNORECASE)
+# sphinx-gallery's computation-time pages sort their table with DataTables from a CDN (no maths on them)
+REMOTE_OK = "sg_execution_times.html"
+
+
+def test_maths_renderer_is_bundled(html):
+    """No page loads MathJax (or any script but the timing table's) from the network; MathJax is in _static."""
+    pages = sorted(html.rglob("*.html"))
+    remote = {(p.relative_to(html).as_posix(), src) for p in pages if p.name != REMOTE_OK
+              for src in SCRIPT_SRC.findall(p.read_text(encoding="utf-8"))
+              if re.match(r"(https?:)?//", src)}
+    assert not remote, f"pages load scripts from the network: {sorted(remote)[:5]}"
+    maths = [p for p in pages if 'class="math' in p.read_text(encoding="utf-8")]
+    assert maths, "no page has maths (the check would be empty)"
+    for page in maths[:3]:
+        srcs = SCRIPT_SRC.findall(page.read_text(encoding="utf-8"))
+        mathjax = [s for s in srcs if "mathjax" in s.lower()]
+        assert mathjax, f"{page.name} has maths but no MathJax script"
+        for src in mathjax:
+            assert (page.parent / src.split("?")[0]).resolve().is_file(), f"{page.name}: {src} not in the build"

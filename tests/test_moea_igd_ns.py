@@ -19,14 +19,10 @@ import numpy as np
 import pytest
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
-from pymoo.indicators.igd import IGD
 from pymoo.optimize import minimize
 from pymoo.problems import get_problem
-from pymoo.util.ref_dirs import get_reference_directions
 
-from moo.algorithms import make_algorithm
 from moo.algorithms.moea_igd_ns import (
-    MOEAIGDNS,
     IGDNSSurvival,
     igd_ns,
     igd_ns_deletion_scores,
@@ -35,7 +31,6 @@ from moo.algorithms.moea_igd_ns import (
     truncate_by_angle,
     update_archive,
 )
-from moo.algorithms.nsga import make_nsga3
 
 PROBLEM2 = Problem(n_var=1, n_obj=2)
 
@@ -197,31 +192,6 @@ def test_survival_any_merged_size():
         pop = Population.new(X=rng.random((n, 2)), F=rng.random((n, 3)))
         assert len(surv.do(problem, pop, n_survive=20)) == 20
     assert len(surv.archive) <= 50
-
-
-# ----------------------------------------------------------------------------- whole runs
-def test_registry_and_defaults():
-    alg = make_algorithm("moea-igd-ns", n_obj=3)
-    assert isinstance(alg, MOEAIGDNS)
-    assert alg.pop_size == 92 and alg.survival.archive_size == 460
-
-
-def test_dtlz2_quality_against_nsga3():
-    problem = get_problem("dtlz2", n_obj=3)
-    igd = IGD(problem.pareto_front(get_reference_directions("das-dennis", 3, n_partitions=40)))
-    ours = np.mean([igd(minimize(problem, make_moea_igd_ns(n_obj=3), ("n_eval", 2000), seed=s).F) for s in (0, 1)])
-    peer = np.mean([igd(minimize(problem, make_nsga3(n_obj=3), ("n_eval", 2000), seed=s).F) for s in (0, 1)])
-    assert ours < 1.5 * peer, (ours, peer)
-    assert ours < 0.15
-
-
-def test_dtlz1_reaches_linear_front():
-    problem = get_problem("dtlz1", n_obj=3)
-    res = minimize(problem, make_moea_igd_ns(n_obj=3), ("n_eval", 20000), seed=1)
-    s = res.F.sum(axis=1)
-    assert abs(np.median(s) - 0.5) < 0.02, np.median(s)
-    assert np.mean(np.abs(s - 0.5) < 0.05) > 0.9
-    assert np.all(res.F.max(axis=0) - res.F.min(axis=0) > 0.4)
 
 
 def test_archive_on_runs_wrapped_with_molsp():

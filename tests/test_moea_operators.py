@@ -71,7 +71,15 @@ def test_variation_operators_carry_the_settings():
     assert ops["crossover"].prob.value == 0.9 and ops["crossover"].eta.value == 15.0
     assert isinstance(ops["mutation"], PaperPM)
     assert ops["mutation"].expected_mutations == 2.0 and ops["mutation"].eta.value == 25.0
-    assert PAPER_OPERATORS.mutation_rate == 0.5
+
+
+def test_paper_operators_mutate_half_a_variable_per_offspring_on_average():
+    # the reproduced paper's PlatEMO proM = 0.5: over 10000 offspring of 8 variables, 0.5 mutated per offspring
+    ops = variation_operators(PAPER_OPERATORS)
+    X = np.full((10000, 8), 0.5)
+    Y = ops["mutation"]._do(_Box(8), X.copy(), random_state=np.random.default_rng(0))
+    per_offspring = np.mean(np.sum(Y != X, axis=1))
+    assert per_offspring == pytest.approx(0.5, abs=0.03)        # sd of the mean about 0.007
 
 
 def test_paper_pm_mutates_expected_number_of_variables():

@@ -51,10 +51,8 @@ Readings where the papers leave room
   polynomial mutation produce at the bounds of the variables, e.g. DTLZ2's
   ``x_1 = 0``) costs only its axis term, about 1.03. Such a point, found in
   an early generation, is then never replaced, and the intercept stays 1-3 %
-  too large for the rest of the run (measured on DTLZ2 with 3 objectives;
-  theta-DEA's median IGD under the Deb & Jain protocol, 20 runs, is 1.82e-3
-  with the ASF as printed and 1.07e-3 with the rule below, NSGA-III's
-  published value being 1.36e-3). The
+  too large for the rest of the run (measured on theta-DEA:
+  :ref:`validation-theta-dea`). The
   theta-DEA authors' code (yyxhdy/ManyEAs, ``ThetaDEA.asfFunction``)
   computes the ASF exactly as printed and has the same flaw. pymoo's
   NSGA-III (``get_extreme_points_c``, read, not copied) sets the terms below

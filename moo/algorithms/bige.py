@@ -66,16 +66,13 @@ Readings where the paper leaves a choice
   sorts all of ``Q`` into bi-goal layers ("the candidate set Q is divided
   into different layers by the nondominated sorting procedure with respect
   to the two goals"); Sec. 4 says the experiments put an objective-space
-  non-dominated sorting in front of it. Three readings were measured
-  (DTLZ2, 10000 evaluations, population 92, seeds 0-9; mean IGD over
-  NSGA-III's, +- one standard error): (a) this module -- goals on the
-  critical front only, the reading of PlatEMO's implementation, which the
-  reproduced paper ran -- 1.54 +- 0.03 (M = 3), 1.34 +- 0.01 (M = 4);
-  (b) goals estimated on all of ``Q`` (normalisation and neighbours), bi-goal
-  layers on the critical front only: 1.51 +- 0.02, 1.32 +- 0.03, not
-  distinguishable from (a); (c) Alg. 3 literally, no objective-space
-  sorting: 2.30 +- 0.05, 1.55 +- 0.04, and it contradicts Sec. 4. (a) is
-  kept.
+  non-dominated sorting in front of it. Three readings were compared:
+  (a) this module -- goals on the critical front only, the reading of
+  PlatEMO's implementation, which the reproduced paper ran; (b) goals
+  estimated on all of ``Q`` (normalisation and neighbours), bi-goal layers
+  on the critical front only, not distinguishable from (a); (c) Alg. 3
+  literally, no objective-space sorting, clearly worse, and it contradicts
+  Sec. 4 (measured: :ref:`validation-bige`). (a) is kept.
 * ``N`` in the radius is the population size ``pop_size`` in the
   environmental selection and the size of the current population in the
   mating selection (they are equal in a normal run).
@@ -96,61 +93,11 @@ Readings where the paper leaves a choice
   are the reproduced paper's operators shared by every algorithm here, not
   [1]'s ``pm = 1/n``.
 
-Behaviour worth knowing
------------------------
-On a concave front the sum of normalised objectives is smallest near the
-corners and edges, so the proximity goal pulls the population there ("The
-accuracy of the estimation can be influenced by the shape of an MOP's
-Pareto front", Sec. 3.2). On 3-objective DTLZ2 at 10000 evaluations 75% of
-the final points have a direction ``f / ||f||`` with a component below 0.1
-(41% of the dense Das-Dennis sample of the front used for the IGD, 43% of
-NSGA-III's points; 5 seeds),
-and the mean IGD is 1.54 +- 0.03 times NSGA-III's (1.34 +- 0.01 with 4
-objectives; 10 seeds). The paper targets 5 to 15 objectives and reports
-NSGA-III ahead of BiGE on 3- to 5-objective WFG9 (Sec. 6.1). BiGE keeps no
-extreme points and can keep a dominance-resistant point of the critical
-front (e.g. on DTLZ1).
-
-With 5 objectives on DTLZ1 and DTLZ3 (Deb & Jain budget, population 212) the
-runs do not converge (dense-front IGD 7x and 16x NSGA-III's,
-``benchmarks/results/protocol_dense_m5.md``). All ``2N`` candidates are
-mutually non-dominated there, so everything rests on the two goals, and the
-min/max normalisation of Sec. 3.2 is stretched by the far points (objective
-values in the hundreds): the bulk of the population is squeezed into a
-corner of the normalised cube, every individual has neighbours within the
-radius ``r = 212^(-1/5) = 0.34`` (measured at generations 50-150: all of
-them), and the crowding goal rewards the far points; the survivors' median
-proximity was no better than the rejected ones' (0.39 against 0.44).
-
-DTLZ4 (3 objectives): 11 of 30 runs lose a region of the front at the
-paper's setting of 10000 evaluations (seeds 0-29; pymoo's NSGA-III 6), 0 of 10
-under the Deb & Jain budget of 600 generations. The cause is shared by all
-the Pareto-based algorithms here and measured in
-:mod:`moo.algorithms.operators` (DTLZ4's few points off the axis are
-dominated in the first generations: 202 lost beyond the last front, 6 within
-it, 10 runs, first six generations). BiGE gets a lost region back given the
-generations, as pymoo's NSGA-III does and for the same reason: its min/max
-normalisation stretches the lost objective's tiny range to [0, 1], so the
-points with its largest values are isolated in the normalised space (seeds
-0-9, 600 generations: 0 collapsed as written, 5 with ranges ``<= 1e-6`` left
-unstretched; :mod:`moo.algorithms.operators`).
-
-EvoMO's BiGE (``evomo`` 0.3.1 on ``evox`` 1.4.0, its defaults, population
-92, 10000 evaluations, seeds 0-29, scored as ``bench_protocol`` scores ours)
-collapsed in 0 of 30 runs, ours in 11. The difference lies in two choices of
-EvoMO's, and neither is in BiGE's paper. It computes the objectives in single precision,
-where ``x^100`` is exactly 0 for ``x < 0.37``, so the meaningless
-``1e-300 < 1e-100`` comparisons that drive a lost variable to 0 become
-ties. And its mating tournament is won by the smaller crowding degree (a
-lexicographic sort with ``f_cd`` as the primary key), not by bi-goal Pareto
-dominance and a coin (Alg. 2). Put back one at a time into EvoMO's: double
-precision 2 of 30, Alg. 2's tournament 5, both 11. Taken one at a time into
-ours: single precision 2 of 30, the crowding-first tournament 2, both 0.
-EvoMO's other departures do not matter: clipped SBX, a mutation
-probability of ``1/n^2`` per variable (``pro_m = 1/n`` divided by ``n``
-again) and no duplicate elimination give 10 of 30 together. No defect
-here (``benchmarks/dtlz4_bige_ingredients.py``,
-``benchmarks/results/dtlz4_bige_ingredients.md``).
+Notes
+-----
+What the algorithm does on the test problems (measured runs, collapses, comparisons with
+other implementations) is in the documentation's Validation pages,
+:ref:`validation-bige`.
 """
 
 from __future__ import annotations

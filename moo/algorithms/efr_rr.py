@@ -63,12 +63,7 @@ Readings where the paper leaves room
   directions the ranker orders points by their off-face objectives. A point
   lies exactly on a face of a DTLZ front only when its position variables
   sit exactly on their bounds, which pymoo's bound-aware SBX never produces
-  and a clipped SBX often does: on DTLZ2 at 8 objectives (Deb & Jain's
-  protocol, 156 two-layer directions) the IGD to the targets is 0.21 with the
-  default operators and 0.038 with
-  :class:`~moo.algorithms.operators.ClippedSBX`, EvoMO's 0.039
-  (``benchmarks/results/evomo_m8_check.md``). At 3 and 5 objectives the
-  dense-front IGD is 1.00-1.01x NSGA-III's with the default operators.
+  and a clipped SBX often does (measured: :ref:`validation-efr-rr`).
 * The population (92 in the paper's experiments) need not equal the number of
   weight vectors (91 for 3 objectives, 84 for 4); the rankings are defined for
   any population size, so no change is needed.

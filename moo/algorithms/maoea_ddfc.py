@@ -55,11 +55,10 @@ Readings where the paper leaves room
 * How the FC tournament is decided. The paper describes the environmental
   selection as "tournament-like"; PlatEMO (on which the reproduced study ran)
   draws the winner by roulette wheel on ``1/FC``. The roulette is the default;
-  ``candidate_choice="best"`` is the greedy reading. Measured on DTLZ2
-  (3 objectives, 10000 evaluations, 24 seeds) the roulette reaches a mean IGD
-  of about 1.08x NSGA-III's, the greedy choice about 1.4x (8 seeds): FC alone favours
+  ``candidate_choice="best"`` is the greedy reading. FC alone favours
   directions near the boundary of the front (``FC -> 0`` as any
-  ``f~_i -> 0``), and the greedy choice follows that bias more strictly.
+  ``f~_i -> 0``), and the greedy choice follows that bias more strictly
+  (measured: :ref:`validation-maoea-ddfc`).
 * FC is computed on the same normalised objectives as DD, so that it does not
   depend on the units of the objectives (the paper's control MOPs have
   objectives of very different scales); PlatEMO translates by the ideal point
@@ -74,11 +73,9 @@ Readings where the paper leaves room
   environmental selection (the roulette weight ``1/max(FC, 1e-6)`` is finite
   for ``FC = 0``; ``"best"`` breaks FC ties by the smaller DD, then by
   population index). PlatEMO's ``CalFC`` floors FC at ``1e-6`` the same way
-  (in raw units; ours are normalised). Measured on DTLZ4 (3 objectives,
-  10000 evaluations, paper operators, seeds 0-29): 13 collapsed runs with
-  the floor in the tournament, 20 without it (see below). The floor costs
-  convergence on DTLZ1 at 8 objectives (7 of 20 runs fail with it, none
-  without; "Behaviour worth knowing").
+  (in raw units; ours are normalised). The floor is a trade-off: fewer
+  collapsed runs on DTLZ4, a weaker convergence on DTLZ1 at
+  8 objectives (measured: :ref:`validation-maoea-ddfc`).
 * A solution exactly at the ideal point (``sum f~ = 0``) is projected to the
   simplex centre ``1/M``.
 * Coincident projections (distance 0) give ``DD = inf``: a duplicated
@@ -88,84 +85,11 @@ Readings where the paper leaves room
   updates itself. It stores ``"FC"`` and ``"rank"`` (Pareto front index) on
   the survivors.
 
-Behaviour worth knowing
------------------------
-DTLZ4 (3 objectives, population 92) loses a region of the front in part of
-the runs, mostly in the first five generations (13 of 30 at the paper's
-setting of 10000 evaluations, seeds 0-29; pymoo's NSGA-III 6 of the same
-30; 9 of 10 under the Deb & Jain budget of 600 generations, NSGA-III 0).
-``x^100`` leaves a random population about ``92 x 0.03 = 2.8`` points with
-``x_1 > 0.97`` (and as many with ``x_2 > 0.97``), the only ones away from the
-``f_1`` axis; when these few are also poorly converged they are dominated and
-drop out at the front cut, before the DD/FC rule sees them (10 runs, first
-six generations: 173 such points lost beyond the last front, 5 lost and 62
-kept within it). The runs that lose a region are mostly those whose initial
-population holds at most one such point, for NSGA-III as well. Once a region
-is lost the variable that leads to it is driven to 0 (a smaller, if
-meaningless, ``f_i`` of ``1e-300`` dominates ``1e-100``), and polynomial
-mutation cannot bring it back to ``x >= 0.97``. pymoo's NSGA-III gets it back
-through its normalisation, which stretches the lost objective's tiny range to
-[0, 1]. The shared normalisation used here rejects the hyperplane (the lost
-objective has no extreme point left) and sets a range still below ``1e-10``
-to 1, so the lost objective's ``1e-100`` values stay 0 for DD and FC. With
-Blank et al.'s last fall-back (pymoo's, which keeps the tiny range) instead,
-seeds 0-9 at the paper's setting ran identically (5 collapsed), the lost
-objective ending at exactly 0 (``x^100`` underflows)
-(:mod:`moo.algorithms.operators`).
-
-Before FC got its resolution (see "Readings") 20 of the 30 runs lost a
-region, also with favourable initial populations: the one point of a region
-whose smallest normalised objective was ``1e-50`` lost every mating
-tournament against the axis points' ``1e-100`` and never became a parent
-(seed 10, first 40 generations: the points with ``x_1 > 0.97``, 56
-individual-generations in the population, were picked as parents 0 times;
-with the resolution they are picked 927 times out of 1460).
-
-DTLZ1 with 8 objectives (Deb & Jain budget: population 156, 750
-generations) does not converge: over seeds 0-19 the median distance
-``sum f - 0.5`` of the final set is 0.4-4.7 in 16 runs and never below 0.01
-(NSGA-III 0.0006-0.02, theta-DEA 0.00007-0.004, seeds 0-9); the 7 runs that
-count as failed (dense-front IGD 3.9-11x NSGA-III's) are the far end of
-that, a non-convergence, not a collapse. The reason is the method's:
-nothing but the front cut pushes towards the front, and at 8 objectives the
-cut is weak (``benchmarks/ddfc_dtlz1_m8.py``; generations 10-200, seeds
-0-9):
-
-* FC ranks a solution by its direction more than by its distance. On DTLZ1
-  ``f = (1 + g) h / 2`` with ``sum h = 1``, and FC is homogeneous of degree
-  1, so ``FC(f) = (1 + g) FC(h) / 2``: the direction term ``FC(h)`` runs from
-  ``1/M^2`` at the simplex centre to 0 on its boundary, and both tournaments
-  compare solutions of *different* directions (two random parents; the ``L``
-  least crowded candidates). 99 % of the mating tournaments are between
-  mutually non-dominated parents, and the FC winner is the one nearer the
-  front in 49 % of them, a coin toss (47 % at 3 objectives). DD is scale
-  free by construction.
-* Convergence therefore comes from the front cut alone: it removes the
-  dominated 86 of the 312 merged solutions per generation (28 %; at 5
-  objectives 150 of 424, 35 %; at 3, 73 of 184, 40 %; DTLZ1 converges at
-  both, median distance 0.001-0.006 and 0.002-0.008, seeds 0-4), while the
-  DD/FC choice within the first front leaves the median ``sum f`` of the
-  survivors at 0.98 of the front's.
-* FC's boundary bias helps indirectly. Compared at full precision (before
-  the resolution, see "Readings") the mating tournament prefers the parents
-  nearest a face of the simplex; the population gathers there (4.5 of the 8
-  objectives below ``1e-4`` of the point's sum, 3.2 with the resolution) and
-  the cut removes more (102 instead of 86), plausibly because solutions
-  sharing near-zero objectives are compared by dominance in the others. With
-  the resolution 62 % of the non-dominated tournaments are between two FC
-  values below it and go to a random winner. Seeds 0-19: no failed run with
-  full precision, 7 with the resolution; even so full precision stays at
-  1.7x NSGA-III's median IGD (median distance 0.005-0.5). The resolution is
-  kept for DTLZ4 (13 of 30 collapsed runs with it, 20 without, see above).
-
-Not the root cause (seeds 0-9): the shared normalisation, although its
-estimate is poor here (ranges up to 460 in the first generations, the
-hyperplane rejected in 79 % of generations 10-200): with the true ideal
-point 0 and nadir 0.5 no run fails, but the runs stay at 1.6x NSGA-III's
-median IGD (median distance 0.004-0.5; the cut is not larger, 88, and why
-it helps was not traced); overflow or underflow (FC is computed in ratio
-form; no run warned). The greedy FC choice (``candidate_choice="best"``)
-is worse: 6 of 10 fail.
+Notes
+-----
+What the algorithm does on the test problems (measured runs, collapses, comparisons with
+other implementations) is in the documentation's Validation pages,
+:ref:`validation-maoea-ddfc`.
 """
 
 from __future__ import annotations

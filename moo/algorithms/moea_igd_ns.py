@@ -64,32 +64,11 @@ resolve doubts, nothing ported).
   :class:`~pymoo.core.survival.Survival` (least violation first) and never
   enter the archive.
 
-Behaviour worth knowing
------------------------
-* DTLZ4 (3 objectives): 11 of 30 runs lose a region of the front at the
-  paper's setting (seeds 0-29; pymoo's NSGA-III 6), 8 of 10 under the Deb &
-  Jain budget (NSGA-III 0). The shared cause, measured, is in
-  :mod:`moo.algorithms.operators` (DTLZ4's few points off the axis are
-  dominated in the first generations; most collapsed runs start with at
-  most one of them). Most of these points are lost at the front cut (10 runs,
-  first six generations: 160 beyond the last front); of the 93 that reach the
-  last front IGD-NS deletes 37, as its rule deletes first the
-  non-contributing solution farthest from the archive (the second term of
-  Eq. 2; PlatEMO's implementation has the same rule). A lost region does not
-  come back: its variable is driven to 0. pymoo's NSGA-III regains it within
-  600 generations because its normalisation stretches the lost objective's
-  tiny range (``1e-30``) to [0, 1]; IGD-NS's raw distances (the paper's) see
-  nothing there (measured in :mod:`moo.algorithms.operators`).
-* 5 objectives, DTLZ1 / DTLZ3 (Deb & Jain budget): no convergence (dense-front
-  IGD 5.5x / 40x NSGA-III's, ``benchmarks/results/protocol_dense_m5.md``).
-  From about generation 100 all ``2N`` candidates are non-dominated, so the
-  selection is IGD-NS against the archive, which holds the non-dominated
-  solutions of everything seen - with 5 objectives almost all of them, the
-  unconverged ones included (its truncation keeps the largest value of each
-  objective first): the population is pulled towards them, not towards the
-  front. The method targets multi-objective problems; PlatEMO, maintained
-  by the paper's authors' group, lists it for them only (``<multi>``, not
-  ``<many>``).
+Notes
+-----
+What the algorithm does on the test problems (measured runs, collapses, comparisons with
+other implementations) is in the documentation's Validation pages,
+:ref:`validation-moea-igd-ns`.
 """
 
 from __future__ import annotations

@@ -62,22 +62,16 @@ resolve doubts, nothing ported). Where those differ:
   and so did this module before: with Das-Dennis weights most vectors have a
   zero component (74 of the 84 for 4 objectives), and 1e-6 makes each of them
   rank the points by their smallest objective alone, which crowds the
-  population onto the edges of the front. Measured on DTLZ2 (population 92,
-  10000 evaluations, 10 seeds, dense-front IGD over NSGA-III's; both with
-  the stagnation rule below): 1e-6 gives 1.15x (3 objectives) and 1.37x (4),
-  1e-2 gives 1.03x and 1.03x; with neither change 1.22x and 1.53x
-  (``benchmarks/results/moeas.md`` and ``protocol.md`` have the current
-  figures).
+  population onto the edges of the front (measured:
+  :ref:`validation-mombi2`).
 * "``v_i = 0``" in rule c. The authors' code tests the variance of the record
   for exact equality with zero, which in floating point holds only when the
   population's worst value in objective ``i`` comes from one and the same
   individual for ``record_size`` generations. On DTLZ2 with 4 objectives that
-  almost never happens for some objectives: the nadir estimate of f4 then
-  stays at the initial population's maximum (2.26 against the true 1) for the
-  whole 10000-evaluation run (measured, seed 1). We read the test as
+  almost never happens for some objectives, and the nadir estimate then
+  stays at the initial population's maximum. We read the test as
   ``v_i < epsilon``, the paper's own tolerance parameter (PlatEMO instead
-  compares only the last two candidates, exactly); with it the estimate
-  reaches the true nadir within about 80 generations.
+  compares only the last two candidates, exactly).
 
 * The update order follows the authors' C implementation (EMO framework):
   rule 1 uses the largest component of the *new* candidate, marks live for
@@ -103,40 +97,11 @@ resolve doubts, nothing ported). Where those differ:
   :func:`moo.algorithms.operators.reference_directions` (91 for 3
   objectives, 84 for 4), population 92.
 
-Behaviour worth knowing
------------------------
-At 8 objectives under Deb & Jain's protocol (DTLZ2, population 156, the
-two-layer 120 + 36 directions, 500 generations) the IGD to the 156 targets is
-about 3.5x NSGA-III's published median although the points are on the front
-(median distance 2-4e-5). It is the ASF, not a defect (measured on seeds 0-2 by
-``benchmarks/mombi2_m8_placement.py``; ``benchmarks/results/protocol_m8.md``):
-every direction has exactly one final point nearest to it by angle, the first
-R2 rank is the whole population, and each point is the ASF winner of its own
-weight. But the ASF winner is not the point nearest the target:
-
-* Inner directions (no zero component, smallest weight 1/16): the ASF is flat
-  towards the faces. Zeroing three of the seven small components of
-  ``(1, ..., 1, 9) / 16``'s target moves the point 0.185 away and raises the
-  ASF by only 1.7 %; raising one of them by 0.05 raises it by 46 %. The final
-  winners are 0.14-0.17 from their targets, 2.2-2.9 % above the optimal ASF,
-  on the face side (IGD to the inner targets 0.14-0.16; 4x the generations:
-  0.10-0.12). Of 10^6 uniform points on the front, the ASF-best for an inner
-  weight is 0.14 from the target, the angle-best 0.077.
-* Boundary directions (5-7 zeros read as :data:`ZERO_WEIGHT`): components off
-  the weight's face below ``1e-2 x ASF`` cost nothing, and on the sphere they
-  lower the face components, so the ASF's optimum lies along ``w`` with its
-  zeros read as 1e-2, 0.033 from the target (that set scores IGD 0.027, 1.7x
-  NSGA-III's published 0.0157, at best). The final boundary winners sit within
-  4e-4 of the target on the face, with off-face components of 0.013.
-
-Swapped one at a time in the run's objects: the true ideal and nadir in place
-of the estimate (IGD 0.057-0.062 against 0.051-0.055), a random tie key in
-place of the norm (0.048-0.051): no effect. Zero weights 1e-6 (PlatEMO's
-floor) 0.25-0.28, 1e-4 0.13-0.24, 1e-3 0.068-0.081, 0.1 0.24: 1e-2 is the best
-of these. PBI (theta 5) in place of the ASF (not MOMBI-II) gives 0.013-0.014
-(boundary 0.0015, inner 0.05-0.056). PlatEMO's other differences (rule 1
-per objective, the variance test on the last two candidates) act through the
-normalisation, which does not matter here.
+Notes
+-----
+What the algorithm does on the test problems (measured runs, collapses, comparisons with
+other implementations) is in the documentation's Validation pages,
+:ref:`validation-mombi2`.
 """
 
 from __future__ import annotations

@@ -14,72 +14,11 @@ Readings (see PAPER_NOTES.md):
   (:class:`ClippedSBX`), pymoo's the bound-aware form of Deb's NSGA-II code;
   the default stays pymoo's (``crossover_form="bounded"``;
   ``OperatorSettings(..., crossover_form="clipped")`` selects PlatEMO's). The
-  two differ at the bounds of the box, which matters on DTLZ4 (next item); on
-  DTLZ2 (3 objectives, 10000 evaluations, 5 seeds) the clipped form's IGD is
-  0-2 % higher for MOEA/IGD-NS, SPEA2+SDE and BiGE, equal for NSGA-III and
-  MaOEA-DDFC. At 8 objectives (Deb & Jain's protocol) the form matters far
-  more, because only the clipped form puts position variables exactly on
-  their bounds and so points exactly on the faces of a DTLZ front, where the
-  120 boundary targets lie: on DTLZ2 NSGA-III's IGD to the targets is 0.47x
-  Deb & Jain's published median with it and 0.92x without, EFR-RR's 0.038
-  against 0.21 (``benchmarks/results/evomo_m8_check.md``). Deb & Jain's
-  values come from the bound-aware form. On the paper's two control-design
-  MOPs the form makes no significant difference (NSGA-II, NSGA-III,
-  SPEA2+SDE, theta-DEA; 10 seeds; hypervolume rank-sum p 0.10-1.00), although
-  the clipped form leaves up to 11 % of the final variables exactly on a
-  bound (``benchmarks/sbx_form_mops.py``).
-* DTLZ4 (3 objectives, population 92), measured. ``x^100`` leaves a random
-  population about ``92 x 0.03 = 2.8`` points with ``x_1 > 0.97`` and as many
-  with ``x_2 > 0.97``, the only ones away from the ``f_1`` axis. When these
-  few are also poorly converged they are dominated and drop out at the front
-  cut within the first five or so generations, in every Pareto-based
-  algorithm here and in pymoo's NSGA-III; the variable that leads to the lost
-  region is then driven to 0 (a meaningless ``f_i = 1e-300`` dominates
-  ``1e-100``), and polynomial mutation cannot bring it back to 0.97. The
-  population ends on one edge of the front (dense-front IGD 0.541, the IGD of
-  the edge arc itself) or at one corner (0.946). Which runs collapse is set
-  mostly by the initial population, the same for every algorithm with a
-  given seed: 14 of seeds 0-29 start with at most one such point in a region
-  (a probability of 0.41 with 92 points), and they hold 5 of NSGA-III's 6
-  collapsed runs, 8 of MOEA/IGD-NS's 11, 7 of SPEA2+SDE's 10 and 8 of BiGE's
-  11 (bounded SBX; the other 16 seeds: 1, 3, 3, 3). With such rates an
-  independent implementation's 0 collapses in 5 runs is no contradiction
-  (probability 0.1-0.4 per algorithm at the rates below, and its algorithms
-  share the seeds' initial populations too). Clipping turns a child of such a point that
-  overshoots the bound into an exact corner (``x = 1``: the other objectives
-  are ``6e-17 (1 + g)``), which is non-dominated and holds the region; the
-  bound-aware form never reaches the bound. Collapsed runs out of 30 (seeds
-  0-29, 10000 evaluations, paper operators), bounded / clipped: NSGA-III 6 /
-  5, MOEA/IGD-NS 11 / 7, MaOEA-DDFC 13 / 10, SPEA2+SDE 10 / 12, BiGE 11 / 6;
-  with PlatEMO's own defaults (clipped SBX, ``pm = 1/n``) 6, 7, 9, 9 and 5.
-  Given 600 generations (Deb & Jain's budget) NSGA-III regains a lost region
-  (0 of 10 runs collapsed); MOEA/IGD-NS, MaOEA-DDFC and SPEA2+SDE do not.
-  Why, measured (``benchmarks/dtlz4_regain.py``): once a region is lost,
-  its objective, say ``f_3``, is ``1e-30`` or less in every survivor; pymoo's
-  normalisation (Blank, Deb & Roy 2019's fall-backs) then rejects the
-  hyperplane and, the front's range being ``<= 1e-6``, divides ``f_3`` by the
-  population's own tiny range, so the survivors with the largest ``f_3``
-  (the largest ``x_1``) reach the ``f_3`` end of the normalised cube, take
-  niches of their own and are kept, and ``x_1`` is selected upwards until
-  the region is back. Seeds 0-9, 600 generations: as shipped, 5 runs miss a
-  region for 88-309 generations and all 5 get it back (0 collapsed); with
-  every range still ``<= 1e-6`` set to 1 (no stretch, nothing else changed)
-  4 of the 5 never do (4 collapsed). The stretch is pymoo's, not Deb & Jain's
-  (whose worst published run here is a collapse), and it needs more
-  generations than 10000 evaluations give (NSGA-III at the paper's setting:
-  the same 4 of seeds 0-9 collapsed with and without it). The others: BiGE's min/max
-  normalisation (its paper's) stretches the same way, and BiGE gets regions
-  back under the same budget (seeds 0-9: 0 collapsed; 5 with ranges
-  ``<= 1e-6`` left unstretched); SPEA2+SDE's stretches too, but the
-  shifted density makes a point that is worse in one objective look crowded
-  (a neighbour better in ``f_3`` is shifted onto it), so the raised points
-  are truncated first; MOEA/IGD-NS measures raw distances (its paper's), in
-  which ``1e-30`` is nothing; MaOEA-DDFC (and theta-DEA) use the shared
-  normalisation, which sets a range still below ``1e-10`` to 1, so nothing
-  is stretched (with Blank et al.'s last fall-back instead, seeds 0-9 of
-  DDFC at the paper's setting ran identically, 5 collapsed, the lost
-  objective ending at exactly 0 as ``x^100`` underflows). None of these is a departure
-  from the algorithm's paper.
+  two differ at the bounds of the box: only the clipped form puts variables
+  exactly on a bound, and so points exactly on the faces of a DTLZ front.
+  What that changes on DTLZ2, DTLZ4, at 8 objectives and on the paper's two
+  MOPs is measured in the documentation's Validation pages
+  (:ref:`validation-operators`, :ref:`validation-dtlz4`).
 * Reference directions: Das & Dennis with 12 divisions for 3 objectives
   (91 directions). For 4 objectives the paper is silent and 92 directions are
   impossible with one layer; we take the largest one-layer Das-Dennis set with

@@ -57,36 +57,16 @@ Readings where the papers leave a choice
   compress the scale of the region that matters. The map is increasing in
   every objective, so dominance, ``S`` and ``R`` are unchanged; only the
   densities depend on it. ``normalize=False`` gives the raw-objective form.
-  On DTLZ2 (commensurable objectives) the two give the same IGD within the
-  seed-to-seed spread (3 objectives, 5 seeds: 0.0774 +- 0.0006 vs
-  0.0769 +- 0.0015; min-max of the whole set gave 0.0810 +- 0.0015).
 * Population and archive have the same size ``N`` (92 by default), as in [1]
   and in the paper being reproduced.
 * Survival is a function of the set it receives (no hidden state), so it can
   be called again on any merged population, as MO-LSP does.
 
-Behaviour worth knowing
------------------------
-DTLZ4 (3 objectives): 10 of 30 runs lose a region of the front at the
-paper's setting (seeds 0-29; pymoo's NSGA-III 6), 8 of 10 under the Deb & Jain
-budget (NSGA-III 0); ``normalize=False`` gives the same counts (10 and 8).
-Plain SPEA2 collapses as often at the paper's setting: this module with
-Euclidean distances in 8 of 30 runs, pymoo's ``SPEA2`` (an independent
-implementation) in 13 of 30, 10 with its normalisation; under the Deb & Jain
-budget 5 and 4 of 10 (``benchmarks/dtlz4_spea2_peer.py``). The
-shared cause, measured, is in :mod:`moo.algorithms.operators`: DTLZ4's few
-points off the axis are dominated in the first generations, and SPEA2 fills
-the archive by raw fitness (Zitzler et al. 2001, Sec. 3.2), so they go first
-(10 runs, first six generations: 252 lost from the later fronts, 35 from the
-front that is cut); a lost region does not come back (its variable is driven
-to 0). pymoo's NSGA-III gets it back because its normalisation stretches
-the lost objective's tiny range to [0, 1] and gives the points with its
-largest values niches of their own; the normalisation here stretches the same
-way, but the shifted density makes such a point, worse than its neighbours in
-that objective alone, look crowded: with ``b = (0.6, 0.8, 0)`` and
-``c = (0.6, 0.79, 1e-30)`` (normalised ``f_3`` 0 and 1) ``sd(c, b) = 0.01``
-in ``f_2``'s units while ``sd(b, c) = 1``, so truncation removes ``c`` first
-(:mod:`moo.algorithms.operators`).
+Notes
+-----
+What the algorithm does on the test problems (measured runs, collapses, comparisons with
+other implementations) is in the documentation's Validation pages,
+:ref:`validation-spea2-sde`.
 """
 
 from __future__ import annotations

@@ -63,21 +63,12 @@ argument).
   the non-dominated solutions is not robust to dominance-resistant points:
   on DTLZ1 and DTLZ3 a point far from the front but with one objective a
   hair below everyone else's (an SBX/mutation child at a variable bound) is
-  non-dominated and stretches ``z_max`` (measured on DTLZ1, Deb & Jain
-  budget, 3 seeds: ``z_max`` 1.03, 1.00, 1.51 in one objective, the front's
-  is 0.5). The directions near that axis then cut subregions that contain
-  no front point, and "diversity first" keeps one straggler in each: 2-17
-  globally dominated points in the final population of those seeds. With
-  the hyperplane nadir (NSGA-III's and theta-DEA's normalisation; a
-  dominance-resistant point loses the extreme-point ASF to any converged
-  point near the axis) the stragglers go. Deb & Jain budgets, 3 objectives,
-  10 runs: globally dominated members of the final population per run,
-  median (max) 4.5 (21) on DTLZ1 and 1 (16) on DTLZ3 with ``"front"``, 0 (1)
-  and 0 (0) with ``"hyperplane"``; dense-front IGD relative to NSGA-III 1.02
-  on DTLZ1 and 1.00 on DTLZ3 (``benchmarks/results/protocol.md``). A few
-  non-dominated points off the front can remain (median 2 on DTLZ1, 1 on
-  DTLZ3): "diversity first" picks the smallest angle in a subregion, not
-  the best converged point.
+  non-dominated and stretches ``z_max``. The directions near that axis then
+  cut subregions that contain no front point, and "diversity first" keeps
+  one straggler in each. With the hyperplane nadir (NSGA-III's and
+  theta-DEA's normalisation; a dominance-resistant point loses the
+  extreme-point ASF to any converged point near the axis) the stragglers go
+  (measured: :ref:`validation-spea-r`).
   ``normalization="front"`` keeps the paper's reading.
 
 * Population ``N = 92`` with the project's 91 (3 objectives) / 84
@@ -101,18 +92,11 @@ argument).
   the survival (:func:`~moo.algorithms.theta_dea.finite_first`) and count
   as infinitely far in the mating; the paper assumes finite objectives.
 
-Behaviour worth knowing
------------------------
-At 8 objectives, under Deb & Jain's budget with their operators, 6 of 10
-DTLZ3 runs do not converge (``benchmarks/results/protocol_m8.md``). EvoMO's
-SPEA/R does not either when it is given the same number of evaluations (3 of
-10 fail); as shipped it converges because it makes ``2N`` offspring per
-generation (twice the evaluations) with a clipped SBX, and ours given both
-converges too (1.14-1.34x NSGA-III's published median; either alone does
-not). On DTLZ2 the points lie 3x farther from the front than NSGA-III's with
-pymoo's bound-aware SBX and 0.71x the published median with the clipped one
-(:class:`~moo.algorithms.operators.ClippedSBX`), which also helps NSGA-III
-(``benchmarks/evomo_m8_check.py``, ``benchmarks/results/evomo_m8_check.md``).
+Notes
+-----
+What the algorithm does on the test problems (measured runs, collapses, comparisons with
+other implementations) is in the documentation's Validation pages,
+:ref:`validation-spea-r`.
 """
 
 from __future__ import annotations

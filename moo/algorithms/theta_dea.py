@@ -47,10 +47,8 @@ code (Yuan Yuan, github.com/yyxhdy/ManyEAs, ``ThetaDEA.java``,
   compute the ASF exactly as printed; the shared normalisation reads terms
   below 1e-3 of the scale as zero, which keeps a poorly converged point lying
   exactly on an axis from staying the extreme point for the whole run
-  (``moo.algorithms._normalize``, "Readings"). Under the Deb & Jain
-  protocol this takes theta-DEA's median IGD on 3-objective DTLZ2 from
-  1.82e-3 to 1.07e-3 (20 runs), below NSGA-III's published 1.36e-3
-  (``benchmarks/results/protocol.md``).
+  (``moo.algorithms._normalize``, "Readings"; measured:
+  :ref:`validation-theta-dea`).
 * Operators: ``operators="original"`` gives the authors' settings
   (``ThetaDEA_main.java``: SBX probability 1.0, distribution index 30;
   polynomial mutation probability ``1 / n``, index 20).

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/ddfc_dtlz1_m8.py [--seeds 10] [--first-seed 0] [--objectives 8]
+    python -m benchmarks.investigations.many_objectives_ddfc_dtlz1 [--seeds 10] [--first-seed 0] [--objectives 8]
                                        [--variants shipped,full-fc] [--peers nsga3,theta-dea]
 
 DTLZ1 under bench_protocol's dense part (Deb & Jain budget: population 156 and
@@ -44,7 +44,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
@@ -54,9 +53,7 @@ from pymoo.optimize import minimize  # noqa: E402
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting  # noqa: E402
 from scipy.stats import rankdata  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parent))
-import bench_protocol as bp  # noqa: E402
-
+from benchmarks import bench_protocol as bp  # noqa: E402  (bench_protocol pins BLAS before numpy loads)
 from moo.algorithms._normalize import HyperplaneNormalization  # noqa: E402
 from moo.algorithms.maoea_ddfc import (  # noqa: E402
     DDFCMatingSelection,

@@ -3,10 +3,12 @@
 Two halves, two environments (neither imports the other's code; final populations go through ``.npz``):
 
     # EvoMO's algorithm, from the separate EvoMO venv (evomo 0.3.1, evox 1.4.0, torch CPU):
-    <evomo-venv>/bin/python benchmarks/evomo_m8_check.py run --algorithm spear --problem dtlz3 \
+    <evomo-venv>/bin/python -m benchmarks.investigations.many_objectives_evomo_check run \
+        --algorithm spear --problem dtlz3 \
         --seeds 0-4 [--variant shipped|n-offspring] [--operators protocol|evomo] [--dtype float64] --out X.npz
     # score those files, and run ours on the same seed numbers, from the project's venv:
-    .venv/bin/python benchmarks/evomo_m8_check.py score X.npz ... [--ours spea-r:dtlz3:0-4 ...] [--out md]
+    .venv/bin/python -m benchmarks.investigations.many_objectives_evomo_check score X.npz ...
+        [--ours spea-r:dtlz3:0-4 ...] [--out md]
 
 ``run`` drives EvoMO's own ``SPEAR`` / ``EFRRR`` through evox's ``StdWorkflow``
 on EvoMO's DTLZ problems (``n_var = M + k - 1``, k = 10), population 156 (EvoMO's
@@ -43,7 +45,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
 from pathlib import Path
 
@@ -148,11 +149,10 @@ def build_ours(bp, name: str, problem: str, seed: int, variant: str):
 
 
 def score(args: argparse.Namespace) -> None:
-    sys.path.insert(0, str(Path(__file__).parent))
-    import bench_protocol as bp
     import moocore
     from pymoo.optimize import minimize
 
+    from benchmarks import bench_protocol as bp
     from moo.problems import make_problem
 
     rows = []   # (label, problem, seed, igd, median distance, failed, cpu)

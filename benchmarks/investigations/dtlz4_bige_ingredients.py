@@ -2,7 +2,8 @@
 
 Usage::
 
-    python benchmarks/dtlz4_bige_ingredients.py [--seeds 0-29] [--variants shipped,float32,...] [--algorithm bige]
+    python -m benchmarks.investigations.dtlz4_bige_ingredients [--seeds 0-29] [--variants shipped,float32,...]
+        [--algorithm bige]
 
 EvoMO's own BiGE (``evomo`` 0.3.1 on ``evox`` 1.4.0, torch 2.13.0 on the
 CPU, its defaults, seeds 0-29) collapsed in 0 of 30 runs where ours does in
@@ -47,7 +48,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
@@ -56,12 +56,10 @@ import numpy as np  # noqa: E402
 from pymoo.core.duplicate import NoDuplicateElimination  # noqa: E402
 from pymoo.optimize import minimize  # noqa: E402
 
+from benchmarks import bench_protocol as bp  # noqa: E402  (bench_protocol pins BLAS before numpy loads)
 from moo.algorithms._base import BinaryTournament  # noqa: E402
 from moo.algorithms.bige import bige_estimation, niche_radius  # noqa: E402
 from moo.algorithms.operators import OperatorSettings  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).parent))
-import bench_protocol as bp  # noqa: E402
 
 INGREDIENTS = ("shipped", "original", "evomo-ops", "no-dedup", "crowding-mating", "float32")
 #: EvoMO's BiGE variation as it acts (see the module docstring).

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/dtlz4_spea2_peer.py [--seeds 0-29] [--budget paper|protocol]
+    python -m benchmarks.investigations.dtlz4_spea2_peer [--seeds 0-29] [--budget paper|protocol]
         [--variants sde,sde-raw,euclidean,pymoo,pymoo-normalized]
 
 Ours collapses on DTLZ4 more often than an independent implementation did in
@@ -37,7 +37,6 @@ import argparse
 import os
 import sys
 from contextlib import contextmanager
-from pathlib import Path
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
@@ -48,9 +47,7 @@ from pymoo.optimize import minimize  # noqa: E402
 from pymoo.util.misc import vectorized_cdist  # noqa: E402
 
 import moo.algorithms.spea2_sde as spea2_sde  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).parent))
-import bench_protocol as bp  # noqa: E402
+from benchmarks import bench_protocol as bp  # noqa: E402  (bench_protocol pins BLAS before numpy loads)
 
 VARIANTS = ("sde", "sde-raw", "euclidean", "pymoo", "pymoo-normalized")
 

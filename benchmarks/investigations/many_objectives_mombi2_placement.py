@@ -2,7 +2,8 @@
 
 Usage::
 
-    .venv/bin/python benchmarks/mombi2_m8_placement.py [--seeds 0-2] [--variants default,zero-1e-6,...]
+    .venv/bin/python -m benchmarks.investigations.many_objectives_mombi2_placement [--seeds 0-2]
+        [--variants default,zero-1e-6,...]
 
 Each run is ``bench_protocol``'s protocol task (population 156, the 120 + 36
 two-layer directions, 500 generations, protocol operators; about 4 s). For the
@@ -28,17 +29,18 @@ PBI (theta = 5, not MOMBI-II: a contrast that isolates the scalarising function)
 from __future__ import annotations
 
 import argparse
-import sys
-from pathlib import Path
+import os
 
-sys.path.insert(0, str(Path(__file__).parent))   # bench_protocol first: it pins BLAS before numpy loads
-import bench_protocol as bp
-import moocore
-import numpy as np
-from pymoo.optimize import minimize
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):   # before numpy loads
+    os.environ.setdefault(_var, "1")
 
-from moo.algorithms import mombi2
-from moo.algorithms.mombi2 import R2RankingSurvival, asf_matrix, r2_ranking, zero_weight
+import moocore  # noqa: E402
+import numpy as np  # noqa: E402
+from pymoo.optimize import minimize  # noqa: E402
+
+from benchmarks import bench_protocol as bp  # noqa: E402
+from moo.algorithms import mombi2  # noqa: E402
+from moo.algorithms.mombi2 import R2RankingSurvival, asf_matrix, r2_ranking, zero_weight  # noqa: E402
 
 M, N_BOUNDARY = 8, 120
 

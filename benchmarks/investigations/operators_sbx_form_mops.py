@@ -2,7 +2,8 @@
 
 Usage::
 
-    python benchmarks/sbx_form_mops.py --problem generic|applied [--algorithms nsga2,nsga3] [--seeds 10]
+    python -m benchmarks.investigations.operators_sbx_form_mops --problem generic|applied
+        [--algorithms nsga2,nsga3] [--seeds 10]
 
 The reproduced study ran on PlatEMO, whose SBX is the unbounded form with the
 children clipped to the box (:class:`moo.algorithms.operators.ClippedSBX`);

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/dtlz4_regain.py [--seeds 10] [--part protocol|paper]
+    python -m benchmarks.investigations.dtlz4_regain [--seeds 10] [--part protocol|paper]
 
 DTLZ4 (3 objectives): once the points off the ``f_1`` axis in one direction are
 lost, every survivor has, say, ``f_3 = (1 + g) sin(x_1^100 pi / 2)`` of order
@@ -31,7 +31,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
@@ -42,8 +41,7 @@ import pymoo.algorithms.moo.nsga3 as pymoo_nsga3  # noqa: E402
 from pymoo.core.callback import Callback  # noqa: E402
 from pymoo.optimize import minimize  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parent))
-import bench_protocol as bp  # noqa: E402
+from benchmarks import bench_protocol as bp  # noqa: E402  (bench_protocol pins BLAS before numpy loads)
 
 SHIPPED = pymoo_nsga3.get_nadir_point
 REGION = 0.1
