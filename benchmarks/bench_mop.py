@@ -75,7 +75,7 @@ class ElementwiseApplied(ElementwiseProblem):
         pen = b.penalty
         try:
             K = rc.design("rlqr", b.plant, x[None, :4], x[None, 4:6], 10.0 ** np.sqrt(x[6]),
-                          Q=b.Q, R=b.R, H=b.H, alpha=b.alpha, max_iter=b.max_iter).K
+                          Q=b.Q, R=b.R, H=b.H, alpha=b.alpha, max_iter=b.max_iter, check_stability=False).K
         except (rc.ConvergenceError, rc.RankConditionError):
             out["F"] = np.full(b.n_obj, 2.0 * pen)
             return

@@ -19,12 +19,15 @@ Spread             :func:`spread`           lower     Zhou et al. (2006); Wang, 
 =================  =======================  ========  ==========================================
 
 Scale. Every indicator is computed on the objective vectors divided by a
-common power of two (the largest magnitude in ``F``, ``ref_set`` and
-``ref_point``, an exact division) and scaled back: distances are homogeneous
-of degree 1, the hypervolume of degree ``m``, Spread of degree 0. So
-coordinates up to the float range give finite, accurate values (squared
-distances would overflow above about 1e154 and underflow below 1e-154); a
-hypervolume that itself exceeds the float range raises ``OverflowError``.
+common power of two (about the largest magnitude in ``F``, ``ref_set`` and
+``ref_point``, so the scaled coordinates lie in ``(-2, 2)``; an exact
+division) and scaled back: distances are homogeneous of degree 1, the
+hypervolume of degree ``m``, Spread of degree 0. So coordinates up to the
+float range (fronts spanning ``+-1e308``) give finite, accurate values
+(squared distances would overflow above about 1e154 and underflow below
+1e-154); an indicator whose value itself exceeds the float range (a
+hypervolume, or a spacing or pure diversity of points ``2e308`` apart)
+raises ``OverflowError`` instead of returning ``inf`` or NaN.
 """
 
 from __future__ import annotations
@@ -42,6 +45,9 @@ __all__ = ["igd", "igd_plus", "spacing", "hypervolume", "pure_diversity", "sprea
 
 #: Largest set :func:`pure_diversity` accepts with ``method="exact"`` (2^n subsets).
 PD_EXACT_MAX_POINTS = 16
+#: Smallest Minkowski exponent :func:`pure_diversity` accepts: the dissimilarity of two vectors differing in
+#: all ``m`` objectives by the same amount ``t`` is ``m^(1/p) t``, finite for ``p >= 0.01`` up to 1200 objectives.
+PD_MIN_P = 0.01
 
 
 def _points(F: ArrayLike, name: str, *, n_obj: int | None = None, min_rows: int = 1) -> np.ndarray:
@@ -52,9 +58,23 @@ def _points(F: ArrayLike, name: str, *, n_obj: int | None = None, min_rows: int 
 
 
 def _common_scale(*arrays: np.ndarray) -> float:
-    """A power of two near the largest magnitude in ``arrays`` (1 when they are all zero)."""
+    """A power of two at most the largest magnitude in ``arrays`` and above half of it (1 when all are zero).
+
+    ``2^(e - 1)`` with ``top = f 2^e``, ``0.5 <= f < 1``: finite even for
+    ``top`` near the float maximum (``2^e`` itself would be ``2^1024 = inf``
+    there, and ``A / inf = 0`` turned every indicator into NaN).
+    """
     top = max(float(np.max(np.abs(a))) for a in arrays)
-    return 1.0 if top == 0.0 else float(2.0 ** np.frexp(top)[1])
+    return 1.0 if top == 0.0 else float(np.ldexp(1.0, int(np.frexp(top)[1]) - 1))
+
+
+def _scaled_back(value: float, c: float, name: str) -> float:
+    """``c * value``; ``OverflowError`` naming the indicator if that exceeds the float range."""
+    with np.errstate(over="ignore"):
+        out = float(np.float64(c) * np.float64(value))
+    if not np.isfinite(out):
+        raise OverflowError(f"the {name} exceeds the float range ({value!r} x {c!r}); rescale the objectives")
+    return out
 
 
 def _distance_to_reference(indicator, F: ArrayLike, ref_set: ArrayLike) -> float:
@@ -189,7 +209,7 @@ def spacing(F: ArrayLike) -> float:
     A = _points(F, "F", min_rows=2)
     c = _common_scale(A)
     d = _nearest_neighbour(cdist(A / c, A / c, metric="cityblock"))
-    return c * float(np.std(d, ddof=1))
+    return _scaled_back(float(np.std(d, ddof=1)), c, "spacing")
 
 
 def hypervolume(F: ArrayLike, ref_point: ArrayLike) -> float:
@@ -307,7 +327,11 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
     ----------
     F : array_like, shape (n, m)
     p : float, default 0.1
-        Minkowski exponent (> 0; ``inf`` is the Chebyshev distance).
+        Minkowski exponent, ``PD_MIN_P = 0.01 <= p <= inf`` (``inf``: the
+        Chebyshev distance, the limit). Smaller ``p`` are refused: as ``p ->
+        0`` the dissimilarity of vectors differing in ``k >= 2`` objectives
+        grows like ``k^(1/p)`` (``p = 1e-300`` gives ``inf`` for any such
+        front, an indicator that no longer ranks anything).
     method : {"greedy", "exact"}
         ``"exact"`` evaluates the recursion exactly by dynamic programming over
         subsets, O(2^n n^2), for n <= 16. ``"greedy"`` (default) is the practical
@@ -330,6 +354,13 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
     float
         Larger is more diverse; 0 for a single point.
 
+    Raises
+    ------
+    ValueError
+        ``p`` is below ``PD_MIN_P``, NaN or not positive.
+    OverflowError
+        The value exceeds the float range (points about ``1e308`` apart).
+
     References
     ----------
     H. Wang, Y. Jin and X. Yao (2017), "Diversity assessment in many-objective
@@ -348,6 +379,9 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
     """
     A = _points(F, "F")
     p = check_positive_scalar(p, "p", allow_inf=True)
+    if p < PD_MIN_P:
+        raise ValueError(f"p must be >= {PD_MIN_P:g} (or inf), got {p:g}: for smaller p the Minkowski "
+                         "dissimilarity grows like (number of differing objectives)^(1/p) and overflows")
     if method not in ("greedy", "exact"):
         raise ValueError(f"method must be 'greedy' or 'exact', got {method!r}")
     n = A.shape[0]
@@ -360,8 +394,8 @@ def pure_diversity(F: ArrayLike, *, p: float = 0.1,
         if n > PD_EXACT_MAX_POINTS:
             raise ValueError(f"method='exact' handles at most {PD_EXACT_MAX_POINTS} points, "
                              f"F has {n}; use method='greedy'")
-        return c * _pd_exact(D)
-    return c * _pd_greedy(D)
+        return _scaled_back(_pd_exact(D), c, "pure diversity")
+    return _scaled_back(_pd_greedy(D), c, "pure diversity")
 
 
 def spread(F: ArrayLike, ref_set: ArrayLike) -> float:

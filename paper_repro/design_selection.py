@@ -1,6 +1,6 @@
 """Reproduce the paper's Monte Carlo design selection (Sections 4.4.1 and 4.5.1, Figs. fl-generic / fl-applied).
 
-    python paper_repro/design_selection.py --problem generic|applied [--setup ours|authors]
+    .venv/bin/python paper_repro/design_selection.py --problem generic|applied [--setup authors|ours]
         [--algorithm nsga2] [--molsp | --no-molsp] [--evals 3000] [--seed 1] [--sims N]
         [--horizon-steps N] [--pop-size 92] [--out DIR]
 
@@ -25,10 +25,16 @@
    ``truck_margins.py``); generic, against the problem's
    true norm-bounded uncertainty ``H Delta [EF_true EG_true]``.
 
-``--setup`` (applied problem only): ``ours`` (default) or ``authors``, the
+``--setup`` (applied problem only): ``authors`` (default) or ``ours``, the
 loop, initial state and weights of :data:`robustctl.pathfollow.SETUPS`, for
 the MOEA, the candidate designs and the selection alike
-(``make_problem("applied", setup=...)``).
+(``make_problem("applied", setup=...)``). The default is that of
+``paper_repro/mse_table.py`` (``DEFAULT_SETUP`` of ``mse_designs.py``,
+one constant for both scripts), so the chain selection -> MSE table runs in
+one set-up: every script of ``paper_repro`` reproduces the paper, and the
+authors' set-up reproduces its MSE table better (``mse_table.py`` prints the
+agreement of both). ``ours`` is the engineering set-up; the printed MSE-table
+command always names the set-up explicitly.
 
 ``--horizon-steps N`` shortens the selection's simulations only (generic:
 regulation horizon N steps instead of 200; applied: the first N samples of
@@ -40,20 +46,23 @@ compiled kernel, :mod:`robustctl.batchsim`).
 
 Writes ``DIR/selection.json`` (settings, z*, win counts of every design, the
 winner's margins, the front's objectives, timings) and
-``DIR/selection_histogram.png`` (default ``DIR``: ``out/selection_<problem>``,
-``out/selection_applied_authors`` for the authors' set-up). For the applied problem it also prints
-the command that feeds ``z*`` to the MSE table (``paper_repro/mse_table.py --z``).
+``DIR/selection_histogram.png`` (default ``DIR``: ``out/selection_generic``,
+``out/selection_applied_<setup>``). For the applied problem it also prints the
+command that feeds ``z*`` to the MSE table (``paper_repro/mse_table.py --setup
+<setup> --z``), run with the interpreter running this script (``sys.executable``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from mse_designs import DEFAULT_SETUP
 from truck_margins import truck_margins
 
 import robustctl as rc
@@ -82,7 +91,7 @@ def _problem(name: str, horizon_steps: int | None, setup: str | None):
             raise ValueError("--setup applies to the applied problem only")
         prob = GenericRLQRProblem() if horizon_steps is None else GenericRLQRProblem(horizon=horizon_steps)
         return prob, None
-    prob = AppliedRLQRProblem(setup=setup or "ours")
+    prob = AppliedRLQRProblem(setup=setup or DEFAULT_SETUP)
     path = prob.path if horizon_steps is None else prob.path.truncated(horizon_steps * prob.path.dt)
     return prob, path
 
@@ -151,7 +160,8 @@ def main(argv=None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--problem", choices=("generic", "applied"), required=True)
     ap.add_argument("--setup", choices=tuple(SETUPS), default=None,
-                    help="applied problem: the set-up (default ours; robustctl.pathfollow.SETUPS)")
+                    help=f"applied problem: the set-up (default {DEFAULT_SETUP}, as paper_repro/mse_table.py; "
+                         "robustctl.pathfollow.SETUPS)")
     ap.add_argument("--algorithm", choices=tuple(ALGORITHMS), default="nsga2", help="MOEA (default nsga2)")
     ap.add_argument("--molsp", action=argparse.BooleanOptionalAction, default=True,
                     help="wrap the MOEA with MO-LSP (default on)")
@@ -162,10 +172,13 @@ def main(argv=None) -> int:
     ap.add_argument("--horizon-steps", type=int, default=None,
                     help="shorten the selection's simulations to N steps (default: the problem's)")
     ap.add_argument("--pop-size", type=int, default=92, help="MOEA population size (default 92)")
-    ap.add_argument("--out", type=Path, default=None, help="output directory (default out/selection_<problem>)")
+    ap.add_argument("--out", type=Path, default=None,
+                    help="output directory (default out/selection_generic, out/selection_applied_<setup>)")
     args = ap.parse_args(argv)
     sims = DEFAULT_SIMS[args.problem] if args.sims is None else args.sims
-    tag = args.problem if args.setup in (None, "ours") else f"{args.problem}_{args.setup}"
+    if args.problem == "applied" and args.setup is None:
+        args.setup = DEFAULT_SETUP
+    tag = args.problem if args.problem == "generic" else f"{args.problem}_{args.setup}"
     out = Path("out") / f"selection_{tag}" if args.out is None else args.out
     for name, value, low in (("--evals", args.evals, 1), ("--sims", sims, 1), ("--pop-size", args.pop_size, 4),
                              ("--seed", args.seed, 0)):
@@ -217,7 +230,8 @@ def main(argv=None) -> int:
           + f" ({time.perf_counter() - t0:.1f} s)")
     if args.problem == "applied":
         if np.all(np.isfinite(z)):
-            print(f"feed it to the MSE table:\n  python paper_repro/mse_table.py --setup {setup} --z {z_txt}")
+            print(f"feed it to the MSE table:\n  {shlex.quote(sys.executable)} paper_repro/mse_table.py "
+                  f"--setup {setup} --z {z_txt}")
         else:
             print("the winner is the nominal LQR (no z): the MSE table's LQR row already shows it")
 

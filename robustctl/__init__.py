@@ -28,7 +28,14 @@ from .analysis import (
 )
 from .controller import Controller
 from .design import design
-from .errors import ConvergenceError, InfeasibleError, NotStabilizableError, RankConditionError, RobustCtlError
+from .errors import (
+    ConvergenceError,
+    InfeasibleError,
+    NotStabilizableError,
+    NotStabilizingError,
+    RankConditionError,
+    RobustCtlError,
+)
 from .h2 import H2Controller, h2
 from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .input_memory import InputMemoryFeedback
@@ -46,6 +53,7 @@ __all__ = [
     "h2", "H2Controller", "Disk", "HalfPlane", "ConicSector",
     "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
+    "NotStabilizingError",
 ]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
             "RobustStability", "CostBound", "HinfBound", "WorstCase"]

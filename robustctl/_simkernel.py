@@ -80,7 +80,9 @@ def closed_loop(KT, F, G, xr, uff, w, e0, lim, bound, dead, keep, sq, sqx, div_s
     lim : (p,) ndarray
         Saturation levels (``inf``: none).
     bound : float
-        Divergence bound (``inf``: no test).
+        Divergence bound: a run diverges when ``not |e_i| <= bound`` for some
+        state, so a NaN error (an overflowed run: ``inf - inf``) diverges
+        too, even with ``bound = inf`` (no bound test).
     dead : (B,) bool ndarray
         Gains flagged as not computable (frozen at ``+bound`` from step 0).
     keep : bool
@@ -145,19 +147,19 @@ def closed_loop(KT, F, G, xr, uff, w, e0, lim, bound, dead, keep, sq, sqx, div_s
                         for j in range(nb):
                             v = x[o + j] - r if alive[j] else ef[o + j]
                             e[o + j] = v
-                            nout += abs(v) > bound
+                            nout += not abs(v) <= bound       # NaN counts: overflow is divergence
                     else:
                         for j in range(nb):
                             v = x[o + j] - r
                             e[o + j] = v
-                            nout += abs(v) > bound
+                            nout += not abs(v) <= bound       # NaN counts: overflow is divergence
                 if nout > 0:                          # rare: a run leaves the bound now
                     for j in range(nb):
                         if not alive[j]:
                             continue
                         out = False
                         for i in range(n):
-                            out |= abs(e[i * W + j]) > bound
+                            out |= not abs(e[i * W + j]) <= bound
                         if out:
                             alive[j] = False
                             any_dead = True

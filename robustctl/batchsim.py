@@ -22,8 +22,11 @@ drifts away) are not integrated to overflow: once any error component exceeds
 therefore has, in every state, a mean squared error of at least
 ``(T - k) / T * bound**2``: large, finite, larger the earlier it diverged, and
 never better than a stable run in any single objective (which holding the last
-value would allow) - a safe ranking for an optimiser. ``bound=inf`` turns the
-test off.
+value would allow) - a safe ranking for an optimiser. A run whose error
+becomes NaN (gains so large that ``K e`` or ``F x`` overflows, ``inf - inf``)
+is flagged the same way, design by design, whatever the others in the batch
+do; its error is frozen at ``+bound``. ``bound=inf`` turns the bound test off
+(an overflowed run is still flagged, frozen at ``+inf``: MSE ``inf``).
 
 Backends. ``backend="numba"`` (default) runs the compiled kernel of
 :mod:`robustctl._simkernel`; ``backend="numpy"`` runs the reference
@@ -413,8 +416,12 @@ def _run_numba(sim: LinearSimulator, Keff: np.ndarray, dead: np.ndarray, keep: b
     return sq, sqx, div, sat, (E if keep else None), (U if keep else None)
 
 
+@np.errstate(over="ignore", invalid="ignore")
 def _run_numpy(sim: LinearSimulator, Keff: np.ndarray, dead: np.ndarray, keep: bool):
-    """The reference implementation: one array recursion over T steps on (S, n, B) states."""
+    """The reference implementation: one array recursion over T steps on (S, n, B) states.
+
+    Overflow is not warned about (as in the kernel): a run that overflows is flagged as diverged.
+    """
     B, S, T, n, p = Keff.shape[0], sim.S, sim.T, sim.n, sim.p
     bound = sim._bound
     Fa = np.broadcast_to(sim._F, (S, *sim._F.shape[1:]))
@@ -443,8 +450,10 @@ def _run_numpy(sim: LinearSimulator, Keff: np.ndarray, dead: np.ndarray, keep: b
         e = x - xr[:, k, :, None]
         if any_dead:
             e = np.where(alive3, e, e_frozen)
-        if np.abs(e).max() > bound:                              # rare: someone diverges now
-            newly = (np.abs(e) > bound).any(axis=1) & alive
+        # rare: someone diverges now. "not <=" so that NaN (an overflowed run, inf - inf) counts as divergence:
+        # a NaN max must not switch the test off for the whole batch
+        if not np.abs(e).max() <= bound:
+            newly = (~(np.abs(e) <= bound)).any(axis=1) & alive
             div_step[newly] = k
             alive &= ~newly
             any_dead = True

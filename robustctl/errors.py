@@ -36,3 +36,14 @@ class NotStabilizableError(ConvergenceError, InfeasibleError):
     :class:`InfeasibleError` (what the LMI syntheses raise when no gain
     exists), so handlers written for either keep working.
     """
+
+
+class NotStabilizingError(ConvergenceError):
+    """A design was computed but its gain does not stabilise the nominal plant ``F + G K``.
+
+    Raised by :func:`robustctl.rlqr` at finite ``mu`` unless it is called with
+    ``check_stability=False``; the message gives ``rho(F + G K)`` and the
+    spectral radius of the RLQR's own closed loop ``L``. It is a
+    :class:`ConvergenceError` (no stabilising design was found), so handlers
+    written for that keep working.
+    """

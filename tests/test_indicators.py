@@ -327,3 +327,37 @@ def test_against_pymoo_indicators():
     assert hypervolume(A, [1.2, 1.1, 1.0]) == pytest.approx(HV(ref_point=np.array([1.2, 1.1, 1.0]))(A), rel=1e-12)
     n = len(A)
     assert spacing(A) == pytest.approx(SpacingIndicator()(A) * math.sqrt(n / (n - 1)), rel=1e-12)
+
+
+# ----------------------------------------------------------------------------- the float range's edge (issue 23, 11)
+
+
+def test_spacing_of_fronts_spanning_the_float_range():
+    # the common scale was 2^1024 = inf for coordinates near 1.8e308: A / inf = 0 and 0 * inf = NaN
+    F = np.array([[-1e308, 1e308], [0.0, 0.0], [1e308, -1e308]])        # every nearest L1 distance 2e308
+    assert spacing(F) == 0.0
+    G = np.column_stack([[0.0, 2e307, 4e307, 8e307], [1.7e308, 1.5e308, 1.3e308, 0.9e308]])
+    d = np.array([4.0, 4.0, 4.0, 8.0])                                   # nearest L1 distances / 1e307, by hand
+    assert spacing(G) == pytest.approx(1e307 * np.std(d, ddof=1), rel=1e-12)
+
+
+def test_pure_diversity_near_the_float_range_and_its_overflow():
+    line = lambda xs: np.column_stack([xs, np.zeros(len(xs))])  # noqa: E731
+    F = line([1.0e308, 1.5e308, 1.7e308])
+    # greedy: withdraw 1.0 (nearest 0.5), then 1.5 or 1.7 (0.2): 0.7e308; exact: remove 1.5 first: 0.2 + 0.7
+    assert pure_diversity(F) == pytest.approx(0.7e308, rel=1e-12)
+    assert pure_diversity(F, method="exact") == pytest.approx(0.9e308, rel=1e-12)
+    assert pure_diversity(F, p=np.inf) == pytest.approx(0.7e308, rel=1e-12)
+    # +-1e308 apart in two objectives: (2 (2e308)^0.1)^10 is beyond the float range: said, not inf or NaN
+    with pytest.raises(OverflowError, match="pure diversity exceeds the float range"):
+        pure_diversity([[-1e308, 1e308], [1e308, -1e308]])
+    with pytest.raises(OverflowError, match="spacing exceeds the float range"):
+        spacing([[-1.7e308, -1.7e308], [1.7e308, 1.7e308], [1.7e308, 1.6e308]])   # std of [6.7, .1, .1]e308
+
+
+@pytest.mark.parametrize("p", [1e-300, 1e-3, 0.0099])
+def test_pure_diversity_refuses_a_vanishing_exponent(p):
+    # p -> 0: (|a|^p + |b|^p)^(1/p) -> 2^(1/p) |.|, inf for p = 1e-300 (returned before)
+    with pytest.raises(ValueError, match=r"p must be >= 0.01 \(or inf\)"):
+        pure_diversity([[0.0, 0.0], [1.0, 1.0]], p=p)
+    assert pure_diversity([[0.0, 0.0], [1.0, 1.0]], p=0.01) == pytest.approx(2.0 ** 100, rel=1e-12)

@@ -3,6 +3,7 @@
 import control
 import numpy as np
 import pytest
+import scipy.linalg
 from conftest import random_plant
 
 import robustctl as rc
@@ -123,3 +124,71 @@ def test_lqr_and_hinf_work_with_slycot_hidden():
     np.testing.assert_allclose(out["K"], K_pc, atol=1e-8)
     assert abs(out["gamma_opt"] - out["gamma_riccati"]) <= 1e-5 * out["gamma_riccati"]
     assert out["gamma_opt"] * (1 - 1e-3) <= out["peak"] <= out["gamma"] * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("F,G,Q", [
+    (np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]]), np.diag([0.0, 1.0])),  # position left out
+    (np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1))),                                # Q = 0
+    (np.array([[0.0, 1.0], [-1.0, 0.0]]), np.array([[0.0], [1.0]]), np.zeros((2, 2))),        # lambda = +-1j
+])
+def test_lqr_unweighted_mode_on_unit_circle_raises(F, G, Q):
+    """(Q^1/2, F) with an unobservable mode on the unit circle: no stabilising DARE solution exists
+    (Lancaster & Rodman, Thm 13.1.3); both backends return P with rho(F + G K) = 1, which is refused."""
+    plant = rc.Plant(F, G, 0.1)
+    with pytest.raises(rc.ConvergenceError, match=r"not detectable on the unit circle: the mode lambda = "):
+        rc.lqr(plant, Q=Q)
+
+
+def test_lqr_unweighted_unstable_mode_is_fine():
+    """Only the unit circle matters: an unweighted mode at |lambda| = 2 is still stabilised (mirrored)."""
+    F, G, Q = np.diag([2.0, 0.5]), np.array([[1.0], [1.0]]), np.diag([0.0, 1.0])
+    c = rc.lqr(rc.Plant(F, G, 0.1), Q=Q)
+    np.testing.assert_allclose(c.K, -control.dlqr(F, G, Q, np.eye(1))[0], atol=1e-10)
+    assert c.is_stabilizing()
+
+
+@pytest.mark.parametrize("seed", [1, 3, 4])
+def test_lqr_input_scaled_1e8_matches_dlqr(seed):
+    """G x 1e8: both backends' P miss 1e-8 relative to max(1, ||P||) (the old test); relative to the
+    equation's terms, after a Newton refinement, they pass and the gain equals control.dlqr's."""
+    plant = random_plant(np.random.default_rng(seed), 4, 2, scale=1.5)
+    G = plant.G * 1e8
+    c = rc.lqr(rc.Plant(plant.F, G, 0.1))
+    K_pc = -control.dlqr(plant.F, G, np.eye(4), np.eye(2))[0]
+    np.testing.assert_allclose(c.K, K_pc, rtol=1e-6, atol=1e-6 * np.abs(K_pc).max())
+    assert c.info["residual"] < 1e-8 and c.is_stabilizing()
+
+
+@pytest.mark.parametrize("spread", [4, 8])
+def test_lqr_state_units_1e_spread(spread):
+    """States in units 1e-spread..1e+spread (x_s = T x): the same problem, so K_s = K T^-1, checked against
+    scipy.linalg.solve_discrete_are; slycot warns (spread 4: SlycotResultWarning, raised by python-control)
+    or fails (8), and the PBH test on the unbalanced F refused the plant."""
+    plant = random_plant(np.random.default_rng(0), 4, 1, scale=1.5)
+    t = np.logspace(-spread, spread, 4)
+    F, G, Q = plant.F * t[:, None] / t[None, :], plant.G * t[:, None], np.diag(t ** -2.0)
+    c = rc.lqr(rc.Plant(F, G, 0.1), Q=Q)
+    P = scipy.linalg.solve_discrete_are(F, G, Q, np.eye(1))
+    K_ref = -np.linalg.solve(np.eye(1) + G.T @ P @ G, G.T @ P @ F)
+    np.testing.assert_allclose(c.K, K_ref, rtol=1e-6)
+    K0 = -control.dlqr(plant.F, plant.G, np.eye(4), np.eye(1))[0]                  # unscaled problem
+    np.testing.assert_allclose(c.K, K0 / t[None, :], rtol=1e-6)
+    assert c.info["backend"] == "scipy" and c.info["residual"] < 1e-8
+
+
+def test_dare_slycot_warning_falls_back(monkeypatch):
+    """A backend that raises a warning class (python-control turns SlycotResultWarning into an exception) hands
+    over to scipy instead of escaping."""
+    plant = random_plant(np.random.default_rng(2), 3, 1)
+
+    class ResultWarning(UserWarning):
+        pass
+
+    def warns(*a, **k):
+        raise ResultWarning("solution may be inaccurate")
+
+    monkeypatch.setattr(control, "dare", warns)
+    P, backend = dare(plant.F, plant.G)
+    assert backend == "scipy"
+    np.testing.assert_allclose(P, scipy.linalg.solve_discrete_are(plant.F, plant.G, np.eye(3), np.eye(1)),
+                               rtol=1e-10)

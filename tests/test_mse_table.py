@@ -219,7 +219,7 @@ def test_printed_rlqr_a_is_forced_to_a_unit_eigenvalue_as_mu_grows():
     dist = []
     for mu in (1e9, 1e12, 1e15, 1e18):
         K = rc.design("rlqr", truck.truck_plant(0.0, doubled=True), u.EF, u.EG, mu, Q=Q, R=R2,
-                      H=np.ones((4, 1))).K.sum(axis=0, keepdims=True)
+                      H=np.ones((4, 1)), check_stability=False).K.sum(axis=0, keepdims=True)
         dist.append((np.abs(K - K_lim).max(), np.min(np.abs(np.linalg.eigvals(p.F + p.G @ K) - 1.0))))
     assert all(b[0] < a[0] and b[1] < a[1] for a, b in itertools.pairwise(dist))
     assert dist[-1][0] < 1e-3 and dist[-1][1] < 1e-5

@@ -217,7 +217,7 @@ def test_batch_equals_single_designs():
     assert batch.K.shape == (12, 2, 4) and batch.ok.all()
     for i in range(12):
         ref = rc.rlqr(plant, z[i, None, :4], z[i, None, 4:6], mu[i], accelerate=False, tol=1e-13,
-                      max_iter=100_000)
+                      max_iter=100_000, check_stability=False)
         assert _rel(batch.K[i], ref.K) < 1e-9, i
 
 
@@ -255,7 +255,7 @@ def test_batch_whole_paper_search_space_is_sound():
     for i in [*list(range(0, 60, 7)), 100, 200, 300]:
         if b.ok[i]:
             ref = rc.rlqr(plant, z[i, None, :4], z[i, None, 4:6], 10 ** np.sqrt(z[i, 6]), accelerate=False,
-                          max_iter=200_000)
+                          max_iter=200_000, check_stability=False)
             assert _rel(b.K[i], ref.K) < 1e-7, i
 
 
@@ -338,7 +338,8 @@ def test_newton_fallback_on_ill_conditioned_designs_matches_the_recursion():
     compared = 0
     for i in np.flatnonzero(refined):
         try:
-            ref = rc.rlqr(plant, EF[i], EG[i], mu[i], Q=Q, R=R, accelerate=False, tol=3e-12, max_iter=20_000)
+            ref = rc.rlqr(plant, EF[i], EG[i], mu[i], Q=Q, R=R, accelerate=False, tol=3e-12, max_iter=20_000,
+                          check_stability=False)
         except rc.ConvergenceError:
             continue
         compared += 1
@@ -356,7 +357,7 @@ def test_newton_fallback_accepts_a_slow_design_the_capped_recursion_flags(generi
     assert list(rc.rlqr_gains(*args, max_iter=50).reason) == ["not converged"]
     new = rc.rlqr_gains(*args, max_iter=50, fallback="newton")
     ref = rc.rlqr(generic_plant, z[None, :3], z[None, 3:4], 10 ** np.sqrt(z[4]), accelerate=False,
-                  max_iter=50_000, tol=1e-13)
+                  max_iter=50_000, tol=1e-13, check_stability=False)
     assert new.ok[0] and new.iterations[0] < 50
     assert _rel(new.P[0], ref.info["P"]) < 1e-9 and _rel(new.K[0], ref.K) < 1e-9
 

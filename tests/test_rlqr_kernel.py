@@ -348,7 +348,8 @@ def test_steady_state_verdicts_match_the_numpy_path(monkeypatch):
     plant = rc.Plant(GENERIC_F, GENERIC_G, 1.0)
     args = (plant, z[:, None, :3], z[:, None, 3:4], 10 ** np.sqrt(z[:, 4]))
     new = rc.rlqr_gains(*args, max_iter=50)
-    plain_new = [rc.rlqr(plant, z[i, None, :3], z[i, None, 3:4], 10 ** np.sqrt(z[i, 4]), accelerate=False)
+    plain_new = [rc.rlqr(plant, z[i, None, :3], z[i, None, 3:4], 10 ** np.sqrt(z[i, 4]), accelerate=False,
+                         check_stability=False)
                  for i in np.flatnonzero(new.ok)[:5]]
     _numpy_kernel(monkeypatch)
     ref = rc.rlqr_gains(*args, max_iter=50)
@@ -373,7 +374,8 @@ def test_steady_state_verdicts_match_the_numpy_path(monkeypatch):
     for a, b in ((new.K, ref.K), (new.P, ref.P)):
         assert _rel(a[ok & small], b[ok & small]).max() < 1e-12 and _rel(a[ok], b[ok]).max() < 1e-10
     for c, i in zip(plain_new, np.flatnonzero(new.ok)[:5], strict=True):
-        r = rc.rlqr(plant, z[i, None, :3], z[i, None, 3:4], 10 ** np.sqrt(z[i, 4]), accelerate=False)
+        r = rc.rlqr(plant, z[i, None, :3], z[i, None, 3:4], 10 ** np.sqrt(z[i, 4]), accelerate=False,
+                    check_stability=False)
         assert c.info["iterations"] == r.info["iterations"]
         assert _rel(c.K, r.K) < 1e-12
 

@@ -474,3 +474,27 @@ def test_unwritable_cache_falls_back_to_compiling_in_place(fresh_copy):
     assert not res["cached"] and res["hits"] == 0
     assert any("compiled in every process" in w for w in res["warnings"])
     np.testing.assert_allclose(res["e"], -(0.5 ** np.arange(10)))
+
+
+@pytest.mark.parametrize("bound", [1e3, np.inf])
+def test_overflowing_gain_is_flagged_next_to_an_ordinary_diverging_one(backend, bound):
+    """A gain so large that K e overflows (1e308 * 10 - 1e308 * 10 = inf - inf = NaN) diverges at step 1
+    (its state is NaN), design by design: it must not hide the ordinary diverging design beside it (the
+    numpy backend's batch-wide max was NaN), nor itself be left with a NaN MSE. The stable and the
+    ordinary diverging designs keep the results they have alone (closed form: matrix powers)."""
+    F, G = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.0], [0.1]])
+    K = np.array([[[-10.0, -5.0]], [[1.0, 1.0]], [[1e308, -1e308]]])   # stable, diverging, overflowing
+    x_ref, x0 = np.zeros((200, 2)), np.array([10.0, 10.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = simulate_linear(K, F, G, x_ref, x0=x0, bound=bound, backend=backend)
+    assert res.diverged[:, 0].tolist() == [False, bound < np.inf, True]
+    assert res.diverged_step[2, 0] == 1
+    mse = res.mse()
+    assert not np.isnan(mse).any()
+    assert np.all(mse[2] == (bound ** 2 * 199 + 100.0) / 200)          # step 0 at x0, then frozen at +bound
+    for b in (0, 1):                                                   # x[k] = (F + G K)^k x0
+        A = F + G @ K[b]
+        xs = np.array([np.linalg.matrix_power(A, k) @ x0 for k in range(200)])
+        k = res.diverged_step[b, 0] if res.diverged[b, 0] else 200
+        np.testing.assert_allclose(res.errors[b, 0, :k], xs[:k], rtol=1e-9, atol=1e-12)

@@ -40,7 +40,8 @@ def test_rlqr_shape_errors_name_the_argument(l, cols_EF, rows_EG, cols_EG):
     plant = rc.Plant(0.5 * np.eye(3), np.ones((3, 2)), 0.1)
     EF, EG = np.ones((l, cols_EF)), np.ones((rows_EG, cols_EG))
     if cols_EF == 3 and rows_EG == l and cols_EG == 2:
-        assert np.isfinite(rc.rlqr(plant, EF, EG, 10.0).K).all()
+        # (EF, EG all ones at mu = 10 can destabilise even this stable plant: shapes are the point here)
+        assert np.isfinite(rc.rlqr(plant, EF, EG, 10.0, check_stability=False).K).all()
     else:
         with pytest.raises(ValueError, match=r"^(EF|EG) must have"):
             rc.rlqr(plant, EF, EG, 10.0)

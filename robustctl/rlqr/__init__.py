@@ -84,6 +84,18 @@ recursion would not fail: for finite ``mu`` the fictitious input ``v``
 "stabilises" ``L`` while no ``K`` stabilises ``F + G K``.
 :func:`rlqr_gains` flags every design ``"unstabilizable"`` instead.
 
+A design that converges is not always a stabilising gain. For finite ``mu``
+the RLQR stabilises its own closed loop ``L = (I + S P)^-1 (F + G K)``, in
+which the fictitious input ``v`` (penalised by ``S^-1``, i.e. by ``mu``) helps
+``u``; the nominal loop ``F + G K`` may still be unstable (a cart-pole with
+a sizeable ``EF``, a nearly uncontrollable mode: ``v`` moves what ``G``
+hardly can). :func:`rlqr` therefore also checks ``F + G K`` (Schur stable,
+``rho < 1 - 1e-9``) and raises :class:`NotStabilizingError` (a
+``ConvergenceError``) with both spectral radii unless called with
+``check_stability=False``, which returns the design with
+``info["stabilizing"] = False``. :func:`rlqr_gains` never raises for this:
+it flags such designs ``ok`` but ``stabilizing`` False.
+
 References
 ----------
 Cerri, J. P., Terra, M. H., & Ishihara, J. Y. (2009). Recursive robust
@@ -108,14 +120,15 @@ import numpy as np
 
 from .._validation import as_matrix, check_bool, check_choice, check_int, check_positive_scalar, check_spd
 from ..controller import Controller
-from ..errors import ConvergenceError
+from ..errors import ConvergenceError, NotStabilizingError
 from ..plant import Plant, _frozen
-from ..stability import check_stabilizable, is_schur_stable
+from ..stability import STABILITY_MARGIN, check_stabilizable, is_schur_stable, spectral_radius
 from ._model import DEFAULT_ALPHA, Model, build
 from ._steady import DEFAULT_MAX_ITER, DEFAULT_TOL, steady_state
 from ._step import block_steps, kkt_step, rlqr_step, rlqr_step_block
 
 __all__ = ["rlqr", "rlqr_schedule", "rlqr_gains", "rlqr_step", "rlqr_step_block", "RLQRBatch", "RLQRSchedule"]
+
 
 _IMPLEMENTATIONS = ("kkt", "block")
 _FALLBACKS = ("recursion", "newton")
@@ -226,7 +239,12 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
     mu : (B,) array_like
         Penalty parameters in ``[1e-100, inf]``; ``np.inf`` gives the limit form.
         Any of ``EF``, ``EG``, ``mu`` may omit the batch axis to be shared.
-    Q, R : weights (defaults identity); ``H`` (n, p), default ``ones((n, l))``.
+    Q, R : weights (defaults identity)
+    H : (n, p) array_like, default ``ones((n, l))``
+        Same default as :func:`rlqr` (every row of ``Delta [EF EG]`` perturbs
+        every state equally); give it explicitly unless that is the
+        uncertainty meant. Designs with the same arguments equal
+        :func:`rlqr`'s.
     alpha : float
         ``lambda = (1 + alpha) ||mu H'H||``.
     uncertainty : NormBounded, optional
@@ -293,17 +311,17 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
 @overload
 def rlqr(plant: Plant, EF=..., EG=..., mu=..., *, Q=..., R=..., H=..., alpha: float = ..., uncertainty=...,
          P_N=..., tol: float = ..., max_iter: int = ..., accelerate: bool = ..., implementation: str = ...,
-         fallback: str = ..., horizon: None = ...) -> Controller: ...
+         fallback: str = ..., check_stability: bool = ..., horizon: None = ...) -> Controller: ...
 @overload
 def rlqr(plant: Plant, EF=..., EG=..., mu=..., *, Q=..., R=..., H=..., alpha: float = ..., uncertainty=...,
          P_N=..., tol: float = ..., max_iter: int = ..., accelerate: bool = ..., implementation: str = ...,
-         fallback: str = ..., horizon: int) -> RLQRSchedule: ...  # deprecated: use rlqr_schedule
+         fallback: str = ..., check_stability: bool = ..., horizon: int) -> RLQRSchedule: ...  # deprecated
 
 
 def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alpha: float = DEFAULT_ALPHA,
          uncertainty=None, P_N=None, tol: float = DEFAULT_TOL, max_iter: int = DEFAULT_MAX_ITER,
          accelerate: bool = True, implementation: str = "kkt", fallback: str = "recursion",
-         horizon: int | None = None) -> Controller | RLQRSchedule:
+         check_stability: bool = True, horizon: int | None = None) -> Controller | RLQRSchedule:
     """Steady-state robust LQR for ``[dF dG] = H Delta [EF EG]``, ``||Delta|| <= 1`` (paper Theorem 1).
 
     Parameters
@@ -318,8 +336,13 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
         full row rank.
     Q : (n, n) symmetric PSD, default identity (PD for ``implementation="block"``)
     R : (m, m) symmetric PD, default identity
-    H : (n, p), default ``ones((n, l))``; ``H = 0`` means no uncertainty
-        (``lambda -> 0`` limit: ``EF``, ``EG`` are then ignored).
+    H : (n, p), default ``ones((n, l))``
+        ``[dF dG] = H Delta [EF EG]``. Without ``H`` every row of
+        ``Delta [EF EG]`` perturbs every state equally (``H`` all ones, the
+        paper's choice for its examples), which is rarely the uncertainty
+        meant: give ``H``. ``H = 0`` means no uncertainty (``lambda -> 0``
+        limit: ``EF``, ``EG`` are then ignored). :func:`rlqr_gains` has the
+        same default.
     alpha : float, default 0.1
         ``lambda = (1 + alpha) ||mu H'H||``.
     uncertainty : NormBounded, optional
@@ -340,6 +363,10 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     fallback : {"recursion", "newton"}
         With ``accelerate``: how a design on which doubling misses the
         acceptance test is redone (see :func:`rlqr_gains`).
+    check_stability : bool, default True
+        Raise :class:`NotStabilizingError` if the gain does not make ``F + G
+        K`` Schur stable (possible at finite ``mu``, package docstring).
+        ``False`` returns such a design with ``info["stabilizing"]`` False.
     horizon : int, optional
         Deprecated: use :func:`rlqr_schedule`, which this then calls.
 
@@ -347,9 +374,9 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     -------
     Controller
         ``info`` holds ``P``, ``L``, ``mu``, ``alpha``, ``lambda``,
-        ``implementation``, ``iterations``, ``residual``. For finite ``mu``
-        the RLQR stabilises its closed loop ``L``; check
-        ``ctrl.is_stabilizing()`` for the nominal ``F + G K``.
+        ``implementation``, ``iterations``, ``residual`` and ``stabilizing``
+        (``F + G K`` is Schur stable; always True unless
+        ``check_stability=False``).
 
     Raises
     ------
@@ -362,6 +389,9 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     ConvergenceError
         No stabilising steady state was reached (the recursion diverged, or
         did not converge in ``max_iter`` steps).
+    NotStabilizingError
+        (a ``ConvergenceError``) The steady state was reached but ``F + G K``
+        is not Schur stable, with ``check_stability`` True (the default).
     """
     if horizon is not None:
         warnings.warn("rlqr(..., horizon=N) is deprecated; use rlqr_schedule(..., horizon=N)",
@@ -374,6 +404,7 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     max_iter = check_int(max_iter, "max_iter")
     accelerate = check_bool(accelerate, "accelerate")
     fallback = check_choice(fallback, "fallback", _FALLBACKS)
+    check_stability = check_bool(check_stability, "check_stability")
     P_N = _start(P_N, "P_N", d, definite=implementation == "block")
     check_stabilizable(plant)
     if not d.rank_ok()[0]:
@@ -390,9 +421,19 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     if verdict != "ok":
         raise ConvergenceError(f"the RLQR recursion did not reach a stabilising steady state in "
                                f"max_iter={max_iter} steps (relative change of P {res:.3g}, tol={tol:g})")
+    K = st.K[0]
+    closed = plant.F + plant.G @ K
+    stabilizing = bool(is_schur_stable(closed))
+    if not stabilizing and check_stability:
+        raise NotStabilizingError(
+            f"the RLQR design at mu = {float(d.mu[0]):g} converged but does not stabilise the nominal plant: "
+            f"rho(F + G K) = {spectral_radius(closed):.6g} >= 1 - {STABILITY_MARGIN:g}, while its own closed "
+            f"loop L, helped by the fictitious input a finite mu allows, has rho(L) = "
+            f"{spectral_radius(st.L[0]):.6g}. Increase mu (mu = inf forces L = F + G K), reduce EF, EG or H, "
+            "or pass check_stability=False to get this design anyway (info['stabilizing'] is then False)")
     info = _info(d, implementation)
-    info.update(P=st.P[0], L=st.L[0], iterations=int(st.iterations[0]), residual=res)
-    return Controller(st.K[0], "rlqr", plant, info)
+    info.update(P=st.P[0], L=st.L[0], iterations=int(st.iterations[0]), residual=res, stabilizing=stabilizing)
+    return Controller(K, "rlqr", plant, info)
 
 
 def rlqr_schedule(plant: Plant, EF=None, EG=None, mu=None, *, horizon: int, Q=None, R=None, H=None,

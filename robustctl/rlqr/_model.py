@@ -79,11 +79,19 @@ class Model:
         return ok
 
     def rank_error(self) -> RankConditionError:
+        """The error for the first design of the batch (what :func:`rlqr` raises), with the numbers of the test."""
         l, m = self.EG.shape[1:]
+        head = f"mu = inf needs EG ({l}x{m}) to have full row rank {l} (equivalently [I -G; 0 -EG] of full row rank)"
+        tail = "; use a finite mu or change EG"
+        if l > m:
+            return RankConditionError(f"{head}, but it has more rows than columns (rank at most {m}){tail}")
+        sv = np.linalg.svd(self.EG[0], compute_uv=False)
+        rank = int(np.sum(sv > RANK_TOL * max(float(sv[0]), 1e-300)))
+        cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
         return RankConditionError(
-            f"mu = inf needs EG ({l}x{m}) to have full row rank {l} "
-            f"(equivalently [I -G; 0 -EG] of full row rank), got rank {np.linalg.matrix_rank(self.EG[0])}; "
-            "use a finite mu or change EG")
+            f"{head}, got numerical rank {rank}: its singular values are {np.array2string(sv, precision=3)}, "
+            f"condition number {cond:.3g}, and full rank needs the smallest above {RANK_TOL:g} times the largest "
+            f"(condition number below {1 / RANK_TOL:.3g}){tail}")
 
 
 def _norm2(H: np.ndarray) -> float:
