@@ -251,6 +251,10 @@ class TuningProblem(Problem):
             F_s, G_s = np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
         return F_s[None] + G_s[None] @ K[:, None]
 
+    def closed_loop_radius(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
+        """Spectral radius (B, S) of the closed loop per scenario (inf for non-finite K)."""
+        return np.asarray(rc.spectral_radius(self.closed_loops(K, scenarios)))      # a stack: an array
+
     def stability(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the worst spectral radius.
 
