@@ -246,3 +246,23 @@ def test_tune_options_and_record():
         tuning.tune(prob, molsp=False, max_leaders=3, evals=40, pop_size=20)
     with pytest.raises(ValueError, match="unknown algorithm"):
         tuning.tune(prob, "nope", evals=40, pop_size=20)
+
+
+def test_sample_reference_points_by_hand():
+    prob = tuning.TuningProblem(tuning.LQRFamily(PLANT), SCENARIOS, [effort, radius])
+    hv, ms = prob.sample_reference_points(200, seed=4, margin=0.5)
+    Z = np.random.default_rng(4).uniform(prob.xl, prob.xu, (200, prob.n_var))
+    F = prob.evaluate(Z)
+    ok = np.all(prob.penalty > F, axis=1)
+    Fa = F[ok]
+    nd = np.array([not np.any(np.all(Fa <= f, axis=1) & np.any(Fa < f, axis=1)) for f in Fa])
+    lo, hi = Fa[nd].min(axis=0), Fa[nd].max(axis=0)
+    np.testing.assert_allclose(hv, hi + 0.5 * (hi - lo))
+    np.testing.assert_allclose(ms, np.maximum(Fa.max(axis=0), hi) + 0.5 * (hi - lo))
+    assert np.all(Fa[nd] < hv) and np.all(Fa < ms)
+    def huge(K, plants):                 # above the penalty: clipped, never acceptable
+        return np.full(len(K), 2e6)
+
+    tight = tuning.TuningProblem(tuning.LQRFamily(PLANT), SCENARIOS, [huge])
+    with pytest.raises(ValueError, match="none of the 20 sampled designs is acceptable"):
+        tight.sample_reference_points(20)
