@@ -27,7 +27,7 @@ Two event handlers keep the references right:
   the page of what it names (ours, or another project's through intersphinx).
   Names that do not exist there, or are private, stay unresolved (warnings).
 * ``autodoc-process-bases``: "Bases:" lists a private, undocumented base
-  class (``moo.problems.generic._RLQRTuningProblem``) as its own bases;
+  class (for example a private mixin) as its own bases;
   ``autodoc-skip-member``: class pages include inherited members defined in
   our packages (what a public class gets from such a base), never pymoo's.
 
