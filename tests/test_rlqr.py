@@ -178,14 +178,10 @@ def test_finite_horizon_schedule():
     assert _rel(short.K[4], K4) < 1e-10 and _rel(short.P[4], P4) < 1e-10
 
 
-def test_rlqr_with_horizon_is_deprecated_and_returns_the_schedule(generic_plant):
-    args = (generic_plant, [[0.1, 0.2, 0.2]], [[0.1]], 1e3)
-    with pytest.warns(DeprecationWarning, match="rlqr_schedule"):
-        old = rc.rlqr(*args, horizon=7)
-    new = rc.rlqr_schedule(*args, horizon=7)
-    assert isinstance(old, rc.RLQRSchedule)
-    np.testing.assert_array_equal(old.K, new.K)
-    np.testing.assert_array_equal(old.P, new.P)
+def test_rlqr_has_no_horizon_argument(generic_plant):
+    """The finite-horizon form is rlqr_schedule only (the deprecated rlqr(..., horizon=N) is gone)."""
+    with pytest.raises(TypeError, match="horizon"):
+        rc.rlqr(generic_plant, [[0.1, 0.2, 0.2]], [[0.1]], 1e3, horizon=7)
 
 
 def test_errors_single_design(generic_plant):
@@ -286,13 +282,11 @@ def test_batch_broadcasting_and_shapes():
         ({"H": np.ones((2, 1))}, ValueError, "H must have 3 rows"),
         ({"Q": np.ones((3, 3)) - 2 * np.eye(3)}, ValueError, "Q must be positive semidefinite"),
         ({"R": [[-1.0]]}, ValueError, "R must be positive definite"),
-        ({"horizon": 0}, ValueError, "horizon must be a positive integer"),  # the deprecated form
         ({"tol": 0.0}, ValueError, "tol must be > 0"),
         ({"max_iter": 0}, ValueError, "max_iter must be a positive integer"),
         ({"implementation": "fast"}, ValueError, "implementation must be"),
     ],
 )
-@pytest.mark.filterwarnings("ignore:rlqr\\(\\.\\.\\., horizon=N\\) is deprecated:DeprecationWarning")
 def test_rlqr_bad_input(generic_plant, kw, err, match):
     args = {"EF": [[0.1, 0.2, 0.2]], "EG": [[0.1]], "mu": 1e3}
     args.update(kw)

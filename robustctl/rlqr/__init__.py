@@ -111,10 +111,9 @@ state gains for the discrete optimal regulator. IEEE TAC 16(4), 382-384.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, overload
+from typing import Any
 
 import numpy as np
 
@@ -227,7 +226,7 @@ def _info(d: Model, implementation: str) -> dict:
 
 def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None,
                alpha: float = DEFAULT_ALPHA, uncertainty=None, tol: float = DEFAULT_TOL,
-               max_iter: int = DEFAULT_MAX_ITER, P0=None, fallback: str = "recursion") -> RLQRBatch:
+               max_iter: int = DEFAULT_MAX_ITER, P_N=None, fallback: str = "recursion") -> RLQRBatch:
     """Steady-state RLQR gains for ``B`` uncertainty models at once (vectorised).
 
     Parameters
@@ -253,15 +252,17 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
         Acceptance: one more recursion step changes ``P`` by less than ``tol``
         (relative) and ``rho(L) < 1 - 1e-9``; at most ``max_iter`` steps of
         the plain recursion where it is needed.
-    P0 : (n, n) array_like, optional
+    P_N : (n, n) array_like, optional
         Starting point of the plain recursion where it is needed (default
-        ``Q``; the steady state does not depend on it).
+        ``Q``; the steady state does not depend on it). The same name as in
+        :func:`rlqr` and :func:`rlqr_schedule`, where the recursion starts from
+        the terminal weight ``P[N]``.
     fallback : {"recursion", "newton"}
         What happens to designs on which doubling settles but misses the
         acceptance test (ill-conditioned ones, e.g. the doubled steering
         column with nearly equal ``EG`` entries, ``P`` near 1e15):
         ``"recursion"`` (default) redoes them with the plain recursion from
-        ``P0``, so ``max_iter`` also decides which slowly converging designs
+        ``P_N``, so ``max_iter`` also decides which slowly converging designs
         are flagged ``"not converged"``; ``"newton"`` first refines the doubling
         result by Newton's method (a few Stein equations; on the truck's
         ill-conditioned designs about 2.5 times cheaper than the compiled
@@ -286,7 +287,7 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
     d = build(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, uncertainty=uncertainty, batch=True)
     tol = check_positive_scalar(tol, "tol")
     max_iter = check_int(max_iter, "max_iter")
-    P0 = _start(P0, "P0", d, definite=False)
+    P0 = _start(P_N, "P_N", d, definite=False)
     fallback = check_choice(fallback, "fallback", _FALLBACKS)
     B, (n, m) = d.size, plant.G.shape
     K, P, L = np.full((B, m, n), np.nan), np.full((B, n, n), np.nan), np.full((B, n, n), np.nan)
@@ -308,20 +309,10 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
     return RLQRBatch(_frozen(K), _frozen(P), _frozen(L), ok, reason, stabilizing, iterations, residual)
 
 
-@overload
-def rlqr(plant: Plant, EF=..., EG=..., mu=..., *, Q=..., R=..., H=..., alpha: float = ..., uncertainty=...,
-         P_N=..., tol: float = ..., max_iter: int = ..., accelerate: bool = ..., implementation: str = ...,
-         fallback: str = ..., check_stability: bool = ..., horizon: None = ...) -> Controller: ...
-@overload
-def rlqr(plant: Plant, EF=..., EG=..., mu=..., *, Q=..., R=..., H=..., alpha: float = ..., uncertainty=...,
-         P_N=..., tol: float = ..., max_iter: int = ..., accelerate: bool = ..., implementation: str = ...,
-         fallback: str = ..., check_stability: bool = ..., horizon: int) -> RLQRSchedule: ...  # deprecated
-
-
 def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alpha: float = DEFAULT_ALPHA,
          uncertainty=None, P_N=None, tol: float = DEFAULT_TOL, max_iter: int = DEFAULT_MAX_ITER,
          accelerate: bool = True, implementation: str = "kkt", fallback: str = "recursion",
-         check_stability: bool = True, horizon: int | None = None) -> Controller | RLQRSchedule:
+         check_stability: bool = True) -> Controller:
     """Steady-state robust LQR for ``[dF dG] = H Delta [EF EG]``, ``||Delta|| <= 1`` (paper Theorem 1).
 
     Parameters
@@ -367,8 +358,6 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
         Raise :class:`NotStabilizingError` if the gain does not make ``F + G
         K`` Schur stable (possible at finite ``mu``, package docstring).
         ``False`` returns such a design with ``info["stabilizing"]`` False.
-    horizon : int, optional
-        Deprecated: use :func:`rlqr_schedule`, which this then calls.
 
     Returns
     -------
@@ -393,11 +382,6 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
         (a ``ConvergenceError``) The steady state was reached but ``F + G K``
         is not Schur stable, with ``check_stability`` True (the default).
     """
-    if horizon is not None:
-        warnings.warn("rlqr(..., horizon=N) is deprecated; use rlqr_schedule(..., horizon=N)",
-                      DeprecationWarning, stacklevel=2)
-        return rlqr_schedule(plant, EF, EG, mu, horizon=horizon, Q=Q, R=R, H=H, alpha=alpha,
-                             uncertainty=uncertainty, P_N=P_N, implementation=implementation)
     d = build(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, uncertainty=uncertainty, batch=False)
     implementation = check_choice(implementation, "implementation", _IMPLEMENTATIONS)
     tol = check_positive_scalar(tol, "tol")
