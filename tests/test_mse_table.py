@@ -17,7 +17,7 @@ import robustctl as rc
 from robustctl.hinf_game import hinf_game
 from robustctl.models import truck
 from robustctl.path import default_route
-from robustctl.simulate import simulate
+from robustctl.pathfollow import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 

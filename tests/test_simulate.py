@@ -25,7 +25,8 @@ from robustctl.batchsim import LinearSimulator
 from robustctl.models import truck
 from robustctl.path import Curve, ReferencePath, Straight, default_route
 from robustctl.pathfollow import PathFollowing
-from robustctl.simulate import SimulationResult, simulate, simulate_linear
+from robustctl.batchsim import SimulationResult, simulate_linear
+from robustctl.pathfollow import simulate
 
 Q = np.diag([1 / 0.5**2, 1 / 0.1**2, 1 / 0.25**2, 1 / 0.05**2])
 R = np.array([[1 / 0.1**2]])
