@@ -21,12 +21,10 @@ import numpy as np
 import pytest
 
 import robustctl as rc
-from robustctl.batchsim import LinearSimulator
+from robustctl.batchsim import LinearSimulator, SimulationResult, simulate_linear
 from robustctl.models import truck
 from robustctl.path import Curve, ReferencePath, Straight, default_route
-from robustctl.pathfollow import PathFollowing
-from robustctl.batchsim import SimulationResult, simulate_linear
-from robustctl.pathfollow import simulate
+from robustctl.pathfollow import PathFollowing, simulate
 
 Q = np.diag([1 / 0.5**2, 1 / 0.1**2, 1 / 0.25**2, 1 / 0.05**2])
 R = np.array([[1 / 0.1**2]])
