@@ -105,15 +105,15 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
 
-from . import _cvx
-from ._validation import as_batch, as_matrix, as_rng, check_int, check_performance, check_spd
+from . import _cvx, _hinfnorm
+from ._validation import as_batch, as_float_array, as_matrix, as_rng, check_int, check_performance, check_spd
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .plant import Plant, _frozen, check_vertices
-from .stability import is_stable, spectral_abscissa, spectral_radius
+from .stability import STABILITY_MARGIN, is_stable, spectral_abscissa, spectral_radius
 from .uncertainty import NormBounded, check_norm_bounded
 
-__all__ = ["RobustStability", "CostBound", "HinfBound", "WorstCase",
+__all__ = ["RobustStability", "RobustStabilityBatch", "CostBound", "HinfBound", "WorstCase",
            "robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case"]
 
 # Regularisation (relative to the weight's norm) of the Lyapunov equation defining the coordinates.
@@ -128,11 +128,20 @@ _POLY_T = 1e-9
 _POLY_RTOL = 1e-3
 _POLY_RMAX = 1e3
 _POLY_STEPS = 60
+# Riccati certificate: tries of the regularisation eps (each 100 times smaller) before the SDP.
+_EPS_TRIES = 3
 # Worst-case search: projected-gradient iterations per start.
 _ASCENT_ITER = 200
 
 
 # ---------------------------------------------------------------- results
+def _ro(arr: np.ndarray) -> np.ndarray:
+    """A read-only copy that keeps the dtype (bool, str)."""
+    arr = np.array(arr)
+    arr.flags.writeable = False
+    return arr
+
+
 def _fmt(x) -> str:
     return "None" if x is None else f"{x:.6g}"
 
@@ -179,6 +188,60 @@ class RobustStability:
         cert = min(self.certificate.values()) if self.certificate else None
         return (f"RobustStability(certified={self.certified}, margin={_fmt(self.margin)}, "
                 f"radius={_fmt(self.radius)}, kind={self.kind!r}, smallest certificate eigenvalue={_fmt(cert)})")
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class RobustStabilityBatch:
+    """Quadratic-stability certificates of a stack of gains ``K`` (B, m, n) on one plant.
+
+    Design ``b`` gets the answer that ``robust_stability((plant, K[b]), ...)``
+    gives (:class:`RobustStability`), as entries of arrays.
+
+    Attributes
+    ----------
+    certified : (B,) bool ndarray
+    margin : (B,) ndarray
+        ``0`` where the nominal loop is unstable, ``nan`` where ``K[b]`` has
+        a non-finite entry.
+    radius : (B,) ndarray
+        The radius that ``P[b]`` certifies (0 where there is no ``P``).
+    P : (B, n, n) ndarray
+        Lyapunov matrices in the plant's coordinates (NaN rows where there is none).
+    certificate : Mapping[str, (B,) ndarray]
+        Smallest eigenvalue of each block of the certificate LMI at ``P[b]``
+        (the keys of :class:`RobustStability`; NaN where there is no ``P``).
+    reason : (B,) str ndarray
+        ``"ok"`` (analysed: see ``certified`` and ``margin``), ``"unstable"``
+        (the nominal loop ``F + G K`` is not stable: margin 0) or
+        ``"not finite"`` (``K[b]`` has a NaN or infinite entry: margin NaN).
+    kind : str
+        ``"norm-bounded"`` or ``"polytope"``.
+    info : Mapping
+        ``"path"``: (B,) str ndarray, which computation certified ``P[b]``
+        (``"riccati"``, ``"sdp"``, ``""`` where there is no ``P``);
+        ``"nominal_radius"``: (B,) spectral radius (abscissa) of ``F + G K``;
+        ``"norm_iterations"``: level-set steps of the H-infinity norm;
+        ``"sdp_solves"``: designs that needed the SDP.
+    """
+
+    certified: np.ndarray
+    margin: np.ndarray
+    radius: np.ndarray
+    P: np.ndarray
+    certificate: Mapping[str, np.ndarray]
+    reason: np.ndarray
+    kind: str
+    info: Mapping[str, Any] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return self.margin.shape[0]
+
+    def __repr__(self) -> str:
+        ok = self.reason == "ok"
+        return (f"RobustStabilityBatch(B={len(self)}, kind={self.kind!r}, certified={int(self.certified.sum())}"
+                f"/{len(self)}, unstable={int((self.reason == 'unstable').sum())}, "
+                f"not finite={int((self.reason == 'not finite').sum())}, "
+                f"smallest margin={_fmt(float(self.margin[ok].min()) if ok.any() else None)})")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -271,12 +334,27 @@ class WorstCase:
 
 
 # ---------------------------------------------------------------- validation
-def _loop(controller) -> tuple[Plant, np.ndarray]:
-    """``(plant, K)`` from a Controller or a ``(plant, K)`` pair."""
+def _loop(controller, batch: bool = False) -> tuple[Plant, np.ndarray]:
+    """``(plant, K)`` from a Controller or a ``(plant, K)`` pair.
+
+    With ``batch``, ``K`` may also be a stack (B, m, n) (returned 3-D; its
+    entries may be non-finite: the caller flags those designs).
+    """
     if isinstance(controller, Controller):
         return controller.plant, controller.K
     if isinstance(controller, tuple) and len(controller) == 2 and isinstance(controller[0], Plant):
         plant = controller[0]
+        if batch:
+            arr = as_float_array(controller[1], "K")
+            if arr.ndim == 3:
+                if arr.shape[1:] != (plant.m, plant.n) or arr.shape[0] == 0:
+                    raise ValueError(f"K must be a gain ({plant.m}, {plant.n}) or a non-empty stack of gains "
+                                     f"(B, {plant.m}, {plant.n}) (the numbers of inputs and states), "
+                                     f"got shape {arr.shape}")
+                return plant, arr
+            if arr.ndim > 3:
+                raise ValueError(f"K must be a gain ({plant.m}, {plant.n}) or a stack of gains "
+                                 f"(B, {plant.m}, {plant.n}), got an array of shape {arr.shape}")
         K = as_matrix(controller[1], "K", rows=plant.m, cols=plant.n,
                       rows_what="the number of inputs", cols_what="the number of states")
         return plant, K
@@ -369,7 +447,8 @@ def _relative_min_eig(blocks: Mapping[str, np.ndarray]) -> float:
     return min(_min_eig(M) / max(1.0, float(np.linalg.norm(M, 2))) for M in blocks.values())
 
 
-def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
+def _norm_bounded_sdp(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
+    """The margin and certificate by one SDP (the fallback of :func:`_norm_bounded_batch`)."""
     import cvxpy as cp
 
     discrete = plant.is_discrete
@@ -415,6 +494,169 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     info = {"nominal_radius": nominal, "mu": mu_opt, **_solve_info([rep])}
     return RobustStability(bool(radius == 1.0 and score > _STRICT), float(margin), float(radius), _frozen(P_c),
                            MappingProxyType(cert), "norm-bounded", MappingProxyType(info))
+
+
+def _batched_blocks(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
+    """:func:`_stability_blocks` for stacks (``Hr`` (B, n, p) already scaled by the radius)."""
+    n, p = A.shape[-1], Hr.shape[-1]
+    AH = np.concatenate([A, Hr], axis=-1)
+    if discrete:
+        M = -(AH.mT @ P @ AH)
+        M[:, :n, :n] += P
+    else:
+        S = P @ AH
+        M = np.zeros_like(S, shape=(A.shape[0], n + p, n + p))
+        M[:, :n, :] = -S
+        M[:, :, :n] -= S.mT
+    M[:, :n, :n] -= E.mT @ E
+    M[:, n:, n:] += np.eye(p)
+    return {"P": P, "lyapunov": M}
+
+
+def _verify(blocks: Mapping[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Relative score (smallest of ``lambda_min / max(1, ||M||)`` over the blocks) and smallest eigenvalues."""
+    score, cert = None, {}
+    for key, M in blocks.items():
+        ev = np.linalg.eigvalsh(0.5 * (M + M.mT))
+        cert[key] = ev[:, 0]
+        rel = ev[:, 0] / np.maximum(1.0, np.maximum(np.abs(ev[:, 0]), np.abs(ev[:, -1])))
+        score = rel if score is None else np.minimum(score, rel)
+    return score, cert
+
+
+def _riccati_certificates(A, H, E, g, peak, discrete: bool):
+    """``(radius, P, certificate, verified)`` from the bounded-real Riccati equation (stacks).
+
+    For ``g = ||E (zI - A)^-1 H||_inf`` the target radius is ``r = 1`` if
+    ``r g < 1`` (margin above 1) or ``r = margin / (1 + 1e-3)``. With
+    ``gr = r g`` and ``gamma^2 = (1 + gr^2) / 2`` the stabilising solution
+    ``P`` of the Riccati equation of ``(A, r H, [E; sqrt(eps) I])`` at level
+    ``gamma`` (module :mod:`robustctl._hinfnorm`) makes the certificate LMI at
+    radius ``r`` strictly positive: its Schur complement is
+    ``eps I + A'PH_r ((gamma^2 I - H_r'PH_r)^-1 - (I - H_r'PH_r)^-1) H_r'PA > 0``
+    (continuous alike), provided the level exceeds the regularised norm:
+    ``eps = (gamma^2 - gr^2) / (4 h^2)`` with ``h`` the largest
+    ``sigma_max((zI - A)^-1 H_r)`` at the peak, at 0 and (discrete) at
+    ``z = -1``; every failure is retried with ``eps / 100``.
+    """
+    S, n = A.shape[0], A.shape[-1]
+    with np.errstate(divide="ignore"):
+        margin = np.where(g > 0, 1.0 / g, np.inf)
+    r = np.where(margin > 1.0, 1.0, margin / (1.0 + _BACKOFF))
+    Hr = r[:, None, None] * H
+    gr = r * g
+    gam = np.sqrt(0.5 * (1.0 + gr**2))
+    # H_r and E of equal norms (c): P = c^2 P~ of the balanced problem
+    hn, en = np.linalg.norm(Hr, axis=(1, 2)), np.linalg.norm(E, axis=(1, 2))
+    c = np.where((hn > 0) & (en > 0), np.sqrt(en / np.where(hn > 0, hn, 1.0)), 1.0)
+    Hb, Eb = Hr * c[:, None, None], E / c[:, None, None]
+    ang = np.stack([peak, np.zeros(S), np.full(S, np.pi)], axis=1)
+    pts = np.exp(1j * ang) if discrete else 1j * ang[:, :2]
+    h = _hinfnorm.sigma_max(A, Hb, np.broadcast_to(np.eye(n), (S, n, n)), pts).max(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        eps = np.where(h > 0, (gam**2 - gr**2) / (4.0 * h**2), 1.0)
+    eps = np.minimum(eps, np.maximum(1.0, (en / c) ** 2))
+    P = np.full((S, n, n), np.nan)
+    score = np.full(S, -np.inf)
+    cert = {"P": np.full(S, np.nan), "lyapunov": np.full(S, np.nan)}
+    todo = np.arange(S)
+    eye = np.eye(n)
+    for _ in range(_EPS_TRIES):
+        if not todo.size:
+            break
+        Ea = np.concatenate([Eb[todo], np.sqrt(eps[todo])[:, None, None] * eye], axis=1)
+        Pt, ok = _hinfnorm.bounded_real_riccati(A[todo], Hb[todo], Ea, gam[todo], discrete=discrete)
+        Pt = Pt * (c[todo] ** 2)[:, None, None]
+        Pt[~ok] = np.nan
+        fin = ok.copy()
+        sc = np.full(todo.size, -np.inf)
+        if fin.any():
+            sc_f, cert_f = _verify(_batched_blocks(A[todo][fin], Hr[todo][fin], E[todo][fin], Pt[fin], discrete))
+            sc[fin] = sc_f
+            better = sc > score[todo]
+            sel = todo[better]
+            score[sel], P[sel] = sc[better], Pt[better]
+            idx_f = np.flatnonzero(fin)
+            for key, v in cert_f.items():
+                full = np.full(todo.size, np.nan)
+                full[idx_f] = v
+                cert[key][sel] = full[better]
+        todo = todo[~(sc > _STRICT)]
+        eps[todo] *= 1e-2
+    return r, P, cert, score > _STRICT
+
+
+def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStabilityBatch:
+    """Margins (small-gain values by the level-set H-infinity norm) and Riccati certificates of a stack of gains."""
+    discrete = plant.is_discrete
+    B, n = K.shape[0], plant.n
+    finite = np.isfinite(K).all(axis=(1, 2))
+    Kf = np.where(finite[:, None, None], K, 0.0)
+    A = plant.F + plant.G @ Kf
+    E = unc.EF + unc.EG @ Kf
+    nominal = np.asarray(spectral_radius(A) if discrete else spectral_abscissa(A), dtype=float).reshape(B)
+    stable = finite & (nominal < ((1.0 - STABILITY_MARGIN) if discrete else -STABILITY_MARGIN))
+    nominal = np.where(finite, nominal, np.nan)
+    reason = np.where(finite, np.where(stable, "ok", "unstable"), "not finite")
+    margin = np.where(finite, 0.0, np.nan)
+    radius = np.zeros(B)
+    certified = np.zeros(B, dtype=bool)
+    P = np.full((B, n, n), np.nan)
+    cert = {"P": np.full(B, np.nan), "lyapunov": np.full(B, np.nan)}
+    path = np.full(B, "", dtype=object)
+    iterations = 0
+    sdp = 0
+    idx = np.flatnonzero(stable)
+    if idx.size:
+        As, Es = A[idx], E[idx]
+        Hs = np.broadcast_to(unc.H, (idx.size, *unc.H.shape))
+        g, peak, iterations = _hinfnorm.hinf_norm(As, Hs, Es, discrete=discrete)
+        with np.errstate(divide="ignore"):
+            margin[idx] = np.where(g > 0, 1.0 / g, np.inf)
+        r, Ps, cs, ok = _riccati_certificates(As, Hs, Es, g, peak, discrete)
+        radius[idx], P[idx] = r, Ps
+        for key in cert:
+            cert[key][idx] = cs[key]
+        path[idx[ok]] = "riccati"
+        for j in np.flatnonzero(~ok):   # rare: the SDP, one design at a time
+            b = int(idx[j])
+            sdp += 1
+            try:
+                res = _norm_bounded_sdp(plant, Kf[b], unc)
+            except (InfeasibleError, ConvergenceError):
+                continue
+            if res.P is None:
+                continue
+            Hr = (r[j] * unc.H)[None]
+            score, cs_b = _verify(_batched_blocks(As[j:j + 1], Hr, Es[j:j + 1], res.P[None], discrete))
+            P[b] = res.P
+            for key in cert:
+                cert[key][b] = cs_b[key][0]
+            if score[0] > _STRICT:
+                ok[j] = True
+                path[b] = "sdp"
+        certified[idx] = ok & (r == 1.0)
+    info = {"path": _ro(path.astype(str)), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
+            "sdp_solves": sdp}
+    return RobustStabilityBatch(_ro(certified), _frozen(margin), _frozen(radius), _frozen(P),
+                                MappingProxyType({k: _frozen(v) for k, v in cert.items()}), _ro(reason),
+                                "norm-bounded", MappingProxyType(info))
+
+
+def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
+    """One gain: the batch of one, as a :class:`RobustStability`."""
+    res = _norm_bounded_batch(plant, K[None], unc)
+    nominal = float(res.info["nominal_radius"][0])
+    if res.reason[0] == "unstable":
+        return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
+                               MappingProxyType({"nominal_radius": nominal}))
+    info = {"path": str(res.info["path"][0]) or None, "nominal_radius": nominal,
+            "norm_iterations": res.info["norm_iterations"]}
+    has_P = bool(np.isfinite(res.P[0]).all())
+    return RobustStability(bool(res.certified[0]), float(res.margin[0]), float(res.radius[0]),
+                           _frozen(res.P[0].copy()) if has_P else None,
+                           MappingProxyType({k: float(v[0]) for k, v in res.certificate.items()} if has_P else {}),
+                           "norm-bounded", MappingProxyType(info))
 
 
 def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
@@ -488,7 +730,7 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
 
 
 def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertainty: NormBounded | None = None, *,
-                     vertices: Sequence[Plant] | None = None) -> RobustStability:
+                     vertices: Sequence[Plant] | None = None) -> RobustStability | RobustStabilityBatch:
     r"""Quadratic-stability certificate and margin of ``u = K x`` under norm-bounded or polytopic uncertainty.
 
     Norm-bounded (``uncertainty``): stability of ``A + H Delta E`` for every
@@ -544,14 +786,47 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
     >>> rc.robust_stability(ctrl, vertices=[truck_plant(300.0)]).certified
     True
     """
-    plant, K = _loop(controller)
+    plant, K = _loop(controller, batch=True)
     if (uncertainty is None) == (vertices is None):
         raise ValueError("give exactly one of uncertainty (a NormBounded) and vertices (a list of Plant)")
     if vertices is not None:
         # a polytope needs a vertex besides the nominal plant
-        return _polytope_stability(check_vertices(plant, vertices, reference="the controller's plant",
-                                                  non_empty=True), K)
-    return _norm_bounded_stability(plant, K, check_norm_bounded(uncertainty, plant))
+        plants = check_vertices(plant, vertices, reference="the controller's plant", non_empty=True)
+        if K.ndim == 2:
+            return _polytope_stability(plants, K)
+        return _polytope_batch(plants, K)
+    unc = check_norm_bounded(uncertainty, plant)
+    if K.ndim == 2:
+        return _norm_bounded_stability(plant, K, unc)
+    return _norm_bounded_batch(plant, K, unc)
+
+
+def _polytope_batch(plants: list[Plant], K: np.ndarray) -> RobustStabilityBatch:
+    """The polytope test design by design (a bisection of SDPs each), assembled like the norm-bounded batch."""
+    B, n = K.shape[0], plants[0].n
+    out = {"certified": np.zeros(B, dtype=bool), "margin": np.full(B, np.nan), "radius": np.zeros(B)}
+    P = np.full((B, n, n), np.nan)
+    cert = {f"vertex[{i}]": np.full(B, np.nan) for i in range(len(plants))}
+    cert = {"P": np.full(B, np.nan), **cert}
+    reason = np.full(B, "not finite", dtype=object)
+    nominal = np.full(B, np.nan)
+    path = np.full(B, "", dtype=object)
+    for b in range(B):
+        if not np.isfinite(K[b]).all():
+            continue
+        res = _polytope_stability(plants, K[b])
+        out["certified"][b], out["margin"][b], out["radius"][b] = res.certified, res.margin, res.radius
+        nominal[b] = res.info["nominal_radius"]
+        reason[b] = "ok" if res.P is not None else "unstable"
+        if res.P is not None:
+            P[b] = res.P
+            path[b] = "sdp"
+            for key, v in res.certificate.items():
+                cert[key][b] = v
+    info = {"path": _ro(path.astype(str)), "nominal_radius": _frozen(nominal)}
+    return RobustStabilityBatch(_ro(out["certified"]), _frozen(out["margin"]), _frozen(out["radius"]),
+                                _frozen(P), MappingProxyType({k: _frozen(v) for k, v in cert.items()}),
+                                _ro(reason.astype(str)), "polytope", MappingProxyType(info))
 
 
 # ---------------------------------------------------------------- performance bounds
