@@ -117,17 +117,24 @@ def _theta(w, flip):
     return phi if flip is None else np.where(flip[:, None], np.pi - phi, phi)
 
 
-def _start(A, discrete: bool):
-    """First frequencies (S, k): ``w = 0`` and the moduli of the complex poles (continuous); ``theta = 0``,
-    ``pi`` and the angles of the complex poles (discrete)."""
-    lam = np.linalg.eigvals(A)
-    zero = np.zeros((A.shape[0], 1))
+def _start(lam, discrete: bool):
+    """First frequencies (S, 2 or 3) from the poles ``lam`` (S, n).
+
+    ``w = 0`` and the modulus of the most lightly damped complex pole
+    (continuous, the choice of Bruinsma & Steinbuch); ``theta = 0``, ``pi``
+    and the angle of the complex pole nearest the unit circle (discrete).
+    """
+    zero = np.zeros((lam.shape[0], 1))
+    rows = np.arange(lam.shape[0])
     if discrete:
-        return np.concatenate([zero, zero + np.pi, np.where(lam.imag > 0, np.angle(lam), 0.0)], axis=1)
-    return np.concatenate([zero, np.where(lam.imag > 0, np.abs(lam), 0.0)], axis=1)
+        k = np.argmax(np.where(lam.imag > 0, np.abs(lam), -1.0), axis=1)
+        return np.concatenate([zero, zero + np.pi, np.abs(np.angle(lam[rows, k]))[:, None]], axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.argmax(np.where(lam.imag > 0, np.abs(lam.imag / lam.real), -1.0), axis=1)
+    return np.concatenate([zero, np.where(lam[rows, k].imag > 0, np.abs(lam[rows, k]), 0.0)[:, None]], axis=1)
 
 
-def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL):
+def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
     """``||G_b||_inf`` of each stable loop of a stack (D = 0).
 
     Parameters
@@ -136,6 +143,8 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL):
     discrete : bool
     tol : float
         Relative accuracy (module docstring).
+    poles : (S, n) ndarray, optional
+        The eigenvalues of ``A`` if already known.
 
     Returns
     -------
@@ -148,64 +157,71 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL):
     """
     S = A.shape[0]
     # equal norms for B and C (G unchanged) keep M(gamma) balanced
-    b = np.linalg.norm(B, axis=(1, 2))
-    c = np.linalg.norm(C, axis=(1, 2))
-    gain = np.zeros(S)
-    freq = np.zeros(S)
+    b = np.sqrt((B * B).sum(axis=(1, 2)))
+    c = np.sqrt((C * C).sum(axis=(1, 2)))
     live = (b > 0) & (c > 0)
-    if not live.any():
+    if not live.all():
+        gain, freq = np.zeros(S), np.zeros(S)
+        if live.any():
+            g, w, it = hinf_norm(A[live], B[live], C[live], discrete=discrete, tol=tol,
+                                 poles=None if poles is None else poles[live])
+            gain[live], freq[live] = g, w
+            return gain, freq, it
         return gain, freq, 0
-    f = np.sqrt(c[live] / b[live])
-    A, B, C = A[live], B[live] * f[:, None, None], C[live] / f[:, None, None]
-    rows = np.arange(A.shape[0])
-    w0 = _start(A, discrete)
+    f = np.sqrt(c / b)[:, None, None]
+    B, C = B * f, C / f
+    rows = np.arange(S)
+    w0 = _start(np.linalg.eigvals(A) if poles is None else poles, discrete)
     sig = sigma_max(A, B, C, np.exp(1j * w0) if discrete else 1j * w0)
     k = np.argmax(sig, axis=1)
     lb, peak = sig[rows, k], w0[rows, k]
-    flip = None
+    flip = np.zeros(S, dtype=bool)
     if discrete:
         # Dc of the transform is G(-1), or G(1) where flipped: the smaller keeps R = gamma^2 I - Dc'Dc far from singular
         flip = sig[:, 1] > sig[:, 0]
         Ah, Bh, Ch, Dh = _cayley(A, B, C, flip)
     else:
         Ah, Bh, Ch, Dh = A, B, C, None
-    active = np.flatnonzero(lb > 0)
+    active = rows
+    ham: tuple = (Ah, Bh, Ch, Dh)
     iterations = 0
     while active.size and iterations < _MAX_ITER:
         iterations += 1
-        gam = (1.0 + 2.0 * tol) * lb[active]
-        ev = np.linalg.eigvals(_hamiltonian(Ah[active], Bh[active], Ch[active],
-                                            None if Dh is None else Dh[active], gam))
-        rho = np.abs(ev).max(axis=1, keepdims=True)
-        imag = (np.abs(ev.real) <= _IMAG * (np.abs(ev) + 1e-3 * rho)) & (ev.imag >= 0)
+        ev = np.linalg.eigvals(_hamiltonian(ham[0], ham[1], ham[2], ham[3], (1.0 + 2.0 * tol) * lb[active]))
+        mag = np.abs(ev)
+        imag = (np.abs(ev.real) <= _IMAG * (mag + 1e-3 * mag.max(axis=1, keepdims=True))) & (ev.imag >= 0)
         count = imag.sum(axis=1)
-        done = count == 0
-        go = ~done
-        if go.any():
-            wi = np.where(imag[go], np.abs(ev.imag[go]), np.inf)
-            wi = np.sort(wi, axis=1)[:, :int(count[go].max())]
-            wi = np.concatenate([np.zeros((wi.shape[0], 1)), wi], axis=1)
-            mid = 0.5 * (wi[:, :-1] + wi[:, 1:])
-            valid = np.isfinite(mid)
-            mid = np.where(valid, mid, 0.0)
-            idx = active[go]
-            if discrete:
-                mid = _theta(mid, flip[idx])
-                pts = np.exp(1j * mid)
-            else:
-                pts = 1j * mid
-            s = np.where(valid, sigma_max(A[idx], B[idx], C[idx], pts), -np.inf)
-            j = np.argmax(s, axis=1)
-            best = s[np.arange(s.shape[0]), j]
-            up = best > lb[idx] * (1.0 + tol)
-            better = best > lb[idx]
-            lb[idx[better]] = best[better]
-            peak[idx[better]] = mid[np.arange(mid.shape[0]), j][better]
-            done[np.flatnonzero(go)[~up]] = True   # no progress: the bound is within rounding
-        active = active[~done]
-    gain[live] = lb
-    freq[live] = peak
-    return gain, freq, iterations
+        keep = count > 0
+        if not keep.any():
+            break
+        act = active
+        if not keep.all():
+            imag, ev, count, act = imag[keep], ev[keep], count[keep], active[keep]
+        wi = np.where(imag, np.abs(ev.imag), np.inf)
+        wi = np.sort(wi, axis=1)[:, :int(count.max())]
+        wi = np.concatenate([np.zeros((wi.shape[0], 1)), wi], axis=1)
+        mid = 0.5 * (wi[:, :-1] + wi[:, 1:])
+        valid = np.isfinite(mid)
+        mid = np.where(valid, mid, 0.0)
+        if discrete:
+            mid = _theta(mid, flip[act])
+            pts = np.exp(1j * mid)
+        else:
+            pts = 1j * mid
+        sv = np.where(valid, sigma_max(A[act], B[act], C[act], pts), -np.inf)
+        j = np.argmax(sv, axis=1)
+        r = np.arange(sv.shape[0])
+        best = sv[r, j]
+        old = lb[act]
+        better = best > old
+        lb[act[better]] = best[better]
+        peak[act[better]] = mid[r, j][better]
+        # no progress: the bound is within rounding of the norm
+        keep[np.flatnonzero(keep)[best <= old * (1.0 + tol)]] = False
+        if not keep.all():
+            active = active[keep]
+            ham = tuple(None if M is None else M[keep] for M in ham)
+    return lb, peak, iterations
 
 
 def bounded_real_riccati(A, B, C, gamma, *, discrete: bool):

@@ -515,74 +515,81 @@ def _batched_blocks(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
 
 def _verify(blocks: Mapping[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Relative score (smallest of ``lambda_min / max(1, ||M||)`` over the blocks) and smallest eigenvalues."""
-    score, cert = None, {}
+    cert, rel = {}, []
     for key, M in blocks.items():
         ev = np.linalg.eigvalsh(0.5 * (M + M.mT))
         cert[key] = ev[:, 0]
-        rel = ev[:, 0] / np.maximum(1.0, np.maximum(np.abs(ev[:, 0]), np.abs(ev[:, -1])))
-        score = rel if score is None else np.minimum(score, rel)
-    return score, cert
+        rel.append(ev[:, 0] / np.maximum(1.0, np.maximum(np.abs(ev[:, 0]), np.abs(ev[:, -1]))))
+    return np.minimum.reduce(rel), cert
 
 
 def _riccati_certificates(A, H, E, g, peak, discrete: bool):
     """``(radius, P, certificate, verified)`` from the bounded-real Riccati equation (stacks).
 
     For ``g = ||E (zI - A)^-1 H||_inf`` the target radius is ``r = 1`` if
-    ``r g < 1`` (margin above 1) or ``r = margin / (1 + 1e-3)``. With
+    ``g < 1`` (margin above 1), else ``r = margin / (1 + 1e-3)``. With
     ``gr = r g`` and ``gamma^2 = (1 + gr^2) / 2`` the stabilising solution
     ``P`` of the Riccati equation of ``(A, r H, [E; sqrt(eps) I])`` at level
-    ``gamma`` (module :mod:`robustctl._hinfnorm`) makes the certificate LMI at
+    ``gamma`` (:mod:`robustctl._hinfnorm`) makes the certificate LMI at
     radius ``r`` strictly positive: its Schur complement is
-    ``eps I + A'PH_r ((gamma^2 I - H_r'PH_r)^-1 - (I - H_r'PH_r)^-1) H_r'PA > 0``
-    (continuous alike), provided the level exceeds the regularised norm:
-    ``eps = (gamma^2 - gr^2) / (4 h^2)`` with ``h`` the largest
-    ``sigma_max((zI - A)^-1 H_r)`` at the peak, at 0 and (discrete) at
-    ``z = -1``; every failure is retried with ``eps / 100``.
+    ``eps I + A'PH_r ((gamma^2 I - H_r'PH_r)^-1 - (I - H_r'PH_r)^-1) H_r'PA``
+    (continuous alike), provided the level exceeds the norm of the
+    regularised loop: ``eps = (gamma^2 - gr^2) / (4 h^2)`` with ``h`` the
+    Frobenius norm of ``(zI - A)^-1 H_r`` at the peak frequency (``H_r`` and
+    ``E`` balanced); a design whose ``P`` fails the check is retried with
+    ``eps / 100``.
     """
-    S, n = A.shape[0], A.shape[-1]
+    n = A.shape[-1]
     with np.errstate(divide="ignore"):
-        margin = np.where(g > 0, 1.0 / g, np.inf)
+        margin = 1.0 / g
     r = np.where(margin > 1.0, 1.0, margin / (1.0 + _BACKOFF))
     Hr = r[:, None, None] * H
     gr = r * g
-    gam = np.sqrt(0.5 * (1.0 + gr**2))
+    gam = np.sqrt(0.5 * (1.0 + gr * gr))
     # H_r and E of equal norms (c): P = c^2 P~ of the balanced problem
-    hn, en = np.linalg.norm(Hr, axis=(1, 2)), np.linalg.norm(E, axis=(1, 2))
-    c = np.where((hn > 0) & (en > 0), np.sqrt(en / np.where(hn > 0, hn, 1.0)), 1.0)
+    hn, en = np.sqrt((Hr * Hr).sum(axis=(1, 2))), np.sqrt((E * E).sum(axis=(1, 2)))
+    reach = (hn > 0) & (en > 0)
+    c = np.sqrt(en / hn) if reach.all() else np.where(reach, np.sqrt(en / np.where(reach, hn, 1.0)), 1.0)
+    c2 = (c * c)[:, None, None]
     Hb, Eb = Hr * c[:, None, None], E / c[:, None, None]
-    ang = np.stack([peak, np.zeros(S), np.full(S, np.pi)], axis=1)
-    pts = np.exp(1j * ang) if discrete else 1j * ang[:, :2]
-    h = _hinfnorm.sigma_max(A, Hb, np.broadcast_to(np.eye(n), (S, n, n)), pts).max(axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        eps = np.where(h > 0, (gam**2 - gr**2) / (4.0 * h**2), 1.0)
-    eps = np.minimum(eps, np.maximum(1.0, (en / c) ** 2))
-    P = np.full((S, n, n), np.nan)
-    score = np.full(S, -np.inf)
-    cert = {"P": np.full(S, np.nan), "lyapunov": np.full(S, np.nan)}
-    todo = np.arange(S)
+    z = np.exp(1j * peak) if discrete else 1j * peak
+    X = np.linalg.solve(z[:, None, None] * np.eye(n) - A, Hb.astype(complex))
+    h2 = (X.real ** 2 + X.imag ** 2).sum(axis=(1, 2))
+    eps = np.minimum((gam * gam - gr * gr) / (4.0 * np.where(h2 > 0, h2, 1.0)),
+                     np.maximum(1.0, (Eb * Eb).sum(axis=(1, 2))))
     eye = np.eye(n)
-    for _ in range(_EPS_TRIES):
-        if not todo.size:
+
+    def attempt(idx):
+        Ea = np.concatenate([Eb[idx], np.sqrt(eps[idx])[:, None, None] * eye], axis=1)
+        P, ok = _hinfnorm.bounded_real_riccati(A[idx], Hb[idx], Ea, gam[idx], discrete=discrete)
+        P = P * c2[idx]
+        ok &= np.isfinite(P).all(axis=(1, 2))
+        if ok.all():
+            score, cert = _verify(_batched_blocks(A[idx], Hr[idx], E[idx], P, discrete))
+            return P, score, cert
+        score = np.full(P.shape[0], -np.inf)
+        cert = {"P": np.full(P.shape[0], np.nan), "lyapunov": np.full(P.shape[0], np.nan)}
+        if ok.any():
+            sel = np.flatnonzero(ok) if isinstance(idx, slice) else idx[ok]
+            score[ok], cert_ok = _verify(_batched_blocks(A[sel], Hr[sel], E[sel], P[ok], discrete))
+            for key, v in cert_ok.items():
+                cert[key][ok] = v
+        return P, score, cert
+
+    everyone = slice(None)
+    P, score, cert = attempt(everyone)
+    bad = np.flatnonzero(~(score > _STRICT))
+    for _ in range(_EPS_TRIES - 1):
+        if not bad.size:
             break
-        Ea = np.concatenate([Eb[todo], np.sqrt(eps[todo])[:, None, None] * eye], axis=1)
-        Pt, ok = _hinfnorm.bounded_real_riccati(A[todo], Hb[todo], Ea, gam[todo], discrete=discrete)
-        Pt = Pt * (c[todo] ** 2)[:, None, None]
-        Pt[~ok] = np.nan
-        fin = ok.copy()
-        sc = np.full(todo.size, -np.inf)
-        if fin.any():
-            sc_f, cert_f = _verify(_batched_blocks(A[todo][fin], Hr[todo][fin], E[todo][fin], Pt[fin], discrete))
-            sc[fin] = sc_f
-            better = sc > score[todo]
-            sel = todo[better]
-            score[sel], P[sel] = sc[better], Pt[better]
-            idx_f = np.flatnonzero(fin)
-            for key, v in cert_f.items():
-                full = np.full(todo.size, np.nan)
-                full[idx_f] = v
-                cert[key][sel] = full[better]
-        todo = todo[~(sc > _STRICT)]
-        eps[todo] *= 1e-2
+        eps[bad] *= 1e-2
+        P2, s2, c2b = attempt(bad)
+        up = s2 > score[bad]
+        sel = bad[up]
+        P[sel], score[sel] = P2[up], s2[up]
+        for key in cert:
+            cert[key][sel] = c2b[key][up]
+        bad = bad[~(s2 > _STRICT)]
     return r, P, cert, score > _STRICT
 
 
@@ -591,52 +598,77 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
     discrete = plant.is_discrete
     B, n = K.shape[0], plant.n
     finite = np.isfinite(K).all(axis=(1, 2))
-    Kf = np.where(finite[:, None, None], K, 0.0)
+    all_finite = bool(finite.all())
+    Kf = K if all_finite else np.where(finite[:, None, None], K, 0.0)
     A = plant.F + plant.G @ Kf
     E = unc.EF + unc.EG @ Kf
-    nominal = np.asarray(spectral_radius(A) if discrete else spectral_abscissa(A), dtype=float).reshape(B)
-    stable = finite & (nominal < ((1.0 - STABILITY_MARGIN) if discrete else -STABILITY_MARGIN))
-    nominal = np.where(finite, nominal, np.nan)
-    reason = np.where(finite, np.where(stable, "ok", "unstable"), "not finite")
-    margin = np.where(finite, 0.0, np.nan)
+    lam = np.linalg.eigvals(A)
+    if discrete:
+        nominal = np.abs(lam).max(axis=1)
+        stable = nominal < 1.0 - STABILITY_MARGIN
+    else:
+        nominal = lam.real.max(axis=1)
+        stable = nominal < -STABILITY_MARGIN
+    margin = np.zeros(B)
+    if not all_finite:
+        stable &= finite
+        nominal[~finite] = np.nan
+        margin[~finite] = np.nan
+    reason = np.where(stable, "ok", "unstable").astype("<U10")
+    if not all_finite:
+        reason[~finite] = "not finite"
     radius = np.zeros(B)
     certified = np.zeros(B, dtype=bool)
-    P = np.full((B, n, n), np.nan)
-    cert = {"P": np.full(B, np.nan), "lyapunov": np.full(B, np.nan)}
-    path = np.full(B, "", dtype=object)
-    iterations = 0
-    sdp = 0
-    idx = np.flatnonzero(stable)
-    if idx.size:
-        As, Es = A[idx], E[idx]
-        Hs = np.broadcast_to(unc.H, (idx.size, *unc.H.shape))
-        g, peak, iterations = _hinfnorm.hinf_norm(As, Hs, Es, discrete=discrete)
-        with np.errstate(divide="ignore"):
-            margin[idx] = np.where(g > 0, 1.0 / g, np.inf)
+    path = np.full(B, "", dtype="<U7")
+    iterations = sdp = 0
+    if stable.all():
+        idx = None
+        As, Es, lam_s = A, E, lam
+    else:
+        idx = np.flatnonzero(stable)
+        As, Es, lam_s = A[idx], E[idx], lam[idx]
+    S = As.shape[0]
+    if S:
+        Hs = np.broadcast_to(unc.H, (S, *unc.H.shape))
+        g, peak, iterations = _hinfnorm.hinf_norm(As, Hs, Es, discrete=discrete, poles=lam_s)
         r, Ps, cs, ok = _riccati_certificates(As, Hs, Es, g, peak, discrete)
-        radius[idx], P[idx] = r, Ps
-        for key in cert:
-            cert[key][idx] = cs[key]
-        path[idx[ok]] = "riccati"
+        how = np.where(ok, "riccati", "")
         for j in np.flatnonzero(~ok):   # rare: the SDP, one design at a time
-            b = int(idx[j])
             sdp += 1
+            b = j if idx is None else int(idx[j])
             try:
                 res = _norm_bounded_sdp(plant, Kf[b], unc)
             except (InfeasibleError, ConvergenceError):
                 continue
             if res.P is None:
                 continue
-            Hr = (r[j] * unc.H)[None]
-            score, cs_b = _verify(_batched_blocks(As[j:j + 1], Hr, Es[j:j + 1], res.P[None], discrete))
-            P[b] = res.P
-            for key in cert:
-                cert[key][b] = cs_b[key][0]
-            if score[0] > _STRICT:
-                ok[j] = True
-                path[b] = "sdp"
-        certified[idx] = ok & (r == 1.0)
-    info = {"path": _ro(path.astype(str)), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
+            score, cs_b = _verify(_batched_blocks(As[j:j + 1], (r[j] * unc.H)[None], Es[j:j + 1], res.P[None],
+                                                  discrete))
+            if score[0] > _STRICT or not np.isfinite(Ps[j]).all():
+                Ps[j] = res.P
+                for key in cs:
+                    cs[key][j] = cs_b[key][0]
+                ok[j] = score[0] > _STRICT
+                how[j] = "sdp" if ok[j] else ""
+        with np.errstate(divide="ignore"):
+            m = 1.0 / g
+        if idx is None:
+            margin, radius, P, cert = m, r, Ps, cs
+            certified = ok & (r == 1.0)
+            path = how
+        else:
+            margin[idx], radius[idx] = m, r
+            P = np.full((B, n, n), np.nan)
+            P[idx] = Ps
+            cert = {k: np.full(B, np.nan) for k in cs}
+            for key in cs:
+                cert[key][idx] = cs[key]
+            certified[idx] = ok & (r == 1.0)
+            path[idx] = how
+    else:
+        P = np.full((B, n, n), np.nan)
+        cert = {"P": np.full(B, np.nan), "lyapunov": np.full(B, np.nan)}
+    info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
             "sdp_solves": sdp}
     return RobustStabilityBatch(_ro(certified), _frozen(margin), _frozen(radius), _frozen(P),
                                 MappingProxyType({k: _frozen(v) for k, v in cert.items()}), _ro(reason),
