@@ -108,6 +108,22 @@ def sigma_max(A, B, C, points):
     M = points[:, :, None, None] * np.eye(n) - A[:, None]
     rhs = np.broadcast_to(B[:, None], (*points.shape, *B.shape[1:])).astype(complex)
     T = C[:, None] @ np.linalg.solve(M, rhs)
+    return _smax(T)
+
+
+def _smax(T):
+    """Largest singular value of each matrix of a complex stack (..., l, p); closed forms for min(l, p) <= 2."""
+    k = min(T.shape[-2:])
+    if k == 1:
+        return np.sqrt((T.real ** 2 + T.imag ** 2).sum(axis=(-2, -1)))
+    if k == 2:
+        # the largest eigenvalue of the 2 x 2 Gram matrix [[a, b], [b*, d]]
+        u, v = (T[..., 0], T[..., 1]) if T.shape[-1] == 2 else (T[..., 0, :], T[..., 1, :])
+        a = (u.real ** 2 + u.imag ** 2).sum(axis=-1)
+        d = (v.real ** 2 + v.imag ** 2).sum(axis=-1)
+        b = (u.conj() * v).sum(axis=-1)
+        h = 0.5 * (a - d)
+        return np.sqrt(0.5 * (a + d) + np.sqrt(h * h + b.real ** 2 + b.imag ** 2))
     return np.linalg.svd(T, compute_uv=False)[..., 0]
 
 

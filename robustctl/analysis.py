@@ -96,6 +96,7 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -192,46 +193,80 @@ class RobustStability:
 
 @dataclass(frozen=True, eq=False, repr=False)
 class RobustStabilityBatch:
-    """Quadratic-stability certificates of a stack of gains ``K`` (B, m, n) on one plant.
+    """Quadratic-stability margins and certificates of a stack of gains ``K`` (B, m, n) on one plant.
 
     Design ``b`` gets the answer that ``robust_stability((plant, K[b]), ...)``
     gives (:class:`RobustStability`), as entries of arrays.
 
+    ``margin`` and ``reason`` are computed by the call. For a norm-bounded
+    uncertainty the certificates (``certified``, ``radius``, ``P``,
+    ``certificate``, ``info``) are computed on first access to any of them,
+    for the whole stack at once (one batched Riccati solve and eigenvalue
+    check, the SDP for designs whose Riccati certificate fails), then kept:
+    a caller that needs only the margins (a tuning goal) does not pay for
+    them.
+
     Attributes
     ----------
-    certified : (B,) bool ndarray
     margin : (B,) ndarray
-        ``0`` where the nominal loop is unstable, ``nan`` where ``K[b]`` has
-        a non-finite entry.
-    radius : (B,) ndarray
-        The radius that ``P[b]`` certifies (0 where there is no ``P``).
-    P : (B, n, n) ndarray
-        Lyapunov matrices in the plant's coordinates (NaN rows where there is none).
-    certificate : Mapping[str, (B,) ndarray]
-        Smallest eigenvalue of each block of the certificate LMI at ``P[b]``
-        (the keys of :class:`RobustStability`; NaN where there is no ``P``).
+        ``1 / ||E (zI - A)^-1 H||_inf``; ``0`` where the nominal loop is
+        unstable, ``nan`` where ``K[b]`` has a non-finite entry.
     reason : (B,) str ndarray
         ``"ok"`` (analysed: see ``certified`` and ``margin``), ``"unstable"``
         (the nominal loop ``F + G K`` is not stable: margin 0) or
         ``"not finite"`` (``K[b]`` has a NaN or infinite entry: margin NaN).
     kind : str
         ``"norm-bounded"`` or ``"polytope"``.
+    certified : (B,) bool ndarray
+        As :attr:`RobustStability.certified`: decided by the certificate at radius 1.
+    radius : (B,) ndarray
+        The radius that ``P[b]`` certifies (0 where there is no ``P``).
+    P : (B, n, n) ndarray
+        Lyapunov matrices in the plant's coordinates (NaN where there is none).
+    certificate : Mapping[str, (B,) ndarray]
+        Smallest eigenvalue of each block of the certificate LMI at ``P[b]``
+        (the keys of :class:`RobustStability`; NaN where there is no ``P``).
     info : Mapping
         ``"path"``: (B,) str ndarray, which computation certified ``P[b]``
-        (``"riccati"``, ``"sdp"``, ``""`` where there is no ``P``);
+        (``"riccati"``, ``"sdp"``; ``""`` where there is no verified ``P``);
         ``"nominal_radius"``: (B,) spectral radius (abscissa) of ``F + G K``;
         ``"norm_iterations"``: level-set steps of the H-infinity norm;
         ``"sdp_solves"``: designs that needed the SDP.
     """
 
-    certified: np.ndarray
     margin: np.ndarray
-    radius: np.ndarray
-    P: np.ndarray
-    certificate: Mapping[str, np.ndarray]
     reason: np.ndarray
     kind: str
-    info: Mapping[str, Any] = field(default_factory=dict)
+    _certify: Any = field(repr=False)
+
+    @functools.cached_property
+    def _bundle(self) -> tuple:
+        return self._certify()
+
+    @property
+    def certified(self) -> np.ndarray:
+        """(B,) bool: certified at radius 1 (computed on first access)."""
+        return self._bundle[0]
+
+    @property
+    def radius(self) -> np.ndarray:
+        """(B,): the radius that ``P`` certifies (computed on first access)."""
+        return self._bundle[1]
+
+    @property
+    def P(self) -> np.ndarray:
+        """(B, n, n): Lyapunov matrices, NaN where there is none (computed on first access)."""
+        return self._bundle[2]
+
+    @property
+    def certificate(self) -> Mapping[str, np.ndarray]:
+        """Smallest eigenvalue of each certificate block, (B,) each (computed on first access)."""
+        return self._bundle[3]
+
+    @property
+    def info(self) -> Mapping[str, Any]:
+        """Diagnostics, ``path`` among them (computed on first access)."""
+        return self._bundle[4]
 
     def __len__(self) -> int:
         return self.margin.shape[0]
@@ -617,10 +652,6 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
     reason = np.where(stable, "ok", "unstable").astype("<U10")
     if not all_finite:
         reason[~finite] = "not finite"
-    radius = np.zeros(B)
-    certified = np.zeros(B, dtype=bool)
-    path = np.full(B, "", dtype="<U7")
-    iterations = sdp = 0
     if stable.all():
         idx = None
         As, Es, lam_s = A, E, lam
@@ -628,51 +659,59 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
         idx = np.flatnonzero(stable)
         As, Es, lam_s = A[idx], E[idx], lam[idx]
     S = As.shape[0]
+    g = peak = np.zeros(0)
+    iterations = 0
+    Hs = np.broadcast_to(unc.H, (S, *unc.H.shape))
     if S:
-        Hs = np.broadcast_to(unc.H, (S, *unc.H.shape))
         g, peak, iterations = _hinfnorm.hinf_norm(As, Hs, Es, discrete=discrete, poles=lam_s)
-        r, Ps, cs, ok = _riccati_certificates(As, Hs, Es, g, peak, discrete)
-        how = np.where(ok, "riccati", "")
-        for j in np.flatnonzero(~ok):   # rare: the SDP, one design at a time
-            sdp += 1
-            b = j if idx is None else int(idx[j])
-            try:
-                res = _norm_bounded_sdp(plant, Kf[b], unc)
-            except (InfeasibleError, ConvergenceError):
-                continue
-            if res.P is None:
-                continue
-            score, cs_b = _verify(_batched_blocks(As[j:j + 1], (r[j] * unc.H)[None], Es[j:j + 1], res.P[None],
-                                                  discrete))
-            if score[0] > _STRICT or not np.isfinite(Ps[j]).all():
-                Ps[j] = res.P
-                for key in cs:
-                    cs[key][j] = cs_b[key][0]
-                ok[j] = score[0] > _STRICT
-                how[j] = "sdp" if ok[j] else ""
         with np.errstate(divide="ignore"):
             m = 1.0 / g
         if idx is None:
-            margin, radius, P, cert = m, r, Ps, cs
-            certified = ok & (r == 1.0)
-            path = how
+            margin = m
         else:
-            margin[idx], radius[idx] = m, r
-            P = np.full((B, n, n), np.nan)
-            P[idx] = Ps
-            cert = {k: np.full(B, np.nan) for k in cs}
-            for key in cs:
-                cert[key][idx] = cs[key]
-            certified[idx] = ok & (r == 1.0)
-            path[idx] = how
-    else:
+            margin[idx] = m
+
+    def certify() -> tuple:
+        radius = np.zeros(B)
+        certified = np.zeros(B, dtype=bool)
+        path = np.full(B, "", dtype="<U7")
         P = np.full((B, n, n), np.nan)
         cert = {"P": np.full(B, np.nan), "lyapunov": np.full(B, np.nan)}
-    info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
-            "sdp_solves": sdp}
-    return RobustStabilityBatch(_ro(certified), _frozen(margin), _frozen(radius), _frozen(P),
-                                MappingProxyType({k: _frozen(v) for k, v in cert.items()}), _ro(reason),
-                                "norm-bounded", MappingProxyType(info))
+        sdp = 0
+        if S:
+            r, Ps, cs, ok = _riccati_certificates(As, Hs, Es, g, peak, discrete)
+            how = np.where(ok, "riccati", "")
+            for j in np.flatnonzero(~ok):   # rare: the SDP, one design at a time
+                sdp += 1
+                b = j if idx is None else int(idx[j])
+                try:
+                    res = _norm_bounded_sdp(plant, Kf[b], unc)
+                except (InfeasibleError, ConvergenceError):
+                    continue
+                if res.P is None:
+                    continue
+                score, cs_b = _verify(_batched_blocks(As[j:j + 1], (r[j] * unc.H)[None], Es[j:j + 1],
+                                                      res.P[None], discrete))
+                if score[0] > _STRICT or not np.isfinite(Ps[j]).all():
+                    Ps[j] = res.P
+                    for key in cs:
+                        cs[key][j] = cs_b[key][0]
+                    ok[j] = score[0] > _STRICT
+                    how[j] = "sdp" if ok[j] else ""
+            if idx is None:
+                radius, P, cert, path = r, Ps, cs, how
+                certified = ok & (r == 1.0)
+            else:
+                radius[idx], P[idx], path[idx] = r, Ps, how
+                for key in cs:
+                    cert[key][idx] = cs[key]
+                certified[idx] = ok & (r == 1.0)
+        info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
+                "sdp_solves": sdp}
+        return (_ro(certified), _frozen(radius), _frozen(P), MappingProxyType({k: _frozen(v) for k, v in cert.items()}),
+                MappingProxyType(info))
+
+    return RobustStabilityBatch(_frozen(margin), _ro(reason), "norm-bounded", certify)
 
 
 def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
@@ -855,10 +894,10 @@ def _polytope_batch(plants: list[Plant], K: np.ndarray) -> RobustStabilityBatch:
             path[b] = "sdp"
             for key, v in res.certificate.items():
                 cert[key][b] = v
-    info = {"path": _ro(path.astype(str)), "nominal_radius": _frozen(nominal)}
-    return RobustStabilityBatch(_ro(out["certified"]), _frozen(out["margin"]), _frozen(out["radius"]),
-                                _frozen(P), MappingProxyType({k: _frozen(v) for k, v in cert.items()}),
-                                _ro(reason.astype(str)), "polytope", MappingProxyType(info))
+    info = {"path": _ro(path.astype(str)), "nominal_radius": _frozen(nominal), "sdp_solves": int((path == "sdp").sum())}
+    bundle = (_ro(out["certified"]), _frozen(out["radius"]), _frozen(P),
+              MappingProxyType({k: _frozen(v) for k, v in cert.items()}), MappingProxyType(info))
+    return RobustStabilityBatch(_frozen(out["margin"]), _ro(reason.astype(str)), "polytope", lambda: bundle)
 
 
 # ---------------------------------------------------------------- performance bounds
