@@ -55,14 +55,57 @@ Sec. 4.7 and 21.
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import lapack
 
-__all__ = ["hinf_norm", "bounded_real_riccati", "sigma_max"]
+__all__ = ["hinf_norm", "bounded_real_riccati", "sigma_max", "eigvals", "eigvalsh", "solve"]
 
 #: Relative accuracy of the norm: the value ``g`` returned has ``g <= ||G|| <= (1 + 2 TOL) g``.
 TOL = 1e-10
 # An eigenvalue of M counts as imaginary when |Re| <= _IMAG (|lambda| + 1e-3 rho(M)).
 _IMAG = 1e-6
 _MAX_ITER = 60
+
+
+def eigvals(M):
+    """``np.linalg.eigvals`` of a real stack (S, k, k); one matrix goes to LAPACK directly (less overhead)."""
+    if M.shape[0] == 1:
+        wr, wi, _, _, info = lapack.dgeev(M[0], compute_vl=0, compute_vr=0)
+        if info == 0:
+            return (wr + 1j * wi)[None]
+    return np.linalg.eigvals(M)
+
+
+def solve(a, b):
+    """``np.linalg.solve`` for stacks ``a`` (S, k, k), ``b`` (S, k, r); one system goes to LAPACK directly."""
+    if a.shape[0] == 1 and a.ndim == 3:
+        gesv = lapack.zgesv if (np.iscomplexobj(a) or np.iscomplexobj(b)) else lapack.dgesv
+        _, _, x, info = gesv(a[0], b[0])
+        if info == 0:
+            return x[None]
+    return np.linalg.solve(a, b)
+
+
+def eigvalsh(M):
+    """``np.linalg.eigvalsh`` of a real symmetric stack (S, k, k) (lower triangle); one matrix goes to LAPACK."""
+    if M.shape[0] == 1:
+        w, _, info = lapack.dsyevd(M[0], compute_v=0, lower=1)
+        if info == 0:
+            return w[None]
+    return np.linalg.eigvalsh(M)
+
+
+def _stable_subspace(M, n: int):
+    """Real-part-sorted eigenvalues (S, 2n) and a basis (S, 2n, n) of the invariant subspace of the ``n``
+    eigenvalues with the smallest real parts (real for one matrix: LAPACK's real Schur vectors of a
+    complex pair span the pair's real subspace)."""
+    if M.shape[0] == 1:
+        wr, wi, _, vr, info = lapack.dgeev(M[0], compute_vl=0, compute_vr=1)
+        if info == 0:
+            order = np.argsort(wr, kind="stable")
+            return wr[order][None], vr[:, order[:n]][None]
+    ev, V = np.linalg.eig(M)
+    order = np.argsort(ev.real, axis=1)
+    return np.take_along_axis(ev.real, order, axis=1), np.take_along_axis(V, order[:, None, :n], axis=2)
 
 
 def _cayley(A, B, C, flip=None):
@@ -77,7 +120,7 @@ def _cayley(A, B, C, flip=None):
         A, C = sgn * A, sgn * C
     n = A.shape[-1]
     I = np.eye(n)
-    Mi = np.linalg.inv(A + I)
+    Mi = solve(A + I, np.broadcast_to(I, A.shape))
     MiB = Mi @ B
     return Mi @ (A - I), np.sqrt(2.0) * MiB, np.sqrt(2.0) * (C @ Mi), -(C @ MiB)
 
@@ -91,7 +134,7 @@ def _hamiltonian(A, B, C, D, gamma):
         p = D.shape[-1]
         R = g2 * np.eye(p) - D.mT @ D
         DC = D.mT @ C
-        S = np.linalg.solve(R, np.concatenate([DC, B.mT], axis=-1))   # R^-1 [D'C, B']
+        S = solve(R, np.concatenate([DC, B.mT], axis=-1))   # R^-1 [D'C, B']
         n = A.shape[-1]
         RDC, RB = S[..., :n], S[..., n:]
         Ah = A + B @ RDC
@@ -187,7 +230,7 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
     f = np.sqrt(c / b)[:, None, None]
     B, C = B * f, C / f
     rows = np.arange(S)
-    w0 = _start(np.linalg.eigvals(A) if poles is None else poles, discrete)
+    w0 = _start(eigvals(A) if poles is None else poles, discrete)
     sig = sigma_max(A, B, C, np.exp(1j * w0) if discrete else 1j * w0)
     k = np.argmax(sig, axis=1)
     lb, peak = sig[rows, k], w0[rows, k]
@@ -203,7 +246,7 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
     iterations = 0
     while active.size and iterations < _MAX_ITER:
         iterations += 1
-        ev = np.linalg.eigvals(_hamiltonian(ham[0], ham[1], ham[2], ham[3], (1.0 + 2.0 * tol) * lb[active]))
+        ev = eigvals(_hamiltonian(ham[0], ham[1], ham[2], ham[3], (1.0 + 2.0 * tol) * lb[active]))
         mag = np.abs(ev)
         imag = (np.abs(ev.real) <= _IMAG * (mag + 1e-3 * mag.max(axis=1, keepdims=True))) & (ev.imag >= 0)
         count = imag.sum(axis=1)
@@ -259,25 +302,26 @@ def bounded_real_riccati(A, B, C, gamma, *, discrete: bool):
         Ah, Bh, Ch, Dh = _cayley(A, B, C)
     else:
         Ah, Bh, Ch, Dh = A, B, C, None
-    ev, V = np.linalg.eig(_hamiltonian(Ah, Bh, Ch, Dh, gamma))
-    order = np.argsort(ev.real, axis=1)
-    re = np.take_along_axis(ev.real, order, axis=1)
-    rho = np.abs(ev).max(axis=1)
+    re, X = _stable_subspace(_hamiltonian(Ah, Bh, Ch, Dh, gamma), n)
+    rho = np.abs(re).max(axis=1)
     ok = (re[:, n - 1] < -_IMAG * rho) & (re[:, n] > _IMAG * rho)
-    X = np.take_along_axis(V, order[:, None, :n], axis=2)
     X1, X2 = X[:, :n], X[:, n:]
     with np.errstate(all="ignore"):
         try:
-            P = np.linalg.solve(X1.mT, X2.mT).mT
+            P = solve(X1.mT, X2.mT).mT
         except np.linalg.LinAlgError:   # one singular X1 spoils the stacked solve: one by one
-            P = np.full(X1.shape, np.nan, dtype=complex)
+            P = np.full(X1.shape, np.nan, dtype=X1.dtype)
             for i in range(X1.shape[0]):
                 try:
                     P[i] = np.linalg.solve(X1[i].T, X2[i].T).T
                 except np.linalg.LinAlgError:
                     ok[i] = False
-        Pr = P.real
-        scale = np.abs(Pr).max(axis=(1, 2))
-        ok &= np.isfinite(P).all(axis=(1, 2)) & (np.abs(P.imag).max(axis=(1, 2)) <= 1e-6 * scale)
+        if np.iscomplexobj(P):
+            Pr = P.real
+            ok &= np.isfinite(P).all(axis=(1, 2)) & (np.abs(P.imag).max(axis=(1, 2))
+                                                      <= 1e-6 * np.abs(Pr).max(axis=(1, 2)))
+        else:
+            Pr = P
+            ok &= np.isfinite(P).all(axis=(1, 2))
     Pr = 0.5 * (Pr + Pr.mT)
     return Pr, ok

@@ -552,7 +552,7 @@ def _verify(blocks: Mapping[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.
     """Relative score (smallest of ``lambda_min / max(1, ||M||)`` over the blocks) and smallest eigenvalues."""
     cert, rel = {}, []
     for key, M in blocks.items():
-        ev = np.linalg.eigvalsh(0.5 * (M + M.mT))
+        ev = _hinfnorm.eigvalsh(0.5 * (M + M.mT))
         cert[key] = ev[:, 0]
         rel.append(ev[:, 0] / np.maximum(1.0, np.maximum(np.abs(ev[:, 0]), np.abs(ev[:, -1]))))
     return np.minimum.reduce(rel), cert
@@ -588,7 +588,7 @@ def _riccati_certificates(A, H, E, g, peak, discrete: bool):
     c2 = (c * c)[:, None, None]
     Hb, Eb = Hr * c[:, None, None], E / c[:, None, None]
     z = np.exp(1j * peak) if discrete else 1j * peak
-    X = np.linalg.solve(z[:, None, None] * np.eye(n) - A, Hb.astype(complex))
+    X = _hinfnorm.solve(z[:, None, None] * np.eye(n) - A, Hb.astype(complex))
     h2 = (X.real ** 2 + X.imag ** 2).sum(axis=(1, 2))
     eps = np.minimum((gam * gam - gr * gr) / (4.0 * np.where(h2 > 0, h2, 1.0)),
                      np.maximum(1.0, (Eb * Eb).sum(axis=(1, 2))))
@@ -637,7 +637,7 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
     Kf = K if all_finite else np.where(finite[:, None, None], K, 0.0)
     A = plant.F + plant.G @ Kf
     E = unc.EF + unc.EG @ Kf
-    lam = np.linalg.eigvals(A)
+    lam = _hinfnorm.eigvals(A)
     if discrete:
         nominal = np.abs(lam).max(axis=1)
         stable = nominal < 1.0 - STABILITY_MARGIN
