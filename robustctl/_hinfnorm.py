@@ -95,11 +95,15 @@ def eigvalsh(M):
 
 
 def _stable_subspace(M, n: int):
-    """Real-part-sorted eigenvalues (S, 2n) and a basis (S, 2n, n) of the invariant subspace of the ``n``
-    eigenvalues with the smallest real parts (real for one matrix: LAPACK's real Schur vectors of a
-    complex pair span the pair's real subspace)."""
+    """Sorted real parts (S, 2n) and a basis (S, 2n, n) of the invariant subspace of the smallest ``n``.
+
+    For one matrix the basis is real: LAPACK returns a complex pair's
+    eigenvector as its real and imaginary parts, which span the pair's
+    real invariant subspace (both members of a pair are selected, or the
+    caller's gap test fails).
+    """
     if M.shape[0] == 1:
-        wr, wi, _, vr, info = lapack.dgeev(M[0], compute_vl=0, compute_vr=1)
+        wr, _, _, vr, info = lapack.dgeev(M[0], compute_vl=0, compute_vr=1)
         if info == 0:
             order = np.argsort(wr, kind="stable")
             return wr[order][None], vr[:, order[:n]][None]

@@ -49,8 +49,25 @@ homogeneous):
 Continuous time replaces ``diag(P, 0) - [A B]'P[A B]`` by
 ``-(He([I 0]' P [A B]))``, ``He(M) = M + M'``.
 
-Numerics
---------
+Norm-bounded robust stability without an SDP
+--------------------------------------------
+The margin is the small-gain value ``1 / ||E (zI - A)^-1 H||_inf``,
+computed by a level-set H-infinity norm (Bruinsma & Steinbuch 1990;
+imaginary-axis eigenvalues of a Hamiltonian, the discrete case through a
+bilinear transform; :mod:`robustctl._hinfnorm`) to ``2e-10`` relative, on
+the whole stack of gains at once. The certificate ``P`` at the radius
+``r`` (1 if the margin exceeds 1, else ``margin / (1 + 1e-3)``) is the
+stabilising solution of the bounded-real Riccati equation of
+``(A, r H, [E; sqrt(eps) I])`` at the level ``gamma`` with
+``gamma^2 = (1 + (r / margin)^2) / 2``: between the norm of the scaled loop
+and 1, so that the LMI is strictly feasible (its Schur complement is at
+least ``eps I``). It is verified like any other certificate (eigenvalues of
+the LMI blocks at ``P`` in the plant's coordinates); only a design whose
+Riccati certificate fails that check goes to the SDP below (``info["path"]``
+says which: ``"riccati"`` or ``"sdp"``). Polytopes always use the SDP.
+
+Numerics of the SDPs
+--------------------
 * Each problem is solved in coordinates ``x = L'^-1 x^`` where the
   Lyapunov solution ``P_L = L L'`` of the nominal loop (weight: the
   problem's state weight plus ``1e-3`` of its norm times ``I``) becomes
@@ -174,7 +191,11 @@ class RobustStability:
     kind : str
         ``"norm-bounded"`` or ``"polytope"``.
     info : Mapping
-        Solver diagnostics (``solve_time``, ``iterations``, ``solves``).
+        ``"nominal_radius"`` (spectral radius or abscissa of ``F + G K``);
+        norm-bounded: ``"path"`` (``"riccati"`` or ``"sdp"``: which
+        computation certified ``P``; None if neither passed the check) and
+        ``"norm_iterations"`` (level-set steps); polytope: solver
+        diagnostics (``solve_time``, ``iterations``, ``solves``).
     """
 
     certified: bool
@@ -808,7 +829,12 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
     ``||Delta|| <= r``, ``A = F + G K``, ``E = EF + EG K``, by the
     S-procedure LMI of the module docstring. Its ``margin`` equals the
     small-gain value ``1 / ||E (zI - A)^-1 H||_inf`` (continuous time:
-    ``s``), computed by minimising the bounded-real level (one SDP).
+    ``s``), computed by a level-set H-infinity norm; the certificate ``P``
+    comes from the bounded-real Riccati equation at a level between the
+    norm and 1 and is verified by eigenvalues (the SDP is the fallback).
+    A stack of gains (B, m, n) is analysed at once (eigenvalue problems on
+    (B, 2n, 2n) arrays, one level-set iteration for all); its certificates
+    are computed when first asked for (:class:`RobustStabilityBatch`).
 
     Polytope (``vertices``): a common Lyapunov matrix of
     ``A_i = F_i + G_i K`` for the controller's plant and every vertex
@@ -818,20 +844,26 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
 
     Parameters
     ----------
-    controller : Controller or (Plant, (m, n) array_like)
+    controller : Controller or (Plant, (m, n) or (B, m, n) array_like)
         The gain ``K`` (``u = K x``) and the nominal plant (discrete if
-        ``plant.dt`` is set, else continuous).
+        ``plant.dt`` is set, else continuous). A stack of ``B`` gains may
+        hold non-finite entries: those designs are flagged
+        (``reason == "not finite"``, margin NaN), the others answered; a
+        single gain must be finite.
     uncertainty : NormBounded, optional
         ``[dF dG] = H Delta [EF EG]``.
     vertices : list of Plant, optional
         Further plants (same ``n``, ``m``, ``dt``); the polytope is the convex
         hull of the controller's plant and these. Give exactly one of
-        ``uncertainty`` and ``vertices``.
+        ``uncertainty`` and ``vertices``. (A stack of gains is analysed
+        design by design here: a bisection of SDPs each.)
 
     Returns
     -------
-    RobustStability
-        ``certified``, ``margin``, ``radius``, ``P`` and its ``certificate``.
+    RobustStability or RobustStabilityBatch
+        ``certified``, ``margin``, ``radius``, ``P`` and its ``certificate``
+        for one gain; the same as (B,) arrays (``P`` (B, n, n)) and a
+        per-design ``reason`` for a stack.
 
     Examples
     --------
@@ -903,8 +935,6 @@ def _polytope_batch(plants: list[Plant], K: np.ndarray) -> RobustStabilityBatch:
 # ---------------------------------------------------------------- performance bounds
 def _robust_loop(controller, uncertainty, what: str):
     """``(plant, K, A, H, E)`` after checking that the loop is robustly stable (small gain < 1)."""
-    import control
-
     plant, K = _loop(controller)
     unc = check_norm_bounded(uncertainty, plant)
     discrete = plant.is_discrete
@@ -917,8 +947,7 @@ def _robust_loop(controller, uncertainty, what: str):
         # the uncertainty does not reach the loop: drop its channel (else the
         # S-procedure multiplier would have to go to infinity)
         return plant, K, A, np.zeros((plant.n, 0)), np.zeros((0, plant.n))
-    gain = float(control.linfnorm(control.ss(A, H, E, np.zeros((E.shape[0], H.shape[1])),
-                                             plant.dt if discrete else 0))[0])
+    gain = float(_hinfnorm.hinf_norm(A[None], H[None], E[None], discrete=discrete)[0][0])
     if gain >= 1.0:
         raise InfeasibleError(f"no {what}: the closed loop is not quadratically stable for every "
                               f"||Delta|| <= 1 (||E (zI - A)^-1 H||_inf = {gain:.6g} >= 1, stability "
@@ -953,6 +982,13 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     integral) for every admissible ``Delta``, also time-varying. The bound
     minimises ``x0'P x0``, or ``lambda_max(P)`` (one ``P`` for every unit
     initial state) if ``x0`` is not given.
+
+    One gain per call (no stacks, unlike :func:`robust_stability`): the bound
+    is an optimisation over the multiplier ``lam`` as well as ``P``, one SDP
+    per design. (For a fixed ``lam`` the smallest ``P`` is the stabilising
+    solution of a Riccati equation and the bound is convex in ``lam``, so a
+    batched version would be a scalar search over ``lam`` with batched
+    Riccati solves; it is not implemented.)
 
     Parameters
     ----------
