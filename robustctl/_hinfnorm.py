@@ -298,8 +298,8 @@ def bounded_real_riccati(A, B, C, gamma, *, discrete: bool):
     P : (S, n, n) ndarray
         Symmetric; rows where ``ok`` is False may hold anything finite or NaN.
     ok : (S,) bool ndarray
-        The Hamiltonian had ``n`` eigenvalues clearly left of the imaginary
-        axis and ``X1`` was invertible (not a proof: verify ``P``).
+        The Hamiltonian had ``n`` eigenvalues left of the imaginary axis and
+        ``n`` right of it and ``X1`` was invertible (not a proof: verify ``P``).
     """
     n = A.shape[-1]
     if discrete:
@@ -307,8 +307,7 @@ def bounded_real_riccati(A, B, C, gamma, *, discrete: bool):
     else:
         Ah, Bh, Ch, Dh = A, B, C, None
     re, X = _stable_subspace(_hamiltonian(Ah, Bh, Ch, Dh, gamma), n)
-    rho = np.abs(re).max(axis=1)
-    ok = (re[:, n - 1] < -_IMAG * rho) & (re[:, n] > _IMAG * rho)
+    ok = (re[:, n - 1] < 0.0) & (re[:, n] > 0.0)
     X1, X2 = X[:, :n], X[:, n:]
     with np.errstate(all="ignore"):
         try:
