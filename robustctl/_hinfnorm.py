@@ -57,7 +57,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import lapack
 
-__all__ = ["hinf_norm", "bounded_real_riccati", "sigma_max", "eigvals", "eigvalsh", "solve"]
+__all__ = ["hinf_norm", "bounded_real_riccati", "sigma_max", "eigvals", "eigvalsh", "solve", "hinf_norm_one",
+           "riccati_one"]
 
 #: Relative accuracy of the norm: the value ``g`` returned has ``g <= ||G|| <= (1 + 2 TOL) g``.
 TOL = 1e-10
@@ -328,3 +329,114 @@ def bounded_real_riccati(A, B, C, gamma, *, discrete: bool):
             ok &= np.isfinite(P).all(axis=(1, 2))
     Pr = 0.5 * (Pr + Pr.mT)
     return Pr, ok
+
+
+# ---------------------------------------------------------------- one loop (2-D arrays, less overhead)
+def _cayley_one(A, B, C, flip: bool = False):
+    """:func:`_cayley` of one realisation."""
+    if flip:
+        A, C = -A, -C
+    n = A.shape[0]
+    I = np.eye(n)
+    _, _, Mi, info = lapack.dgesv(A + I, I)
+    if info != 0:
+        Mi = np.linalg.inv(A + I)
+    MiB = Mi @ B
+    return Mi @ (A - I), np.sqrt(2.0) * MiB, np.sqrt(2.0) * (C @ Mi), -(C @ MiB)
+
+
+def _hamiltonian_one(A, B, C, D, gamma: float):
+    """:func:`_hamiltonian` of one realisation."""
+    n = A.shape[0]
+    M = np.empty((2 * n, 2 * n))
+    g2 = gamma * gamma
+    if D is None:
+        Ah, G, Q = A, (B @ B.T) / g2, C.T @ C
+    else:
+        R = g2 * np.eye(D.shape[1]) - D.T @ D
+        DC = D.T @ C
+        _, _, S, info = lapack.dgesv(R, np.hstack([DC, B.T]))
+        if info != 0:
+            S = np.linalg.solve(R, np.hstack([DC, B.T]))
+        Ah = A + B @ S[:, :n]
+        G = B @ S[:, n:]
+        Q = C.T @ C + DC.T @ S[:, :n]
+    M[:n, :n] = Ah
+    M[:n, n:] = G
+    M[n:, :n] = -Q
+    M[n:, n:] = -Ah.T
+    return M
+
+
+def _sigma_one(A, B, C, points):
+    """``sigma_max(C (sI - A)^-1 B)`` at the complex ``points`` (k,) for one realisation."""
+    n = A.shape[0]
+    M = points[:, None, None] * np.eye(n) - A
+    X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (points.shape[0], *B.shape)))
+    return _smax(C @ X)
+
+
+def hinf_norm_one(A, B, C, lam, *, discrete: bool, tol: float = TOL) -> tuple[float, float, int]:
+    """:func:`hinf_norm` of one stable loop ``(A, B, C)`` with poles ``lam``: ``(gain, peak frequency, steps)``."""
+    b2, c2 = float((B * B).sum()), float((C * C).sum())
+    if b2 == 0.0 or c2 == 0.0:
+        return 0.0, 0.0, 0
+    f = (c2 / b2) ** 0.25
+    B, C = B * f, C / f
+    w0 = _start(lam[None], discrete)[0]
+    sig = _sigma_one(A, B, C, np.exp(1j * w0) if discrete else 1j * w0)
+    k = int(np.argmax(sig))
+    lb, peak = float(sig[k]), float(w0[k])
+    flip = bool(discrete and sig[1] > sig[0])
+    if discrete:
+        Ah, Bh, Ch, Dh = _cayley_one(A, B, C, flip)
+    else:
+        Ah, Bh, Ch, Dh = A, B, C, None
+    iterations = 0
+    while iterations < _MAX_ITER:
+        iterations += 1
+        M = _hamiltonian_one(Ah, Bh, Ch, Dh, (1.0 + 2.0 * tol) * lb)
+        wr, wi, _, _, info = lapack.dgeev(M, compute_vl=0, compute_vr=0)
+        if info != 0:
+            ev = np.linalg.eigvals(M)
+            wr, wi = ev.real, ev.imag
+        mag = np.hypot(wr, wi)
+        imag = (np.abs(wr) <= _IMAG * (mag + 1e-3 * mag.max())) & (wi >= 0)
+        if not imag.any():
+            break
+        w = np.sort(wi[imag])
+        mid = 0.5 * (np.concatenate([[0.0], w[:-1]]) + w)
+        if discrete:
+            phi = 2.0 * np.arctan(mid)
+            mid = np.pi - phi if flip else phi
+            pts = np.exp(1j * mid)
+        else:
+            pts = 1j * mid
+        sv = _sigma_one(A, B, C, pts)
+        j = int(np.argmax(sv))
+        best, old = float(sv[j]), lb
+        if best > lb:
+            lb, peak = best, float(mid[j])
+        if best <= old * (1.0 + tol):   # no progress: the bound is within rounding of the norm
+            break
+    return lb, peak, iterations
+
+
+def riccati_one(A, B, C, gamma: float, *, discrete: bool):
+    """:func:`bounded_real_riccati` of one realisation: ``P`` or None."""
+    n = A.shape[0]
+    if discrete:
+        Ah, Bh, Ch, Dh = _cayley_one(A, B, C)
+    else:
+        Ah, Bh, Ch, Dh = A, B, C, None
+    wr, _, _, vr, info = lapack.dgeev(_hamiltonian_one(Ah, Bh, Ch, Dh, gamma), compute_vl=0, compute_vr=1)
+    if info != 0:
+        return None
+    order = np.argsort(wr, kind="stable")
+    if not (wr[order[n - 1]] < 0.0 < wr[order[n]]):
+        return None
+    X = vr[:, order[:n]]
+    _, _, Pt, info = lapack.dgesv(X[:n].T, X[n:].T)
+    if info != 0 or not np.isfinite(Pt).all():
+        return None
+    return 0.5 * (Pt + Pt.T)
