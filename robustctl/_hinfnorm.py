@@ -54,6 +54,8 @@ Sec. 4.7 and 21.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.linalg import lapack
 
@@ -65,6 +67,14 @@ TOL = 1e-10
 # An eigenvalue of M counts as imaginary when |Re| <= _IMAG (|lambda| + 1e-3 rho(M)).
 _IMAG = 1e-6
 _MAX_ITER = 60
+
+
+@functools.lru_cache(maxsize=64)
+def eye(n: int) -> np.ndarray:
+    """A read-only identity of size ``n`` (cached: small calls are overhead-bound)."""
+    out = np.eye(n)
+    out.flags.writeable = False
+    return out
 
 
 def eigvals(M):
@@ -336,8 +346,7 @@ def _cayley_one(A, B, C, flip: bool = False):
     """:func:`_cayley` of one realisation."""
     if flip:
         A, C = -A, -C
-    n = A.shape[0]
-    I = np.eye(n)
+    I = eye(A.shape[0])
     _, _, Mi, info = lapack.dgesv(A + I, I)
     if info != 0:
         Mi = np.linalg.inv(A + I)
@@ -353,11 +362,12 @@ def _hamiltonian_one(A, B, C, D, gamma: float):
     if D is None:
         Ah, G, Q = A, (B @ B.T) / g2, C.T @ C
     else:
-        R = g2 * np.eye(D.shape[1]) - D.T @ D
+        R = g2 * eye(D.shape[1]) - D.T @ D
         DC = D.T @ C
-        _, _, S, info = lapack.dgesv(R, np.hstack([DC, B.T]))
+        rhs = np.concatenate([DC, B.T], axis=1)
+        _, _, S, info = lapack.dgesv(R, rhs)
         if info != 0:
-            S = np.linalg.solve(R, np.hstack([DC, B.T]))
+            S = np.linalg.solve(R, rhs)
         Ah = A + B @ S[:, :n]
         G = B @ S[:, n:]
         Q = C.T @ C + DC.T @ S[:, :n]
@@ -370,23 +380,26 @@ def _hamiltonian_one(A, B, C, D, gamma: float):
 
 def _sigma_one(A, B, C, points):
     """``sigma_max(C (sI - A)^-1 B)`` at the complex ``points`` (k,) for one realisation."""
-    n = A.shape[0]
-    M = points[:, None, None] * np.eye(n) - A
+    M = points[:, None, None] * eye(A.shape[0]) - A
     X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (points.shape[0], *B.shape)))
-    return _smax(C @ X)
+    return _smax(C @ X), (X.real ** 2 + X.imag ** 2).sum(axis=(1, 2))
 
 
-def hinf_norm_one(A, B, C, lam, *, discrete: bool, tol: float = TOL) -> tuple[float, float, int]:
-    """:func:`hinf_norm` of one stable loop ``(A, B, C)`` with poles ``lam``: ``(gain, peak frequency, steps)``."""
+def hinf_norm_one(A, B, C, lam, *, discrete: bool, tol: float = TOL) -> tuple[float, float, int, float]:
+    """:func:`hinf_norm` of one stable loop ``(A, B, C)`` with poles ``lam``.
+
+    Returns ``(gain, peak frequency, steps, h2)`` with ``h2`` the squared
+    Frobenius norm of ``(zI - A)^-1 B`` at the peak.
+    """
     b2, c2 = float((B * B).sum()), float((C * C).sum())
     if b2 == 0.0 or c2 == 0.0:
-        return 0.0, 0.0, 0
+        return 0.0, 0.0, 0, 0.0
     f = (c2 / b2) ** 0.25
     B, C = B * f, C / f
     w0 = _start(lam[None], discrete)[0]
-    sig = _sigma_one(A, B, C, np.exp(1j * w0) if discrete else 1j * w0)
+    sig, xn = _sigma_one(A, B, C, np.exp(1j * w0) if discrete else 1j * w0)
     k = int(np.argmax(sig))
-    lb, peak = float(sig[k]), float(w0[k])
+    lb, peak, h2 = float(sig[k]), float(w0[k]), float(xn[k])
     flip = bool(discrete and sig[1] > sig[0])
     if discrete:
         Ah, Bh, Ch, Dh = _cayley_one(A, B, C, flip)
@@ -412,14 +425,14 @@ def hinf_norm_one(A, B, C, lam, *, discrete: bool, tol: float = TOL) -> tuple[fl
             pts = np.exp(1j * mid)
         else:
             pts = 1j * mid
-        sv = _sigma_one(A, B, C, pts)
+        sv, xn = _sigma_one(A, B, C, pts)
         j = int(np.argmax(sv))
         best, old = float(sv[j]), lb
         if best > lb:
-            lb, peak = best, float(mid[j])
+            lb, peak, h2 = best, float(mid[j]), float(xn[j])
         if best <= old * (1.0 + tol):   # no progress: the bound is within rounding of the norm
             break
-    return lb, peak, iterations
+    return lb, peak, iterations, h2 / (f * f)
 
 
 def riccati_one(A, B, C, gamma: float, *, discrete: bool):

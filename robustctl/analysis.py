@@ -746,7 +746,7 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     if not nominal < ((1.0 - STABILITY_MARGIN) if discrete else -STABILITY_MARGIN):
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
                                MappingProxyType({"nominal_radius": nominal}))
-    g, peak, iterations = _hinfnorm.hinf_norm_one(A, H, E, lam, discrete=discrete)
+    g, peak, iterations, h2 = _hinfnorm.hinf_norm_one(A, H, E, lam, discrete=discrete)
     margin = 1.0 / g if g > 0 else np.inf
     r = 1.0 if margin > 1.0 else margin / (1.0 + _BACKOFF)
     Hr = r * H
@@ -755,14 +755,17 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     hn2, en2 = float((Hr * Hr).sum()), float((E * E).sum())
     c = (en2 / hn2) ** 0.25 if hn2 > 0 and en2 > 0 else 1.0
     Hb, Eb = Hr * c, E / c
-    z = np.exp(1j * peak) if discrete else 1j * peak
-    X = _hinfnorm.solve((z * np.eye(n) - A)[None], Hb.astype(complex)[None])[0]
-    h2 = float((X.real ** 2 + X.imag ** 2).sum())
+    if h2 == 0.0:   # the norm did not evaluate the resolvent (E = 0): do it at the peak
+        z = np.exp(1j * peak) if discrete else 1j * peak
+        X = _hinfnorm.solve((z * _hinfnorm.eye(n) - A)[None], H.astype(complex)[None])[0]
+        h2 = float((X.real ** 2 + X.imag ** 2).sum())
+    h2 *= (r * c) ** 2   # ||(zI - A)^-1 H_b||_F^2 at the peak
     eps = min((gam * gam - gr * gr) / (4.0 * h2 if h2 > 0 else 1.0), max(1.0, en2 / c**2))
     best: tuple = (-np.inf, None, {})
     path = None
     for _ in range(_EPS_TRIES):
-        Pt = _hinfnorm.riccati_one(A, Hb, np.vstack([Eb, np.sqrt(eps) * np.eye(n)]), gam, discrete=discrete)
+        Ea = np.concatenate([Eb, np.sqrt(eps) * _hinfnorm.eye(n)], axis=0)
+        Pt = _hinfnorm.riccati_one(A, Hb, Ea, gam, discrete=discrete)
         if Pt is not None:
             P = c * c * Pt
             score, cert = _verify_one(_stability_blocks_fast(A, Hr, E, P, discrete))
@@ -792,7 +795,7 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
 def _stability_blocks_fast(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
     """:func:`_stability_blocks` at radius 1 of ``(A, Hr, E)`` without block_diag."""
     n, p = A.shape[0], Hr.shape[1]
-    AH = np.hstack([A, Hr])
+    AH = np.concatenate([A, Hr], axis=1)
     if discrete:
         M = -(AH.T @ P @ AH)
         M[:n, :n] += P
@@ -802,7 +805,7 @@ def _stability_blocks_fast(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]
         M[:n, :] = -S
         M[:, :n] -= S.T
     M[:n, :n] -= E.T @ E
-    M[n:, n:] += np.eye(p)
+    M[n:, n:] += _hinfnorm.eye(p)
     return {"P": P, "lyapunov": M}
 
 
