@@ -62,6 +62,10 @@ def test_margins_equal_one_over_linfnorm(discrete):
                     continue
                 assert res.reason[b] == "ok"
                 assert res.margin[b] * linf(plant, Ks[b], unc) == pytest.approx(1.0, rel=1e-8)
+                if abs(res.margin[b] - 1.0) > 1e-6:
+                    assert res.certified[b] == (res.margin[b] > 1.0)
+                if res.certified[b]:
+                    assert res.certificate["P"][b] > 0 and res.certificate["lyapunov"][b] > 0
 
 
 @pytest.mark.parametrize("discrete", [True, False])
@@ -135,6 +139,14 @@ def test_batch_equals_single_calls_and_flags_bad_designs(discrete):
             assert res.info["path"][b] == one.info["path"] == "riccati"
             for key, value in one.certificate.items():
                 assert res.certificate[key][b] == pytest.approx(value, rel=1e-6, abs=1e-13)
+
+
+def test_a_stack_of_one_is_a_batch():
+    """The call form of a tuning goal: (B,) margins for a (B, m, n) stack, also for B = 1."""
+    plant, K, unc = random_loop(1, 3, False, 3.0)
+    res = rc.robust_stability((plant, K[None]), unc)
+    assert isinstance(res, analysis.RobustStabilityBatch) and res.margin.shape == (1,)
+    assert res.margin[0] == pytest.approx(3.0, rel=1e-8) and res.certified[0]
 
 
 def test_uncertainty_outside_the_loop_in_a_batch():
