@@ -14,8 +14,9 @@ I - D'D``)::
                [ -C'(I + D R^-1 D')C         -(A + B R^-1 D'C)'       ]
 
 has the eigenvalue ``j w`` iff ``gamma`` is a singular value of ``G(jw)``.
-Starting from the largest ``sigma_max`` at ``w = 0``, at the moduli of the
-poles and (discrete time) at ``z = -1``, each step takes the imaginary
+Starting from the largest ``sigma_max`` at ``w = 0``, at the modulus of the
+most lightly damped pole (discrete time: ``z = 1``, ``z = -1`` and the
+angle of the complex pole nearest the unit circle), each step takes the imaginary
 eigenvalues of ``M((1 + 2 tol) g)``, evaluates ``sigma_max`` at the
 midpoints of consecutive ones and raises the lower bound ``g`` to the
 largest value found; no imaginary eigenvalue means
@@ -29,7 +30,11 @@ transform ``z = (1 + s) / (1 - s)``::
     Cc = sqrt(2) C (A + I)^-1,  Dc = -C (A + I)^-1 B
 
 which maps the unit circle onto the imaginary axis (``w = tan(theta / 2)``)
-and keeps the norm and the storage function: the stabilising solution of
+and keeps the norm and the storage function. Where ``sigma_max(G(-1))``
+exceeds ``sigma_max(G(1))`` the loop ``(-A, B, -C)`` (the same norm,
+``z -> -z``) is transformed instead, so that ``Dc`` is the smaller of the
+two and ``R = gamma^2 I - Dc'Dc`` stays far from singular near the peak.
+For the Riccati equation: the stabilising solution of
 the continuous bounded-real Riccati equation of ``(Ac, Bc, Cc, Dc)`` is the
 stabilising solution ``P`` of the discrete one,
 ``P = A'PA + C'C + A'PB (gamma^2 I - B'PB)^-1 B'PA``. ``A + I`` is
@@ -40,6 +45,10 @@ Riccati: the stabilising solution at a level ``gamma > ||G||_inf`` is
 ``P = X2 X1^-1`` from the ``n`` eigenvectors ``[X1; X2]`` of ``M(gamma)``
 with negative real parts (continuous:
 ``A'P + PA + C'C + PBB'P / gamma^2 = 0``). The caller verifies it.
+
+One loop: :func:`hinf_norm_one` and :func:`riccati_one` do the same on
+2-D arrays and call LAPACK directly (for a small loop the bookkeeping of the
+stacked versions would cost more than the eigenvalue problems).
 
 References
 ----------
