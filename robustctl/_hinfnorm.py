@@ -179,8 +179,14 @@ def sigma_max(A, B, C, points):
 
 
 def _smax(T):
-    """Largest singular value of each matrix of a complex stack (..., l, p); closed forms for min(l, p) <= 2."""
+    """Largest singular value of each matrix of a complex stack (..., l, p).
+
+    Closed forms for ``min(l, p) <= 2`` on large stacks (cheaper than the
+    stacked SVD there; on a few matrices the SVD's lower overhead wins).
+    """
     k = min(T.shape[-2:])
+    if k > 2 or T.size < 64 * T.shape[-1] * T.shape[-2]:
+        return np.linalg.svd(T, compute_uv=False)[..., 0]
     if k == 1:
         return np.sqrt((T.real ** 2 + T.imag ** 2).sum(axis=(-2, -1)))
     if k == 2:
@@ -405,7 +411,15 @@ def hinf_norm_one(A, B, C, lam, *, discrete: bool, tol: float = TOL) -> tuple[fl
         return 0.0, 0.0, 0, 0.0
     f = (c2 / b2) ** 0.25
     B, C = B * f, C / f
-    w0 = _start(lam[None], discrete)[0]
+    cplx = lam.imag > 0
+    if not cplx.any():
+        w0 = np.array([0.0, np.pi]) if discrete else np.zeros(1)
+    elif discrete:
+        w0 = np.array([0.0, np.pi, abs(np.angle(lam[cplx][np.argmax(np.abs(lam[cplx]))]))])
+    else:
+        lc = lam[cplx]
+        with np.errstate(divide="ignore"):
+            w0 = np.array([0.0, abs(lc[np.argmax(np.abs(lc.imag / lc.real))])])
     sig, xn = _sigma_one(A, B, C, np.exp(1j * w0) if discrete else 1j * w0)
     k = int(np.argmax(sig))
     lb, peak, h2 = float(sig[k]), float(w0[k]), float(xn[k])
