@@ -225,7 +225,7 @@ class RobustStabilityBatch:
     for the whole stack at once (one batched Riccati solve and eigenvalue
     check, the SDP for designs whose Riccati certificate fails), then kept:
     a caller that needs only the margins (a tuning goal) does not pay for
-    them.
+    them. Pickling computes them first (the result can cross processes).
 
     Attributes
     ----------
@@ -291,6 +291,16 @@ class RobustStabilityBatch:
 
     def __len__(self) -> int:
         return self.margin.shape[0]
+
+    def __getstate__(self) -> dict:
+        # pickling computes the certificates and drops the closure that computes them
+        certified, radius, P, cert, info = self._bundle
+        return {**self.__dict__, "_certify": None, "_bundle": (certified, radius, P, dict(cert), dict(info))}
+
+    def __setstate__(self, state: dict) -> None:
+        certified, radius, P, cert, info = state["_bundle"]
+        bundle = (certified, radius, P, MappingProxyType(cert), MappingProxyType(info))
+        self.__dict__.update({**state, "_bundle": bundle})
 
     def __repr__(self) -> str:
         ok = self.reason == "ok"

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+import pickle
 
 import control
 import numpy as np
@@ -196,6 +197,9 @@ def test_batch_result_is_frozen_and_readable():
     for arr in (res.margin, res.certified, res.P, res.reason, res.certificate["P"], res.info["path"]):
         with pytest.raises(ValueError, match="read-only"):
             arr[0] = arr[1]
+    fresh = rc.robust_stability((plant, np.stack([K, 0 * K + 9.0])), unc)
+    back = pickle.loads(pickle.dumps(fresh))   # certificates computed on the way
+    assert np.array_equal(back.certified, res.certified) and np.allclose(back.P[0], res.P[0])
 
 
 # ---------------------------------------------------------------- bad input
