@@ -49,8 +49,25 @@ homogeneous):
 Continuous time replaces ``diag(P, 0) - [A B]'P[A B]`` by
 ``-(He([I 0]' P [A B]))``, ``He(M) = M + M'``.
 
-Numerics
---------
+Norm-bounded robust stability without an SDP
+--------------------------------------------
+The margin is the small-gain value ``1 / ||E (zI - A)^-1 H||_inf``,
+computed by a level-set H-infinity norm (Bruinsma & Steinbuch 1990;
+imaginary-axis eigenvalues of a Hamiltonian, the discrete case through a
+bilinear transform; :mod:`robustctl._hinfnorm`) to ``2e-10`` relative, on
+the whole stack of gains at once. The certificate ``P`` at the radius
+``r`` (1 if the margin exceeds 1, else ``margin / (1 + 1e-3)``) is the
+stabilising solution of the bounded-real Riccati equation of
+``(A, r H, [E; sqrt(eps) I])`` at the level ``gamma`` with
+``gamma^2 = (1 + (r / margin)^2) / 2``: between the norm of the scaled loop
+and 1, so that the LMI is strictly feasible (its Schur complement is at
+least ``eps I``). It is verified like any other certificate (eigenvalues of
+the LMI blocks at ``P`` in the plant's coordinates); only a design whose
+Riccati certificate fails that check goes to the SDP below (``info["path"]``
+says which: ``"riccati"`` or ``"sdp"``). Polytopes always use the SDP.
+
+Numerics of the SDPs
+--------------------
 * Each problem is solved in coordinates ``x = L'^-1 x^`` where the
   Lyapunov solution ``P_L = L L'`` of the nominal loop (weight: the
   problem's state weight plus ``1e-3`` of its norm times ``I``) becomes
@@ -96,6 +113,7 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -105,15 +123,15 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
 
-from . import _cvx
-from ._validation import as_batch, as_matrix, as_rng, check_int, check_performance, check_spd
+from . import _cvx, _hinfnorm
+from ._validation import as_batch, as_float_array, as_matrix, as_rng, check_int, check_performance, check_spd
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
 from .plant import Plant, _frozen, check_vertices
-from .stability import is_stable, spectral_abscissa, spectral_radius
+from .stability import STABILITY_MARGIN, is_stable, spectral_abscissa, spectral_radius
 from .uncertainty import NormBounded, check_norm_bounded
 
-__all__ = ["RobustStability", "CostBound", "HinfBound", "WorstCase",
+__all__ = ["RobustStability", "RobustStabilityBatch", "CostBound", "HinfBound", "WorstCase",
            "robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case"]
 
 # Regularisation (relative to the weight's norm) of the Lyapunov equation defining the coordinates.
@@ -128,11 +146,20 @@ _POLY_T = 1e-9
 _POLY_RTOL = 1e-3
 _POLY_RMAX = 1e3
 _POLY_STEPS = 60
+# Riccati certificate: tries of the regularisation eps (each 100 times smaller) before the SDP.
+_EPS_TRIES = 3
 # Worst-case search: projected-gradient iterations per start.
 _ASCENT_ITER = 200
 
 
 # ---------------------------------------------------------------- results
+def _ro(arr: np.ndarray) -> np.ndarray:
+    """A read-only copy that keeps the dtype (bool, str)."""
+    arr = np.array(arr)
+    arr.flags.writeable = False
+    return arr
+
+
 def _fmt(x) -> str:
     return "None" if x is None else f"{x:.6g}"
 
@@ -164,7 +191,11 @@ class RobustStability:
     kind : str
         ``"norm-bounded"`` or ``"polytope"``.
     info : Mapping
-        Solver diagnostics (``solve_time``, ``iterations``, ``solves``).
+        ``"nominal_radius"`` (spectral radius or abscissa of ``F + G K``);
+        norm-bounded: ``"path"`` (``"riccati"`` or ``"sdp"``: which
+        computation certified ``P``; None if neither passed the check) and
+        ``"norm_iterations"`` (level-set steps); polytope: solver
+        diagnostics (``solve_time``, ``iterations``, ``solves``).
     """
 
     certified: bool
@@ -179,6 +210,104 @@ class RobustStability:
         cert = min(self.certificate.values()) if self.certificate else None
         return (f"RobustStability(certified={self.certified}, margin={_fmt(self.margin)}, "
                 f"radius={_fmt(self.radius)}, kind={self.kind!r}, smallest certificate eigenvalue={_fmt(cert)})")
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class RobustStabilityBatch:
+    """Quadratic-stability margins and certificates of a stack of gains ``K`` (B, m, n) on one plant.
+
+    Design ``b`` gets the answer that ``robust_stability((plant, K[b]), ...)``
+    gives (:class:`RobustStability`), as entries of arrays.
+
+    ``margin`` and ``reason`` are computed by the call. For a norm-bounded
+    uncertainty the certificates (``certified``, ``radius``, ``P``,
+    ``certificate``, ``info``) are computed on first access to any of them,
+    for the whole stack at once (one batched Riccati solve and eigenvalue
+    check, the SDP for designs whose Riccati certificate fails), then kept:
+    a caller that needs only the margins (a tuning goal) does not pay for
+    them. Pickling computes them first (the result can cross processes).
+
+    Attributes
+    ----------
+    margin : (B,) ndarray
+        ``1 / ||E (zI - A)^-1 H||_inf``; ``0`` where the nominal loop is
+        unstable, ``nan`` where ``K[b]`` has a non-finite entry.
+    reason : (B,) str ndarray
+        ``"ok"`` (analysed: see ``certified`` and ``margin``), ``"unstable"``
+        (the nominal loop ``F + G K`` is not stable: margin 0) or
+        ``"not finite"`` (``K[b]`` has a NaN or infinite entry: margin NaN).
+    kind : str
+        ``"norm-bounded"`` or ``"polytope"``.
+    certified : (B,) bool ndarray
+        As :attr:`RobustStability.certified`: decided by the certificate at radius 1.
+    radius : (B,) ndarray
+        The radius that ``P[b]`` certifies (0 where there is no ``P``).
+    P : (B, n, n) ndarray
+        Lyapunov matrices in the plant's coordinates (NaN where there is none).
+    certificate : Mapping[str, (B,) ndarray]
+        Smallest eigenvalue of each block of the certificate LMI at ``P[b]``
+        (the keys of :class:`RobustStability`; NaN where there is no ``P``).
+    info : Mapping
+        ``"path"``: (B,) str ndarray, which computation certified ``P[b]``
+        (``"riccati"``, ``"sdp"``; ``""`` where there is no verified ``P``);
+        ``"nominal_radius"``: (B,) spectral radius (abscissa) of ``F + G K``;
+        ``"norm_iterations"``: level-set steps of the H-infinity norm;
+        ``"sdp_solves"``: designs that needed the SDP.
+    """
+
+    margin: np.ndarray
+    reason: np.ndarray
+    kind: str
+    _certify: Any = field(repr=False)
+
+    @functools.cached_property
+    def _bundle(self) -> tuple:
+        return self._certify()
+
+    @property
+    def certified(self) -> np.ndarray:
+        """(B,) bool: certified at radius 1 (computed on first access)."""
+        return self._bundle[0]
+
+    @property
+    def radius(self) -> np.ndarray:
+        """(B,): the radius that ``P`` certifies (computed on first access)."""
+        return self._bundle[1]
+
+    @property
+    def P(self) -> np.ndarray:
+        """(B, n, n): Lyapunov matrices, NaN where there is none (computed on first access)."""
+        return self._bundle[2]
+
+    @property
+    def certificate(self) -> Mapping[str, np.ndarray]:
+        """Smallest eigenvalue of each certificate block, (B,) each (computed on first access)."""
+        return self._bundle[3]
+
+    @property
+    def info(self) -> Mapping[str, Any]:
+        """Diagnostics, ``path`` among them (computed on first access)."""
+        return self._bundle[4]
+
+    def __len__(self) -> int:
+        return self.margin.shape[0]
+
+    def __getstate__(self) -> dict:
+        # pickling computes the certificates and drops the closure that computes them
+        certified, radius, P, cert, info = self._bundle
+        return {**self.__dict__, "_certify": None, "_bundle": (certified, radius, P, dict(cert), dict(info))}
+
+    def __setstate__(self, state: dict) -> None:
+        certified, radius, P, cert, info = state["_bundle"]
+        bundle = (certified, radius, P, MappingProxyType(cert), MappingProxyType(info))
+        self.__dict__.update({**state, "_bundle": bundle})
+
+    def __repr__(self) -> str:
+        ok = self.reason == "ok"
+        return (f"RobustStabilityBatch(B={len(self)}, kind={self.kind!r}, certified={int(self.certified.sum())}"
+                f"/{len(self)}, unstable={int((self.reason == 'unstable').sum())}, "
+                f"not finite={int((self.reason == 'not finite').sum())}, "
+                f"smallest margin={_fmt(float(self.margin[ok].min()) if ok.any() else None)})")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -271,12 +400,27 @@ class WorstCase:
 
 
 # ---------------------------------------------------------------- validation
-def _loop(controller) -> tuple[Plant, np.ndarray]:
-    """``(plant, K)`` from a Controller or a ``(plant, K)`` pair."""
+def _loop(controller, batch: bool = False) -> tuple[Plant, np.ndarray]:
+    """``(plant, K)`` from a Controller or a ``(plant, K)`` pair.
+
+    With ``batch``, ``K`` may also be a stack (B, m, n) (returned 3-D; its
+    entries may be non-finite: the caller flags those designs).
+    """
     if isinstance(controller, Controller):
         return controller.plant, controller.K
     if isinstance(controller, tuple) and len(controller) == 2 and isinstance(controller[0], Plant):
         plant = controller[0]
+        if batch:
+            arr = as_float_array(controller[1], "K")
+            if arr.ndim == 3:
+                if arr.shape[1:] != (plant.m, plant.n) or arr.shape[0] == 0:
+                    raise ValueError(f"K must be a gain ({plant.m}, {plant.n}) or a non-empty stack of gains "
+                                     f"(B, {plant.m}, {plant.n}) (the numbers of inputs and states), "
+                                     f"got shape {arr.shape}")
+                return plant, arr
+            if arr.ndim > 3:
+                raise ValueError(f"K must be a gain ({plant.m}, {plant.n}) or a stack of gains "
+                                 f"(B, {plant.m}, {plant.n}), got an array of shape {arr.shape}")
         K = as_matrix(controller[1], "K", rows=plant.m, cols=plant.n,
                       rows_what="the number of inputs", cols_what="the number of states")
         return plant, K
@@ -369,7 +513,8 @@ def _relative_min_eig(blocks: Mapping[str, np.ndarray]) -> float:
     return min(_min_eig(M) / max(1.0, float(np.linalg.norm(M, 2))) for M in blocks.values())
 
 
-def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
+def _norm_bounded_sdp(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
+    """The margin and certificate by one SDP (the fallback of :func:`_norm_bounded_batch`)."""
     import cvxpy as cp
 
     discrete = plant.is_discrete
@@ -415,6 +560,273 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     info = {"nominal_radius": nominal, "mu": mu_opt, **_solve_info([rep])}
     return RobustStability(bool(radius == 1.0 and score > _STRICT), float(margin), float(radius), _frozen(P_c),
                            MappingProxyType(cert), "norm-bounded", MappingProxyType(info))
+
+
+def _batched_blocks(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
+    """:func:`_stability_blocks` for stacks (``Hr`` (B, n, p) already scaled by the radius)."""
+    n, p = A.shape[-1], Hr.shape[-1]
+    AH = np.concatenate([A, Hr], axis=-1)
+    if discrete:
+        M = -(AH.mT @ P @ AH)
+        M[:, :n, :n] += P
+    else:
+        S = P @ AH
+        M = np.zeros_like(S, shape=(A.shape[0], n + p, n + p))
+        M[:, :n, :] = -S
+        M[:, :, :n] -= S.mT
+    M[:, :n, :n] -= E.mT @ E
+    M[:, n:, n:] += np.eye(p)
+    return {"P": P, "lyapunov": M}
+
+
+def _verify(blocks: Mapping[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Relative score (smallest of ``lambda_min / max(1, ||M||)`` over the blocks) and smallest eigenvalues."""
+    cert, rel = {}, []
+    for key, M in blocks.items():
+        ev = _hinfnorm.eigvalsh(0.5 * (M + M.mT))
+        cert[key] = ev[:, 0]
+        rel.append(ev[:, 0] / np.maximum(1.0, np.maximum(np.abs(ev[:, 0]), np.abs(ev[:, -1]))))
+    return np.minimum.reduce(rel), cert
+
+
+def _riccati_certificates(A, H, E, g, peak, discrete: bool):
+    """``(radius, P, certificate, verified)`` from the bounded-real Riccati equation (stacks).
+
+    For ``g = ||E (zI - A)^-1 H||_inf`` the target radius is ``r = 1`` if
+    ``g < 1`` (margin above 1), else ``r = margin / (1 + 1e-3)``. With
+    ``gr = r g`` and ``gamma^2 = (1 + gr^2) / 2`` the stabilising solution
+    ``P`` of the Riccati equation of ``(A, r H, [E; sqrt(eps) I])`` at level
+    ``gamma`` (:mod:`robustctl._hinfnorm`) makes the certificate LMI at
+    radius ``r`` strictly positive: its Schur complement is
+    ``eps I + A'PH_r ((gamma^2 I - H_r'PH_r)^-1 - (I - H_r'PH_r)^-1) H_r'PA``
+    (continuous alike), provided the level exceeds the norm of the
+    regularised loop: ``eps = (gamma^2 - gr^2) / (4 h^2)`` with ``h`` the
+    Frobenius norm of ``(zI - A)^-1 H_r`` at the peak frequency (``H_r`` and
+    ``E`` balanced); a design whose ``P`` fails the check is retried with
+    ``eps / 100``.
+    """
+    n = A.shape[-1]
+    with np.errstate(divide="ignore"):
+        margin = 1.0 / g
+    r = np.where(margin > 1.0, 1.0, margin / (1.0 + _BACKOFF))
+    Hr = r[:, None, None] * H
+    gr = r * g
+    gam = np.sqrt(0.5 * (1.0 + gr * gr))
+    # H_r and E of equal norms (c): P = c^2 P~ of the balanced problem
+    hn, en = np.sqrt((Hr * Hr).sum(axis=(1, 2))), np.sqrt((E * E).sum(axis=(1, 2)))
+    reach = (hn > 0) & (en > 0)
+    c = np.sqrt(en / hn) if reach.all() else np.where(reach, np.sqrt(en / np.where(reach, hn, 1.0)), 1.0)
+    c2 = (c * c)[:, None, None]
+    Hb, Eb = Hr * c[:, None, None], E / c[:, None, None]
+    z = np.exp(1j * peak) if discrete else 1j * peak
+    X = _hinfnorm.solve(z[:, None, None] * np.eye(n) - A, Hb.astype(complex))
+    h2 = (X.real ** 2 + X.imag ** 2).sum(axis=(1, 2))
+    eps = np.minimum((gam * gam - gr * gr) / (4.0 * np.where(h2 > 0, h2, 1.0)),
+                     np.maximum(1.0, (Eb * Eb).sum(axis=(1, 2))))
+    eye = np.eye(n)
+
+    def attempt(idx):
+        Ea = np.concatenate([Eb[idx], np.sqrt(eps[idx])[:, None, None] * eye], axis=1)
+        P, ok = _hinfnorm.bounded_real_riccati(A[idx], Hb[idx], Ea, gam[idx], discrete=discrete)
+        P = P * c2[idx]
+        ok &= np.isfinite(P).all(axis=(1, 2))
+        if ok.all():
+            score, cert = _verify(_batched_blocks(A[idx], Hr[idx], E[idx], P, discrete))
+            return P, score, cert
+        score = np.full(P.shape[0], -np.inf)
+        cert = {"P": np.full(P.shape[0], np.nan), "lyapunov": np.full(P.shape[0], np.nan)}
+        if ok.any():
+            sel = np.flatnonzero(ok) if isinstance(idx, slice) else idx[ok]
+            score[ok], cert_ok = _verify(_batched_blocks(A[sel], Hr[sel], E[sel], P[ok], discrete))
+            for key, v in cert_ok.items():
+                cert[key][ok] = v
+        return P, score, cert
+
+    everyone = slice(None)
+    P, score, cert = attempt(everyone)
+    bad = np.flatnonzero(~(score > _STRICT))
+    for _ in range(_EPS_TRIES - 1):
+        if not bad.size:
+            break
+        eps[bad] *= 1e-2
+        P2, s2, c2b = attempt(bad)
+        up = s2 > score[bad]
+        sel = bad[up]
+        P[sel], score[sel] = P2[up], s2[up]
+        for key in cert:
+            cert[key][sel] = c2b[key][up]
+        bad = bad[~(s2 > _STRICT)]
+    return r, P, cert, score > _STRICT
+
+
+def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStabilityBatch:
+    """Margins (small-gain values by the level-set H-infinity norm) and Riccati certificates of a stack of gains."""
+    discrete = plant.is_discrete
+    B, n = K.shape[0], plant.n
+    finite = np.isfinite(K).all(axis=(1, 2))
+    all_finite = bool(finite.all())
+    Kf = K if all_finite else np.where(finite[:, None, None], K, 0.0)
+    A = plant.F + plant.G @ Kf
+    E = unc.EF + unc.EG @ Kf
+    lam = _hinfnorm.eigvals(A)
+    if discrete:
+        nominal = np.abs(lam).max(axis=1)
+        stable = nominal < 1.0 - STABILITY_MARGIN
+    else:
+        nominal = lam.real.max(axis=1)
+        stable = nominal < -STABILITY_MARGIN
+    margin = np.zeros(B)
+    if not all_finite:
+        stable &= finite
+        nominal[~finite] = np.nan
+        margin[~finite] = np.nan
+    reason = np.where(stable, "ok", "unstable").astype("<U10")
+    if not all_finite:
+        reason[~finite] = "not finite"
+    if stable.all():
+        idx = None
+        As, Es, lam_s = A, E, lam
+    else:
+        idx = np.flatnonzero(stable)
+        As, Es, lam_s = A[idx], E[idx], lam[idx]
+    S = As.shape[0]
+    g = peak = np.zeros(0)
+    iterations = 0
+    Hs = np.broadcast_to(unc.H, (S, *unc.H.shape))
+    if S:
+        g, peak, iterations = _hinfnorm.hinf_norm(As, Hs, Es, discrete=discrete, poles=lam_s)
+        with np.errstate(divide="ignore"):
+            m = 1.0 / g
+        if idx is None:
+            margin = m
+        else:
+            margin[idx] = m
+
+    def certify() -> tuple:
+        radius = np.zeros(B)
+        certified = np.zeros(B, dtype=bool)
+        path = np.full(B, "", dtype="<U7")
+        P = np.full((B, n, n), np.nan)
+        cert = {"P": np.full(B, np.nan), "lyapunov": np.full(B, np.nan)}
+        sdp = 0
+        if S:
+            r, Ps, cs, ok = _riccati_certificates(As, Hs, Es, g, peak, discrete)
+            how = np.where(ok, "riccati", "")
+            for j in np.flatnonzero(~ok):   # rare: the SDP, one design at a time
+                sdp += 1
+                b = j if idx is None else int(idx[j])
+                try:
+                    res = _norm_bounded_sdp(plant, Kf[b], unc)
+                except (InfeasibleError, ConvergenceError):
+                    continue
+                if res.P is None:
+                    continue
+                score, cs_b = _verify(_batched_blocks(As[j:j + 1], (r[j] * unc.H)[None], Es[j:j + 1],
+                                                      res.P[None], discrete))
+                if score[0] > _STRICT or not np.isfinite(Ps[j]).all():
+                    Ps[j] = res.P
+                    for key in cs:
+                        cs[key][j] = cs_b[key][0]
+                    ok[j] = score[0] > _STRICT
+                    how[j] = "sdp" if ok[j] else ""
+            if idx is None:
+                radius, P, cert, path = r, Ps, cs, how
+                certified = ok & (r == 1.0)
+            else:
+                radius[idx], P[idx], path[idx] = r, Ps, how
+                for key in cs:
+                    cert[key][idx] = cs[key]
+                certified[idx] = ok & (r == 1.0)
+        info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
+                "sdp_solves": sdp}
+        return (_ro(certified), _frozen(radius), _frozen(P), MappingProxyType({k: _frozen(v) for k, v in cert.items()}),
+                MappingProxyType(info))
+
+    return RobustStabilityBatch(_frozen(margin), _ro(reason), "norm-bounded", certify)
+
+
+def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
+    """One gain: what :func:`_norm_bounded_batch` does for a stack, on 2-D arrays (less overhead)."""
+    discrete = plant.is_discrete
+    n = plant.n
+    A = plant.F + plant.G @ K
+    H, E = unc.H, unc.EF + unc.EG @ K
+    lam = _hinfnorm.eigvals(A[None])[0]
+    nominal = float(np.abs(lam).max() if discrete else lam.real.max())
+    if not nominal < ((1.0 - STABILITY_MARGIN) if discrete else -STABILITY_MARGIN):
+        return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
+                               MappingProxyType({"nominal_radius": nominal}))
+    g, peak, iterations, h2 = _hinfnorm.hinf_norm_one(A, H, E, lam, discrete=discrete)
+    margin = 1.0 / g if g > 0 else np.inf
+    r = 1.0 if margin > 1.0 else margin / (1.0 + _BACKOFF)
+    Hr = r * H
+    gr = r * g
+    gam = np.sqrt(0.5 * (1.0 + gr * gr))
+    hn2, en2 = float((Hr * Hr).sum()), float((E * E).sum())
+    c = (en2 / hn2) ** 0.25 if hn2 > 0 and en2 > 0 else 1.0
+    Hb, Eb = Hr * c, E / c
+    if h2 == 0.0:   # the norm did not evaluate the resolvent (E = 0): do it at the peak
+        z = np.exp(1j * peak) if discrete else 1j * peak
+        X = _hinfnorm.solve((z * _hinfnorm.eye(n) - A)[None], H.astype(complex)[None])[0]
+        h2 = float((X.real ** 2 + X.imag ** 2).sum())
+    h2 *= (r * c) ** 2   # ||(zI - A)^-1 H_b||_F^2 at the peak
+    eps = min((gam * gam - gr * gr) / (4.0 * h2 if h2 > 0 else 1.0), max(1.0, en2 / c**2))
+    best: tuple = (-np.inf, None, {})
+    path = None
+    for _ in range(_EPS_TRIES):
+        Ea = np.concatenate([Eb, np.sqrt(eps) * _hinfnorm.eye(n)], axis=0)
+        Pt = _hinfnorm.riccati_one(A, Hb, Ea, gam, discrete=discrete)
+        if Pt is not None:
+            P = c * c * Pt
+            score, cert = _verify_one(_stability_blocks_fast(A, Hr, E, P, discrete))
+            if score > best[0]:
+                best = (score, P, cert)
+            if score > _STRICT:
+                path = "riccati"
+                break
+        eps *= 1e-2
+    if path is None:   # rare: the SDP
+        try:
+            res = _norm_bounded_sdp(plant, K, unc)
+        except (InfeasibleError, ConvergenceError):
+            res = None
+        if res is not None and res.P is not None:
+            score, cert = _verify_one(_stability_blocks_fast(A, Hr, E, res.P, discrete))
+            if score > _STRICT or best[1] is None:
+                best = (score, res.P, cert)
+                path = "sdp" if score > _STRICT else None
+    score, P, cert = best
+    info = {"path": path, "nominal_radius": nominal, "norm_iterations": iterations}
+    return RobustStability(bool(path is not None and r == 1.0), float(margin), float(r),
+                           None if P is None else _frozen(P), MappingProxyType(cert), "norm-bounded",
+                           MappingProxyType(info))
+
+
+def _stability_blocks_fast(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
+    """:func:`_stability_blocks` at radius 1 of ``(A, Hr, E)`` without block_diag."""
+    n, p = A.shape[0], Hr.shape[1]
+    AH = np.concatenate([A, Hr], axis=1)
+    if discrete:
+        M = -(AH.T @ P @ AH)
+        M[:n, :n] += P
+    else:
+        S = P @ AH
+        M = np.zeros((n + p, n + p))
+        M[:n, :] = -S
+        M[:, :n] -= S.T
+    M[:n, :n] -= E.T @ E
+    M[n:, n:] += _hinfnorm.eye(p)
+    return {"P": P, "lyapunov": M}
+
+
+def _verify_one(blocks: Mapping[str, np.ndarray]) -> tuple[float, dict[str, float]]:
+    """:func:`_verify` of one design."""
+    score, cert = np.inf, {}
+    for key, M in blocks.items():
+        ev = _hinfnorm.eigvalsh(0.5 * (M + M.T)[None])[0]
+        cert[key] = float(ev[0])
+        score = min(score, float(ev[0]) / max(1.0, abs(float(ev[0])), abs(float(ev[-1]))))
+    return score, cert
 
 
 def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
@@ -488,14 +900,19 @@ def _polytope_stability(plants: list[Plant], K: np.ndarray) -> RobustStability:
 
 
 def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertainty: NormBounded | None = None, *,
-                     vertices: Sequence[Plant] | None = None) -> RobustStability:
+                     vertices: Sequence[Plant] | None = None) -> RobustStability | RobustStabilityBatch:
     r"""Quadratic-stability certificate and margin of ``u = K x`` under norm-bounded or polytopic uncertainty.
 
     Norm-bounded (``uncertainty``): stability of ``A + H Delta E`` for every
     ``||Delta|| <= r``, ``A = F + G K``, ``E = EF + EG K``, by the
     S-procedure LMI of the module docstring. Its ``margin`` equals the
     small-gain value ``1 / ||E (zI - A)^-1 H||_inf`` (continuous time:
-    ``s``), computed by minimising the bounded-real level (one SDP).
+    ``s``), computed by a level-set H-infinity norm; the certificate ``P``
+    comes from the bounded-real Riccati equation at a level between the
+    norm and 1 and is verified by eigenvalues (the SDP is the fallback).
+    A stack of gains (B, m, n) is analysed at once (eigenvalue problems on
+    (B, 2n, 2n) arrays, one level-set iteration for all); its certificates
+    are computed when first asked for (:class:`RobustStabilityBatch`).
 
     Polytope (``vertices``): a common Lyapunov matrix of
     ``A_i = F_i + G_i K`` for the controller's plant and every vertex
@@ -505,20 +922,26 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
 
     Parameters
     ----------
-    controller : Controller or (Plant, (m, n) array_like)
+    controller : Controller or (Plant, (m, n) or (B, m, n) array_like)
         The gain ``K`` (``u = K x``) and the nominal plant (discrete if
-        ``plant.dt`` is set, else continuous).
+        ``plant.dt`` is set, else continuous). A stack of ``B`` gains may
+        hold non-finite entries: those designs are flagged
+        (``reason == "not finite"``, margin NaN), the others answered; a
+        single gain must be finite.
     uncertainty : NormBounded, optional
         ``[dF dG] = H Delta [EF EG]``.
     vertices : list of Plant, optional
         Further plants (same ``n``, ``m``, ``dt``); the polytope is the convex
         hull of the controller's plant and these. Give exactly one of
-        ``uncertainty`` and ``vertices``.
+        ``uncertainty`` and ``vertices``. (A stack of gains is analysed
+        design by design here: a bisection of SDPs each.)
 
     Returns
     -------
-    RobustStability
-        ``certified``, ``margin``, ``radius``, ``P`` and its ``certificate``.
+    RobustStability or RobustStabilityBatch
+        ``certified``, ``margin``, ``radius``, ``P`` and its ``certificate``
+        for one gain; the same as (B,) arrays (``P`` (B, n, n)) and a
+        per-design ``reason`` for a stack.
 
     Examples
     --------
@@ -544,21 +967,52 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
     >>> rc.robust_stability(ctrl, vertices=[truck_plant(300.0)]).certified
     True
     """
-    plant, K = _loop(controller)
+    plant, K = _loop(controller, batch=True)
     if (uncertainty is None) == (vertices is None):
         raise ValueError("give exactly one of uncertainty (a NormBounded) and vertices (a list of Plant)")
     if vertices is not None:
         # a polytope needs a vertex besides the nominal plant
-        return _polytope_stability(check_vertices(plant, vertices, reference="the controller's plant",
-                                                  non_empty=True), K)
-    return _norm_bounded_stability(plant, K, check_norm_bounded(uncertainty, plant))
+        plants = check_vertices(plant, vertices, reference="the controller's plant", non_empty=True)
+        if K.ndim == 2:
+            return _polytope_stability(plants, K)
+        return _polytope_batch(plants, K)
+    unc = check_norm_bounded(uncertainty, plant)
+    if K.ndim == 2:
+        return _norm_bounded_stability(plant, K, unc)
+    return _norm_bounded_batch(plant, K, unc)
+
+
+def _polytope_batch(plants: list[Plant], K: np.ndarray) -> RobustStabilityBatch:
+    """The polytope test design by design (a bisection of SDPs each), assembled like the norm-bounded batch."""
+    B, n = K.shape[0], plants[0].n
+    out = {"certified": np.zeros(B, dtype=bool), "margin": np.full(B, np.nan), "radius": np.zeros(B)}
+    P = np.full((B, n, n), np.nan)
+    cert = {f"vertex[{i}]": np.full(B, np.nan) for i in range(len(plants))}
+    cert = {"P": np.full(B, np.nan), **cert}
+    reason = np.full(B, "not finite", dtype=object)
+    nominal = np.full(B, np.nan)
+    path = np.full(B, "", dtype=object)
+    for b in range(B):
+        if not np.isfinite(K[b]).all():
+            continue
+        res = _polytope_stability(plants, K[b])
+        out["certified"][b], out["margin"][b], out["radius"][b] = res.certified, res.margin, res.radius
+        nominal[b] = res.info["nominal_radius"]
+        reason[b] = "ok" if res.P is not None else "unstable"
+        if res.P is not None:
+            P[b] = res.P
+            path[b] = "sdp"
+            for key, v in res.certificate.items():
+                cert[key][b] = v
+    info = {"path": _ro(path.astype(str)), "nominal_radius": _frozen(nominal), "sdp_solves": int((path == "sdp").sum())}
+    bundle = (_ro(out["certified"]), _frozen(out["radius"]), _frozen(P),
+              MappingProxyType({k: _frozen(v) for k, v in cert.items()}), MappingProxyType(info))
+    return RobustStabilityBatch(_frozen(out["margin"]), _ro(reason.astype(str)), "polytope", lambda: bundle)
 
 
 # ---------------------------------------------------------------- performance bounds
 def _robust_loop(controller, uncertainty, what: str):
     """``(plant, K, A, H, E)`` after checking that the loop is robustly stable (small gain < 1)."""
-    import control
-
     plant, K = _loop(controller)
     unc = check_norm_bounded(uncertainty, plant)
     discrete = plant.is_discrete
@@ -571,8 +1025,7 @@ def _robust_loop(controller, uncertainty, what: str):
         # the uncertainty does not reach the loop: drop its channel (else the
         # S-procedure multiplier would have to go to infinity)
         return plant, K, A, np.zeros((plant.n, 0)), np.zeros((0, plant.n))
-    gain = float(control.linfnorm(control.ss(A, H, E, np.zeros((E.shape[0], H.shape[1])),
-                                             plant.dt if discrete else 0))[0])
+    gain = float(_hinfnorm.hinf_norm(A[None], H[None], E[None], discrete=discrete)[0][0])
     if gain >= 1.0:
         raise InfeasibleError(f"no {what}: the closed loop is not quadratically stable for every "
                               f"||Delta|| <= 1 (||E (zI - A)^-1 H||_inf = {gain:.6g} >= 1, stability "
@@ -607,6 +1060,13 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     integral) for every admissible ``Delta``, also time-varying. The bound
     minimises ``x0'P x0``, or ``lambda_max(P)`` (one ``P`` for every unit
     initial state) if ``x0`` is not given.
+
+    One gain per call (no stacks, unlike :func:`robust_stability`): the bound
+    is an optimisation over the multiplier ``lam`` as well as ``P``, one SDP
+    per design. (For a fixed ``lam`` the smallest ``P`` is the stabilising
+    solution of a Riccati equation and the bound is convex in ``lam``, so a
+    batched version would be a scalar search over ``lam`` with batched
+    Riccati solves; it is not implemented.)
 
     Parameters
     ----------
