@@ -20,6 +20,7 @@ from .analysis import (
     CostBound,
     HinfBound,
     RobustStability,
+    RobustStabilityBatch,
     WorstCase,
     guaranteed_cost,
     robust_hinf_bound,
@@ -56,6 +57,6 @@ __all__ = [
     "NotStabilizingError",
 ]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
-            "RobustStability", "CostBound", "HinfBound", "WorstCase"]
+            "RobustStability", "RobustStabilityBatch", "CostBound", "HinfBound", "WorstCase"]
 __all__ += ["lq_output", "InputMemoryFeedback", "margins_report", "MarginsReport"]
 __version__ = "0.1.0"
