@@ -29,7 +29,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -214,10 +214,10 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
         for key, model in checked.items():
             try:
                 if isinstance(model, NormBounded):
-                    row[key] = robust_stability((nominal, law.gain), law.augmented_uncertainty(model, plant))
+                    res = robust_stability((nominal, law.gain), law.augmented_uncertainty(model, plant))
                 else:
-                    row[key] = robust_stability((nominal, law.gain),
-                                                vertices=[law.augmented_plant(v) for v in model])
+                    res = robust_stability((nominal, law.gain), vertices=[law.augmented_plant(v) for v in model])
+                row[key] = cast("RobustStability", res)        # one gain (m, n): never a batch
             except (RobustCtlError, ValueError) as exc:
                 row[key] = f"n/a ({str(exc).splitlines()[0][:60]})"
         results[name] = MappingProxyType(row)
