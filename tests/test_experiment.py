@@ -255,6 +255,10 @@ def test_python_dash_m_exit_code_and_one_line(tmp_path):
 
 def test_rerun_with_another_pop_size_is_an_error_not_a_skip(tmp_path, fake_run):
     run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path, progress=False)
+    with pytest.raises(ValueError, match=r"settings\.json: the directory holds runs with other settings: "
+                                         r"pop_size 92 \(this grid: 50\)"):
+        run_experiment("zdt1", "nsga2", runs=1, evals=300, pop_size=50, out=tmp_path, progress=False)
+    (tmp_path / "settings.json").unlink()          # a directory from before settings.json: its records say
     with pytest.raises(ValueError, match=r"seed_\d+\.json holds a run with other settings: pop_size 92 "
                                          r"\(this grid: 50\)"):
         run_experiment("zdt1", "nsga2", runs=1, evals=300, pop_size=50, out=tmp_path, progress=False)
@@ -266,8 +270,8 @@ def test_cli_rerun_with_other_evals_is_a_one_line_usage_error(tmp_path, fake_run
     capsys.readouterr()
     assert main([*args, "--evals", "400"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "holds a run with other settings: budget 300 (this grid: 400)" in err
-    assert "seed_" in err and "Traceback" not in err
+    assert err.count("\n") == 1 and "holds runs with other settings: budget 300 (this grid: 400)" in err
+    assert "settings.json" in err and "Traceback" not in err
 
 
 @pytest.fixture
