@@ -85,13 +85,13 @@ from moo.executors import POOL_RESTARTS, _RestartingPool, open_executor
 from moo.store import (
     FAILED_SUFFIX,
     CorruptRecordError,
+    check_settings,
     load_records,
     lock_results_dir,
     prepare_results_dir,
     problem_dir,
     read_record,
     read_settings,
-    check_settings,
     validate_record,
     variant_dir,
     write_json_atomic,
@@ -274,14 +274,17 @@ def _check_legacy_dir(out: Path, settings: dict, legacy_setup) -> None:
             validate_record(rec, rec["_path"])
         except CorruptRecordError:
             continue                       # recomputed if in the grid; named by stats otherwise
-        want = {"problem": settings["problem"], "n_obj": settings["n_obj"], "budget": settings["budget"]}
-        if "setup" in rec or legacy_setup != settings["setup"]:
-            want["setup"] = settings["setup"]
+        want = {"budget": settings["budget"]}
+        if rec["_problem_dir"] == settings["problem_dir"]:
+            want.update(problem=settings["problem"], n_obj=settings["n_obj"])
+            if "setup" in rec or legacy_setup != settings["setup"]:
+                want["setup"] = settings["setup"]
         if rec["molsp"]:
             want["max_leaders"] = settings["max_leaders"]
         got = {k: rec.get(k, legacy_setup if k == "setup" else None) for k in want}
-        if rec["_problem_dir"] != settings["problem_dir"]:
-            got["problem_dir"], want["problem_dir"] = rec["_problem_dir"], settings["problem_dir"]
+        if rec["_problem_dir"] != settings["problem_dir"] and \
+                (rec["problem"], rec["n_obj"]) == (settings["problem"], settings["n_obj"]):
+            got["problem directory"], want["problem directory"] = rec["_problem_dir"], settings["problem_dir"]
         idx = rec.get("run_index")
         if isinstance(idx, int) and idx >= 0:
             if idx >= len(seeds):
@@ -476,10 +479,8 @@ class PreparedExperiment:
         with lock_results_dir(self.out):
             if self.settings:
                 recorded = read_settings(self.out)
-                if recorded is None:
-                    write_settings(self.out, self.settings)
-                else:
-                    check_settings(self.out, recorded, self.settings)
+                if recorded is None or check_settings(self.out, recorded, self.settings):
+                    write_settings(self.out, recorded, self.settings)
             # another writer may have added runs between prepare() and the lock
             todo = [s for s in self.todo if s not in self.expected or not _is_done(s, self.out, self.expected[s])]
             skipped = len(self.specs) - len(todo)

@@ -23,10 +23,12 @@ when its holder exits or is killed); a second writer is refused with
 :class:`ResultsDirBusyError`. Platforms without ``fcntl`` get no lock.
 
 ``<out>/settings.json`` records the directory's settings once, at its first
-grid (:data:`SETTINGS_FIELDS`: the problem, its objectives and set-up, the
-budget, the population size asked for, the MO-LSP cap and the base seed); a
-later grid with other settings is refused, naming the setting
-(:func:`check_settings`). A directory written before ``settings.json``
+grid: :data:`DIR_FIELDS` (the budget, the population size asked for, the
+MO-LSP cap and the base seed) for the whole directory, and
+:data:`PROBLEM_FIELDS` (the problem, its objectives and set-up) for each
+problem directory in it (``"problems": {<problem>: {...}}``; a directory may
+hold several problems, each under one name). A later grid with other
+settings is refused, naming the setting (:func:`check_settings`). A directory written before ``settings.json``
 existed is checked against its records instead, and gets the file on its next
 grid.
 
@@ -73,7 +75,7 @@ __all__ = ["write_json_atomic", "write_text_atomic", "atomic_path", "read_record
            "load_records", "check_consistent", "check_output_file", "prepare_results_dir", "problem_dir",
            "variant_dir", "lock_results_dir", "ResultsDirBusyError", "CorruptRecordError", "read_settings",
            "write_settings", "check_settings", "RECORD_NAME", "FAILED_SUFFIX", "SETTINGS_NAME",
-           "SETTINGS_FIELDS", "LOCK_NAME"]
+           "DIR_FIELDS", "PROBLEM_FIELDS", "LOCK_NAME"]
 
 #: File names of finished-run records (``seed_<s>.json``).
 RECORD_NAME = re.compile(r"^seed_(\d+)\.json$")
@@ -83,8 +85,10 @@ FAILED_SUFFIX = ".failed.json"
 SETTINGS_NAME = "settings.json"
 #: The lock file of :func:`lock_results_dir`.
 LOCK_NAME = ".lock"
-#: Fields of ``settings.json``: one value each for the whole directory.
-SETTINGS_FIELDS = ("problem", "problem_dir", "n_obj", "setup", "budget", "pop_size", "max_leaders", "base_seed")
+#: Fields of ``settings.json`` with one value for the whole directory.
+DIR_FIELDS = ("budget", "pop_size", "max_leaders", "base_seed")
+#: Fields of ``settings.json`` with one value per problem directory (under ``"problems"``).
+PROBLEM_FIELDS = ("problem", "n_obj", "setup")
 
 _REQUIRED = ("problem", "n_obj", "algorithm", "molsp", "seed", "F")
 
@@ -100,8 +104,10 @@ class CorruptRecordError(ValueError):
 # ---------------------------------------------------------------------------- naming
 
 def problem_dir(problem: str, n_obj: int | None) -> str:
-    """Directory name of a problem: its name (``:`` as ``~``), plus ``-m<M>`` when ``n_obj`` is given
-    for DTLZ or an import path."""
+    """Directory name of a problem: its name (``:`` as ``~``), with ``-m<M>`` for DTLZ given ``n_obj``.
+
+    An import path given ``n_obj`` gets the ``-m<M>`` too.
+    """
     key = problem if is_import_path(problem) else problem.lower()
     with_m = n_obj is not None and (key.startswith("dtlz") or is_import_path(key))
     return f"{safe_name(key)}-m{n_obj}" if with_m else safe_name(key)
@@ -285,34 +291,40 @@ def _mixed(out: Any, field: str, a: Any, path_a: str, b: Any, path_b: str) -> Va
 def check_consistent(records: Iterable[dict], settings: dict | None = None, out: Any = "") -> None:
     """``ValueError`` naming a file unless the records share one setting.
 
-    With the directory's ``settings`` (``settings.json``), every record must
-    have its problem, objectives, set-up and budget, and the MO-LSP runs its
-    MO-LSP cap. Without (a directory from before ``settings.json``), the
-    records must agree with each other on these. Either way the runs of one
-    algorithm share a population size. A record without a ``setup`` field
+    Across the directory the records share a budget, the MO-LSP runs a
+    MO-LSP cap and the runs of one algorithm on one problem a population
+    size; within a problem directory they share the problem, its objectives
+    and its set-up. With the directory's ``settings`` (``settings.json``)
+    they must also have its values. A record without a ``setup`` field
     (written before set-ups existed) matches any set-up.
     """
-    first: dict[str, tuple[Any, str]] = {}
+    first: dict[tuple, tuple[Any, str]] = {}
     if settings is not None:
         where = str(Path(out) / SETTINGS_NAME) if out else SETTINGS_NAME
-        for k in ("problem", "n_obj", "setup", "budget", "max_leaders"):
+        for k in ("budget", "max_leaders"):
             if k in settings:
-                first[k] = (settings[k], where)
+                first[(k,)] = (settings[k], where)
+        for pdir, entry in (settings.get("problems") or {}).items():
+            for k in PROBLEM_FIELDS:
+                if isinstance(entry, dict) and k in entry:
+                    first[(k, pdir)] = (entry[k], where)
     for rec in records:
         path = rec.get("_path", "a record")
-        items = [(k, rec[k]) for k in ("problem", "n_obj", "setup", "budget") if k in rec]
+        pdir = rec.get("_problem_dir", "")
+        items: list[tuple[tuple, Any]] = [((k, pdir), rec[k]) for k in PROBLEM_FIELDS if k in rec]
+        items.append((("budget",), rec.get("budget")))
         if rec.get("molsp"):
-            items.append(("max_leaders", rec.get("max_leaders")))
+            items.append((("max_leaders",), rec.get("max_leaders")))
         if "pop_size" in rec:
-            items.append((f"pop_size of {rec['algorithm']}", rec["pop_size"]))
-        for k, v in items:
-            if k == "setup" and v is None and settings is None:
+            items.append((("pop_size", pdir, rec["algorithm"]), rec["pop_size"]))
+        for key, v in items:
+            if key[0] == "setup" and v is None and settings is None:
                 continue
-            if k not in first:
-                first[k] = (v, path)
-            elif first[k][0] != v:
-                a, where = first[k]
-                raise _mixed(out, k, a, where, v, path)
+            if key not in first:
+                first[key] = (v, path)
+            elif first[key][0] != v:
+                a, where = first[key]
+                raise _mixed(out, key[0] if key[0] != "pop_size" else f"pop_size of {key[2]}", a, where, v, path)
 
 
 # ---------------------------------------------------------------------------- settings and lock
@@ -332,18 +344,45 @@ def read_settings(out: str | os.PathLike) -> dict | None:
     return data
 
 
-def write_settings(out: str | os.PathLike, settings: dict) -> None:
-    """Record ``settings`` (the fields of :data:`SETTINGS_FIELDS`) in ``<out>/settings.json``."""
-    write_json_atomic(Path(out) / SETTINGS_NAME, {k: settings[k] for k in SETTINGS_FIELDS})
+def _persisted(recorded: dict | None, wanted: dict) -> dict:
+    """``recorded`` with the problem of ``wanted`` (a flat dict of a grid's settings) added."""
+    data = {k: wanted[k] for k in DIR_FIELDS} if recorded is None else dict(recorded)
+    problems = dict(data.get("problems") or {})
+    problems[wanted["problem_dir"]] = {k: wanted[k] for k in PROBLEM_FIELDS}
+    data["problems"] = problems
+    return data
 
 
-def check_settings(out: str | os.PathLike, recorded: dict, wanted: dict) -> None:
-    """``ValueError`` naming ``settings.json`` and every setting where ``wanted`` differs from ``recorded``."""
-    wrong = [(k, recorded.get(k), wanted[k]) for k in SETTINGS_FIELDS if k in recorded and recorded[k] != wanted[k]]
+def write_settings(out: str | os.PathLike, recorded: dict | None, wanted: dict) -> None:
+    """Record the grid's settings ``wanted`` in ``<out>/settings.json`` (added to ``recorded``, if any).
+
+    ``wanted`` is flat: the fields of :data:`DIR_FIELDS` and :data:`PROBLEM_FIELDS` and ``problem_dir``.
+    """
+    write_json_atomic(Path(out) / SETTINGS_NAME, _persisted(recorded, wanted))
+
+
+def check_settings(out: str | os.PathLike, recorded: dict, wanted: dict) -> bool:
+    """``ValueError`` naming ``settings.json`` and every setting where the grid's ``wanted`` differs.
+
+    Returns True when the grid's problem is new to the directory (``settings.json`` is then to be
+    rewritten with :func:`write_settings`). The same problem under another directory name (``dtlz2``
+    and ``dtlz2-m3``) is refused: it would record each run twice.
+    """
+    wrong = [(k, recorded[k], wanted[k]) for k in DIR_FIELDS if k in recorded and recorded[k] != wanted[k]]
+    problems = recorded.get("problems") or {}
+    entry = problems.get(wanted["problem_dir"])
+    if isinstance(entry, dict):
+        wrong += [(k, entry[k], wanted[k]) for k in PROBLEM_FIELDS if k in entry and entry[k] != wanted[k]]
+    else:
+        for pdir, other in problems.items():
+            if isinstance(other, dict) and (other.get("problem"), other.get("n_obj")) == \
+                    (wanted["problem"], wanted["n_obj"]) and pdir != wanted["problem_dir"]:
+                wrong.append(("problem directory", pdir, wanted["problem_dir"]))
     if wrong:
         what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, got, want in wrong)
         raise ValueError(f"{Path(out) / SETTINGS_NAME}: the directory holds runs with other settings: {what}; "
                          "use another out directory or the directory's settings")
+    return entry is None
 
 
 @contextlib.contextmanager
