@@ -551,7 +551,7 @@ def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: 
         corrupt: list[tuple[Path, str]] = []
         todo = tuple(s for s in specs if not _is_done(s, out, expected[s], legacy, corrupt))
     for path, reason in corrupt:
-        print(f"moo.experiment: {reason}; recomputing {path}", file=sys.stderr)
+        print(f"moo.experiment: {reason}; recomputing it", file=sys.stderr)
     retried = sum(s.failed_path(out).is_file() for s in todo)
     return PreparedExperiment(specs=tuple(specs), out=out, todo=todo, retried=retried, settings=settings,
                               expected={s: expected[s] for s in todo}, corrupt=tuple(corrupt))
