@@ -550,7 +550,7 @@ def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: 
         expected = {s: _expected(s, prob.n_obj, pop_sizes, name) for s in specs}
         corrupt: list[tuple[Path, str]] = []
         todo = tuple(s for s in specs if not _is_done(s, out, expected[s], legacy, corrupt))
-    for path, reason in corrupt:
+    for _path, reason in corrupt:
         print(f"moo.experiment: {reason}; recomputing it", file=sys.stderr)
     retried = sum(s.failed_path(out).is_file() for s in todo)
     return PreparedExperiment(specs=tuple(specs), out=out, todo=todo, retried=retried, settings=settings,

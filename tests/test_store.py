@@ -15,7 +15,6 @@ from moo.experiment import plan, run_experiment
 from moo.store import (
     CorruptRecordError,
     ResultsDirBusyError,
-    load_records,
     lock_results_dir,
     read_settings,
     validate_record,
@@ -86,7 +85,7 @@ def test_stats_and_plot_refuse_a_directory_mixing_two_settings(tmp_path, capsys)
     run_experiment("zdt1", "nsga2", out=a, **TINY)
     run_experiment("zdt1", "nsga3", out=b, **{**TINY, "evals": 60})
     shutil.copytree(b / "zdt1" / "nsga3", a / "zdt1" / "nsga3")                # mixed by hand
-    moved = sorted((a / "zdt1" / "nsga3").glob("seed_*.json"))[0]
+    moved = min((a / "zdt1" / "nsga3").glob("seed_*.json"))
     for cmd in (["stats", str(a)], ["plot", str(a), "--out", str(tmp_path / "fig")]):
         assert main(cmd) == 2
         err = _one_line(capsys.readouterr().err)
