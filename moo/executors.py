@@ -188,7 +188,7 @@ def _dask(scheduler: str | None, workers: int) -> Iterator[Executor]:
         raise
     except BaseException as exc:
         if _scheduler_lost(client, exc):
-            raise SchedulerLostError(f"lost {where} ({type(exc).__name__}); the records written are kept: "
+            raise SchedulerLostError(f"lost {where}; the records written are kept: "
                                      "restart the scheduler and rerun the same command to resume") from None
         raise
     finally:
