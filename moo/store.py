@@ -106,11 +106,11 @@ class CorruptRecordError(ValueError):
 def problem_dir(problem: str, n_obj: int | None) -> str:
     """Directory name of a problem: its name (``:`` as ``~``), with ``-m<M>`` for DTLZ given ``n_obj``.
 
-    An import path given ``n_obj`` gets the ``-m<M>`` too.
+    An import path gets no ``-m<M>``: a directory holds one ``n_obj`` of it.
     """
     key = problem if is_import_path(problem) else problem.lower()
-    with_m = n_obj is not None and (key.startswith("dtlz") or is_import_path(key))
-    return f"{safe_name(key)}-m{n_obj}" if with_m else safe_name(key)
+    with_m = n_obj is not None and key.startswith("dtlz") and not is_import_path(key)
+    return f"{key}-m{n_obj}" if with_m else safe_name(key)
 
 
 def variant_dir(algorithm: str, molsp: bool) -> str:
