@@ -20,8 +20,15 @@ An interrupted experiment therefore
 continues where it stopped and never recomputes a finished run. A file that
 holds a run with *other* settings (say another budget) is an error naming the
 file and the setting, raised before any run starts: results of two settings
-are never mixed. A file that cannot be read (not written by us: the writes are
-atomic) is recomputed and replaced. Runs recorded as failed are retried.
+are never mixed. Beyond the grid's own cells, the directory's
+``settings.json`` (written by its first grid, see :mod:`moo.store`) must
+hold the grid's budget, population size, MO-LSP cap and base seed, and for
+its problem directory the problem, objectives and set-up; a directory from
+before ``settings.json`` is checked against all its records. The directory
+is locked while a grid scans and writes it (a second writer is refused). A
+file that cannot be read or holds a corrupt record (not written by us: the
+writes are atomic) is recomputed and replaced, with a line on stderr. Runs
+recorded as failed are retried.
 
 Seeds
 -----

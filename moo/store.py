@@ -171,7 +171,7 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
 
 
 def write_json_atomic(path: str | os.PathLike, data: dict) -> None:
-    """Write ``data`` as JSON to ``path`` atomically (see :func:`write_text_atomic`)."""
+    """Write ``data`` as JSON to ``path`` atomically (see :func:`moo.store.write_text_atomic`)."""
     write_text_atomic(path, json.dumps(data, indent=1) + "\n")
 
 
