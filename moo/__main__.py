@@ -13,6 +13,15 @@
                       [--runs-out FILE.csv] [--alpha A]
     python -m moo plot DIR --out FIGDIR [--format png,pdf]
 
+``--problem`` and ``--algorithm``/``--algorithms`` take a registry name or the
+import path ``package.module:factory`` of a user's problem or MOEA (see
+:mod:`moo._imports`: the problem factory is called with no argument, or with
+``n_obj=`` given ``--n-obj``, and returns a pymoo Problem carrying
+``hv_ref_point`` and ``molsp_ref_point``; the algorithm factory is called as
+``factory(n_obj=M, pop_size=P)`` and returns a pymoo Algorithm). The module
+must be importable by the driver and by every worker (the current directory
+or ``PYTHONPATH``; a Dask cluster's workers need it installed).
+
 ``run`` runs :func:`moo.runner.run` and writes its record (the fields are
 listed in :mod:`moo.runner`) as JSON. ``experiment`` runs a resumable grid
 (:func:`moo.experiment.run_experiment`; one record per run under DIR) in this
@@ -34,9 +43,19 @@ Exit codes (the same for every command):
   the pool restarts, the scheduler unreachable). One line on stderr says
   what and where the traceback is; the records already written stay, and
   rerunning the command resumes;
+  An output that cannot be written (a full disk, ``OSError``) is also 1,
+  with one line naming the file; nothing is left half-written (every output
+  is written atomically), and ``run`` keeps its finished run: its record
+  goes to a file in the temporary directory, or to stdout, and the message
+  says where;
 * 2 - bad arguments (a one-line message on stderr; nothing was run or written),
-  including an unusable ``--out``, a results directory holding runs with
-  other settings, and a corrupt record read by ``stats`` or ``plot``;
+  including an unusable ``--out``, a results directory in use by another
+  ``experiment`` (one writer at a time) or holding runs with other settings
+  (its ``settings.json`` or a record, named with the setting), a ``--problem``
+  or ``--algorithm`` import path that does not import or whose factory
+  returns something else, an unparsable ``--scheduler``, and a corrupt
+  record, a duplicate run or a directory mixing two settings read by
+  ``stats`` or ``plot`` (the file is named);
 * 130 - interrupted (Ctrl-C); the records already written stay.
 
 Progress bars go to stderr when stderr is a terminal.
@@ -45,6 +64,8 @@ Progress bars go to stderr when stderr is a terminal.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
 import os
 import re
 import sys
@@ -92,10 +113,11 @@ def _parser() -> argparse.ArgumentParser:
 
     r = _subparser(sub, "run", "one run of a MOEA on a problem, recorded as JSON",
                    f"{_PROG} run --problem applied --algorithm nsga3 --molsp --seed 1 --evals 10000 --out run.json")
-    r.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}")
+    r.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}, or package.module:factory")
     r.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
     r.add_argument("--setup", default=None, help=_SETUP_HELP)
-    r.add_argument("--algorithm", required=True, help=f"one of {', '.join(ALGORITHMS)}")
+    r.add_argument("--algorithm", required=True,
+                   help=f"one of {', '.join(ALGORITHMS)}, or package.module:factory")
     r.add_argument("--molsp", action="store_true", help="add MO-LSP to the algorithm")
     r.add_argument("--max-leaders", type=int, default=None, help="MO-LSP cap on candidates per generation")
     r.add_argument("--seed", type=int, required=True, help="seed (integer >= 0)")
@@ -106,10 +128,11 @@ def _parser() -> argparse.ArgumentParser:
     e = _subparser(sub, "experiment", "a resumable grid of runs: algorithms x {plain, MO-LSP} x seeds",
                    f"{_PROG} experiment --problem generic --algorithms nsga2,nsga3 --runs 50 --evals 10000 "
                    "--out results/generic --executor dask --workers 2")
-    e.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}")
+    e.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}, or package.module:factory")
     e.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
     e.add_argument("--setup", default=None, help=_SETUP_HELP)
-    e.add_argument("--algorithms", default="all", help="'all' or a comma-separated list (default all)")
+    e.add_argument("--algorithms", default="all",
+                   help="'all' or a comma-separated list of names or package.module:factory (default all)")
     e.add_argument("--runs", type=int, required=True, help="independent runs per algorithm and variant")
     e.add_argument("--evals", type=int, required=True, help="evaluation budget of each run")
     e.add_argument("--max-leaders", type=int, default=None, help="MO-LSP cap on candidates per generation")
@@ -216,13 +239,51 @@ def _cmd_run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    write_json_atomic(out, result.to_dict())
+    record = result.to_dict()
+    try:
+        write_json_atomic(out, record)
+    except OSError as exc:
+        return _error(f"cannot write {out} ({_os_reason(exc)}); {_keep_elsewhere(record, out)}", 1)
     return 0
+
+
+#: errno values of a write that failed for lack of room or rights (reported in one line, exit 1).
+_DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EACCES, errno.EPERM, errno.EIO})
+
+
+def _os_reason(exc: OSError) -> str:
+    """``strerror`` of a disk error (``No space left on device``), else its first line."""
+    if exc.strerror:
+        return exc.strerror
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+
+
+def _keep_elsewhere(record: dict, out) -> str:
+    """Save a finished run's record that could not go to ``out``: a temporary file, else stdout."""
+    import json
+    import tempfile
+
+    text = json.dumps(record, indent=1) + "\n"
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f"moo-run-{os.path.splitext(os.path.basename(out))[0]}-",
+                                   suffix=".json")
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        return f"the finished run's record is kept in {tmp}"
+    except OSError:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return "the finished run's record is printed on stdout"
 
 
 def _cmd_experiment(args) -> int:
     from moo.executors import open_executor
     from moo.experiment import RunFailedError, prepare
+    from moo.store import ResultsDirBusyError
 
     if args.molsp_max_leaders is not None:
         if args.max_leaders is not None:
@@ -245,6 +306,17 @@ def _cmd_experiment(args) -> int:
         return _error(f"{exc}; the records written stay, rerun to resume", 1)
     except ConnectionError as exc:
         return _error(str(exc), 1)
+    except OSError as exc:
+        if exc.errno not in _DISK_ERRORS and exc.filename is None:
+            return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
+        return _error(f"cannot write a record in {grid.out} ({_os_reason(exc)}); the records "
+                      "written stay: free the space and rerun the same command to resume", 1)
+    except ResultsDirBusyError as exc:
+        return _error(str(exc), 2)
+    except ValueError as exc:
+        if "other settings" not in str(exc):
+            return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
+        return _error(_flagged(str(exc)), 2)
     except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
     print(report, file=sys.stderr)
@@ -269,9 +341,13 @@ def _check_table_path(flag: str, path: str | None, formats: tuple[str, ...]) -> 
 
 
 def _write_table(path: str, csv_text: str, markdown: str, latex: str) -> None:
-    text = {".csv": csv_text, ".md": markdown, ".tex": latex}[os.path.splitext(path)[1].lower()]
-    with open(path, "w", encoding="utf-8") as fh:
-        fh.write(text)
+    from moo.store import write_text_atomic
+
+    write_text_atomic(path, {".csv": csv_text, ".md": markdown, ".tex": latex}[os.path.splitext(path)[1].lower()])
+
+
+def _write_failed(exc: OSError, what: str) -> int:
+    return _error(f"cannot write {what} ({_os_reason(exc)}); no partial file is left", 1)
 
 
 def _results_dir(path: str) -> None:
@@ -294,12 +370,17 @@ def _cmd_stats(args) -> int:
     md, ranks_md = stats.to_markdown(table), stats.ranks_to_markdown(ranks)
     print(md)
     print(ranks_md)
-    if args.out is not None:
-        _write_table(args.out, stats.to_csv(table), md, stats.to_latex(table))
-    if args.ranks_out is not None:
-        _write_table(args.ranks_out, stats.ranks_to_csv(ranks), ranks_md, stats.ranks_to_latex(ranks))
-    if args.runs_out is not None:
-        stats.to_csv(runs, args.runs_out)
+    outputs = ((args.out, lambda p: _write_table(p, stats.to_csv(table), md, stats.to_latex(table))),
+               (args.ranks_out, lambda p: _write_table(p, stats.ranks_to_csv(ranks), ranks_md,
+                                                       stats.ranks_to_latex(ranks))),
+               (args.runs_out, lambda p: stats.to_csv(runs, p)))
+    for path, write in outputs:
+        if path is None:
+            continue
+        try:
+            write(path)
+        except OSError as exc:
+            return _error(f"cannot write {path} ({_os_reason(exc)}); no partial file is left", 1)
     return 0
 
 
@@ -316,8 +397,11 @@ def _cmd_plot(args) -> int:
         if not records:
             raise ValueError(f"no run records (*/*/seed_*.json) under {args.dir!r}")
         out = prepare_results_dir(args.out, "--out")
-    for path in plots.plot_results(records, out, formats=formats, alpha=args.alpha):
-        print(path)
+    try:
+        for path in plots.plot_results(records, out, formats=formats, alpha=args.alpha):
+            print(path)
+    except OSError as exc:
+        return _write_failed(exc, f"a figure in {out}")
     return 0
 
 

@@ -15,7 +15,10 @@ manager that yields a :class:`concurrent.futures.Executor` (or ``None`` for
     resubmits the lost runs, at most :data:`POOL_RESTARTS` times per grid (a
     run that kills its process every time would otherwise loop forever), with
     a message on stderr. After that the grid stops; the records written stay
-    and a rerun resumes.
+    and a rerun resumes. The pool processes exit with the driver: each one
+    watches its parent (a thread polling ``os.getppid()`` every
+    :data:`PARENT_POLL` seconds), so a driver killed by SIGTERM or SIGKILL
+    leaves no pool process behind.
 ``"dask"``
     With ``scheduler``: the workers of an existing ``dask.distributed``
     scheduler (started with ``dask scheduler`` / ``dask worker``, or by
@@ -24,7 +27,10 @@ manager that yields a :class:`concurrent.futures.Executor` (or ``None`` for
     thread each. The scheduler recomputes the runs of a lost worker on the
     others (up to ``distributed.scheduler.allowed-failures`` times per run).
     The workers need ``moo`` installed (the same version), not the results
-    directory.
+    directory, and any user module named by an import path (``--problem
+    package.module:factory``). A scheduler lost mid-grid raises
+    :class:`SchedulerLostError` (a ``ConnectionError``): the records written
+    stay and the same command, rerun, resumes.
 
 On leaving the block because of an error (a failed run, Ctrl-C), queued runs
 are cancelled; a local pool or cluster is shut down without waiting for the
@@ -33,6 +39,9 @@ runs in flight.
 
 from __future__ import annotations
 
+import os
+import re
+import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from contextlib import AbstractContextManager, contextmanager
@@ -41,7 +50,36 @@ from typing import Any
 
 from moo._validation import check_choice, check_int
 
-__all__ = ["EXECUTORS", "POOL_RESTARTS", "open_executor"]
+__all__ = ["EXECUTORS", "POOL_RESTARTS", "PARENT_POLL", "SchedulerLostError", "open_executor"]
+
+#: Seconds between two checks of a pool process that its driver is still alive.
+PARENT_POLL = 0.5
+
+_SCHEDULER = re.compile(r"^(tcp|tls|inproc|ucx|ws|wss)://[^\s/:]+(:\d{1,5})?/?$|^[^\s/:]+:\d{1,5}$")
+
+
+class SchedulerLostError(ConnectionError):
+    """The Dask scheduler went away mid-grid (the records written stay; rerun to resume)."""
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Pool-process initializer: exit as soon as the driver ``parent`` is gone.
+
+    A daemon thread polls ``os.getppid()``: an orphan is re-parented, so the
+    value changes when the driver dies, however it dies. (Linux's
+    ``PR_SET_PDEATHSIG`` is not used: it fires when the *thread* that started
+    the process ends, which is not the driver's death.)
+    """
+    if os.getppid() != parent:                                 # died before we got here
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            threading.Event().wait(PARENT_POLL)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="moo-parent-watch", daemon=True).start()
 
 #: Executor kinds of :func:`open_executor` (and ``python -m moo experiment --executor``).
 EXECUTORS: tuple[str, ...] = ("process", "dask")
@@ -76,8 +114,9 @@ def open_executor(kind: str = "process", *, workers: int | None = None,
     if workers is not None:
         workers = check_int(workers, "workers", 1)
     if scheduler is not None:
-        if not isinstance(scheduler, str) or not scheduler.strip():
+        if not isinstance(scheduler, str) or not _SCHEDULER.match(scheduler.strip()):
             raise ValueError(f"scheduler must be an address such as 'tcp://HOST:8786', got {scheduler!r}")
+        scheduler = scheduler.strip()
         if kind != "dask":
             raise ValueError("scheduler needs the 'dask' executor")
         if workers is not None:
@@ -95,7 +134,8 @@ class _RestartingPool(Executor):
         self._pool = self._new()
 
     def _new(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"))
+        return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"),
+                                   initializer=_exit_with_parent, initargs=(os.getpid(),))
 
     def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
         return self._pool.submit(fn, *args, **kwargs)
@@ -138,12 +178,50 @@ def _dask(scheduler: str | None, workers: int) -> Iterator[Executor]:
     else:
         try:
             client = Client(scheduler)
-        except OSError as exc:
+        except (OSError, ValueError, TypeError) as exc:
             raise ConnectionError(f"cannot reach the Dask scheduler at {scheduler}: "
                                   f"{str(exc).splitlines()[0]}") from None
+    where = "the local Dask cluster" if scheduler is None else f"the Dask scheduler at {scheduler}"
     try:
         yield client.get_executor()
+    except (KeyboardInterrupt, SchedulerLostError):
+        raise
+    except BaseException as exc:
+        if _scheduler_lost(client, exc):
+            raise SchedulerLostError(f"lost {where}; the records written are kept: "
+                                     "restart the scheduler and rerun the same command to resume") from None
+        raise
     finally:
-        client.close()
+        _close_quietly(client)
         if cluster is not None:
-            cluster.close()
+            _close_quietly(cluster)
+
+
+def _scheduler_lost(client: Any, exc: BaseException) -> bool:
+    """True if ``exc`` comes from losing the scheduler (a cancelled future or a comm error, client cut off)."""
+    from asyncio import CancelledError as AsyncCancelled
+    from concurrent.futures import CancelledError
+
+    from distributed.comm.core import CommClosedError
+
+    if isinstance(exc, (CancelledError, AsyncCancelled, CommClosedError, OSError, TimeoutError)):
+        return True
+    return getattr(client, "status", "running") not in ("running", "connecting")
+
+
+def _close_quietly(obj: Any) -> None:
+    """Close a Dask client or cluster without the tracebacks of a scheduler that is gone."""
+    import logging
+
+    loggers = [logging.getLogger(n) for n in ("distributed", "distributed.client", "distributed.comm",
+                                               "distributed.batched", "tornado", "asyncio")]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL)
+    try:
+        obj.close(timeout=5)
+    except BaseException:  # noqa: BLE001 - closing a client whose scheduler is gone: nothing left to save
+        pass
+    finally:
+        for lg, level in zip(loggers, levels, strict=True):
+            lg.setLevel(level)

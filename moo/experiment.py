@@ -20,8 +20,15 @@ An interrupted experiment therefore
 continues where it stopped and never recomputes a finished run. A file that
 holds a run with *other* settings (say another budget) is an error naming the
 file and the setting, raised before any run starts: results of two settings
-are never mixed. A file that cannot be read (not written by us: the writes are
-atomic) is recomputed and replaced. Runs recorded as failed are retried.
+are never mixed. Beyond the grid's own cells, the directory's
+``settings.json`` (written by its first grid, see :mod:`moo.store`) must
+hold the grid's budget, population size, MO-LSP cap and base seed, and for
+its problem directory the problem, objectives and set-up; a directory from
+before ``settings.json`` is checked against all its records. The directory
+is locked while a grid scans and writes it (a second writer is refused). A
+file that cannot be read or holds a corrupt record (not written by us: the
+writes are atomic) is recomputed and replaced, with a line on stderr. Runs
+recorded as failed are retried.
 
 Seeds
 -----
@@ -77,14 +84,29 @@ from pathlib import Path
 
 import numpy as np
 
+from moo._imports import build_problem, check_algorithm_name, check_problem_name
 from moo._validation import check_int
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
 from moo.executors import POOL_RESTARTS, _RestartingPool, open_executor
-from moo.store import FAILED_SUFFIX, load_records, prepare_results_dir, read_record, write_json_atomic
+from moo.store import (
+    FAILED_SUFFIX,
+    CorruptRecordError,
+    check_settings,
+    load_records,
+    lock_results_dir,
+    prepare_results_dir,
+    problem_dir,
+    read_record,
+    read_settings,
+    validate_record,
+    variant_dir,
+    write_json_atomic,
+    write_settings,
+)
 
 __all__ = ["RunSpec", "ExperimentReport", "PreparedExperiment", "RunFailedError", "plan", "run_seeds",
-           "prepare", "run_experiment", "load_records", "write_json_atomic"]
+           "prepare", "run_experiment", "load_records", "write_json_atomic", "problem_dir"]
 
 # Fields of a record that must match its RunSpec for the file to count as done.
 _MATCH = ("problem", "n_obj", "algorithm", "molsp", "seed", "budget", "pop_size", "max_leaders")
@@ -107,8 +129,8 @@ class RunSpec:
 
     @property
     def variant(self) -> str:
-        """Directory name of the algorithm variant: ``name`` or ``name+molsp``."""
-        return f"{self.algorithm}+molsp" if self.molsp else self.algorithm
+        """Directory name of the algorithm variant: ``name`` or ``name+molsp`` (``:`` written ``~``)."""
+        return variant_dir(self.algorithm, self.molsp)
 
     @property
     def label(self) -> str:
@@ -149,12 +171,6 @@ class RunFailedError(RuntimeError):
         self.spec, self.path, self.error = spec, path, error
 
 
-def problem_dir(problem: str, n_obj: int | None) -> str:
-    """Directory name of a problem: its name, plus ``-m<M>`` when ``n_obj`` is given for DTLZ."""
-    key = problem.lower()
-    return f"{key}-m{n_obj}" if (n_obj is not None and key.startswith("dtlz")) else key
-
-
 def run_seeds(runs: int, base_seed: int = 0) -> list[int]:
     """The integer seeds of runs ``0`` to ``runs - 1`` (see the module docstring)."""
     runs = check_int(runs, "runs", 1)
@@ -171,10 +187,9 @@ def _algorithms(algorithms: str | Sequence[str]) -> list[str]:
         raise ValueError("algorithms must name at least one algorithm")
     out = []
     for name in names:
-        if not isinstance(name, str) or name.lower() not in ALGORITHMS:
-            raise ValueError(f"unknown algorithm {name!r} in algorithms; valid: {', '.join(ALGORITHMS)}")
-        if name.lower() not in out:
-            out.append(name.lower())
+        key = check_algorithm_name(name)
+        if key not in out:
+            out.append(key)
     return out
 
 
@@ -186,9 +201,11 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
     Parameters
     ----------
     problem : str
-        A name of :data:`moo.problems.PROBLEMS`.
+        A name of :data:`moo.problems.PROBLEMS`, or the import path
+        ``package.module:factory`` of a user's problem (:mod:`moo._imports`).
     algorithms : str or sequence of str
-        ``"all"``, a comma-separated string or a list of registry names.
+        ``"all"``, a comma-separated string or a list of registry names or
+        import paths of a user's algorithm factories.
     runs : int
         Independent runs per algorithm and variant.
     evals : int
@@ -206,10 +223,7 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
     setup : str, optional
         The problem's set-up (``applied`` only, see :func:`moo.runner.prepare`).
     """
-    from moo.problems import PROBLEMS
-
-    if not isinstance(problem, str) or problem.lower() not in PROBLEMS:
-        raise ValueError(f"unknown problem {problem!r}; valid: {', '.join(PROBLEMS)}")
+    problem = check_problem_name(problem)
     names = _algorithms(algorithms)
     evals = check_int(evals, "evals", 1)
     pop_size = check_int(pop_size, "pop_size", 4)
@@ -221,26 +235,31 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
     if not variants:
         raise ValueError("variants must hold at least one of False (plain), True (MO-LSP)")
     seeds = run_seeds(runs, base_seed)
-    return [RunSpec(problem=problem.lower(), n_obj=n_obj, algorithm=name, molsp=v, run_index=i, seed=s,
+    return [RunSpec(problem=problem, n_obj=n_obj, algorithm=name, molsp=v, run_index=i, seed=s,
                     evals=evals, pop_size=pop_size, max_leaders=max_leaders if v else None, setup=setup)
             for i, s in enumerate(seeds) for name in names for v in variants]
 
 
 # ---------------------------------------------------------------------------- the store scan
 
-def _is_done(spec: RunSpec, out: Path, expected: dict, legacy_setup=None) -> bool:
-    """True if the spec's file holds its record; False if absent or unreadable; error if another run.
+def _is_done(spec: RunSpec, out: Path, expected: dict, legacy_setup=None,
+             corrupt: list[tuple[Path, str]] | None = None) -> bool:
+    """True if the spec's file holds its record; False if absent, unreadable or corrupt; error if another run.
 
     ``legacy_setup``: the set-up a record without a ``setup`` field (written before set-ups existed)
     stands for (the problem's default set-up when the grid asks for the default, else no match).
+    A corrupt file (not written by us: the writes are atomic) is appended to ``corrupt`` with the reason.
     """
     path = spec.path(out)
     if not path.is_file():
         return False
     try:
         rec = read_record(path, required=(*_MATCH, "F"))
-    except ValueError:
-        return False                      # unreadable (not written by us): recompute and replace
+        validate_record(rec, path)
+    except ValueError as exc:              # unreadable or corrupt: recompute and replace
+        if corrupt is not None:
+            corrupt.append((path, str(exc).splitlines()[0]))
+        return False
     got = {k: rec.get(k, legacy_setup) if k == "setup" else rec[k] for k in expected}
     wrong = {k: (got[k], v) for k, v in expected.items() if got[k] != v}
     if wrong:
@@ -248,6 +267,43 @@ def _is_done(spec: RunSpec, out: Path, expected: dict, legacy_setup=None) -> boo
         raise ValueError(f"{path} holds a run with other settings: {what}; use another out directory "
                          "or the settings of that run")
     return True
+
+
+def _check_legacy_dir(out: Path, settings: dict, legacy_setup) -> None:
+    """A directory without ``settings.json``: every valid record in it must have the grid's settings."""
+    try:
+        records = load_records(out, check=False)
+    except ValueError:
+        records = []                       # an unreadable file: the per-cell scan recomputes or names it
+    seeds: list[int] = []
+    for rec in records:
+        try:
+            validate_record(rec, rec["_path"])
+        except CorruptRecordError:
+            continue                       # recomputed if in the grid; named by stats otherwise
+        want = {"budget": settings["budget"]}
+        if rec["_problem_dir"] == settings["problem_dir"]:
+            want.update(problem=settings["problem"], n_obj=settings["n_obj"])
+            if "setup" in rec or legacy_setup != settings["setup"]:
+                want["setup"] = settings["setup"]
+        if rec["molsp"]:
+            want["max_leaders"] = settings["max_leaders"]
+        got = {k: rec.get(k, legacy_setup if k == "setup" else None) for k in want}
+        if rec["_problem_dir"] != settings["problem_dir"] and \
+                (rec["problem"], rec["n_obj"]) == (settings["problem"], settings["n_obj"]):
+            got["problem directory"], want["problem directory"] = rec["_problem_dir"], settings["problem_dir"]
+        idx = rec.get("run_index")
+        if isinstance(idx, int) and idx >= 0:
+            if idx >= len(seeds):
+                seeds = run_seeds(idx + 1, settings["base_seed"])
+            if seeds[idx] != rec["seed"]:
+                got["base_seed"], want["base_seed"] = f"giving seed {rec['seed']} to run {idx}", \
+                    settings["base_seed"]
+        wrong = {k: (got[k], v) for k, v in want.items() if got[k] != v}
+        if wrong:
+            what = ", ".join(f"{k} {g!r} (this grid: {w!r})" for k, (g, w) in wrong.items())
+            raise ValueError(f"{rec['_path']} holds a run with other settings: {what}; a results directory "
+                             "holds one setting: use another out directory or the settings of that run")
 
 
 def _expected(spec: RunSpec, n_obj: int, pop_sizes: dict[str, int], setup: str | None) -> dict:
@@ -386,6 +442,9 @@ class PreparedExperiment:
     out: Path
     todo: tuple[RunSpec, ...]
     retried: int
+    settings: dict = field(default_factory=dict)
+    expected: dict = field(default_factory=dict)
+    corrupt: tuple[tuple[Path, str], ...] = ()
 
     @property
     def skipped(self) -> int:
@@ -415,25 +474,39 @@ class PreparedExperiment:
         ------
         RunFailedError
             A run raised (without ``keep_going``).
+        ResultsDirBusyError
+            Another process writes in the directory (a ``ValueError``; nothing run).
+        ValueError
+            Since :func:`prepare`, the directory got other settings (nothing run).
+        OSError
+            A record could not be written (a full disk); the records written stay.
         """
         if executor is not None and not isinstance(executor, Executor):
             raise TypeError(f"executor must be a concurrent.futures.Executor, got {type(executor).__name__}")
-        show = sys.stderr.isatty() if progress is None else bool(progress)
-        bar = _Progress(len(self.specs), self.skipped) if show else None
-        recorder = _Recorder(self.out, bool(keep_going), bar)
-        start = time.perf_counter()
-        try:
-            if bar is not None:
-                bar.update(0, 0, "")
-            if executor is None:
-                for spec in self.todo:
-                    recorder.add(spec, _execute(spec))
-            else:
-                _run_on(executor, self.todo, recorder)
-        finally:
-            if bar is not None:
-                bar.close()
-        return ExperimentReport(out=self.out, total=len(self.specs), skipped=self.skipped,
+        with lock_results_dir(self.out):
+            if self.settings:
+                recorded = read_settings(self.out)
+                if recorded is None or check_settings(self.out, recorded, self.settings):
+                    write_settings(self.out, recorded, self.settings)
+            # another writer may have added runs between prepare() and the lock
+            todo = [s for s in self.todo if s not in self.expected or not _is_done(s, self.out, self.expected[s])]
+            skipped = len(self.specs) - len(todo)
+            show = sys.stderr.isatty() if progress is None else bool(progress)
+            bar = _Progress(len(self.specs), skipped) if show else None
+            recorder = _Recorder(self.out, bool(keep_going), bar)
+            start = time.perf_counter()
+            try:
+                if bar is not None:
+                    bar.update(0, 0, "")
+                if executor is None:
+                    for spec in todo:
+                        recorder.add(spec, _execute(spec))
+                else:
+                    _run_on(executor, todo, recorder)
+            finally:
+                if bar is not None:
+                    bar.close()
+        return ExperimentReport(out=self.out, total=len(self.specs), skipped=skipped,
                                 completed=recorder.completed, wall_time=time.perf_counter() - start,
                                 failed=tuple(recorder.failed))
 
@@ -446,30 +519,49 @@ def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: 
 
     Every check happens here, before any run: the arguments of :func:`plan`,
     the budget against each algorithm's population (the problem is built
-    once), ``out`` (a directory that can be written), and the records already
-    in ``out`` (another setting in any of them is an error).
+    once), ``out`` (a directory that can be written, not locked by another
+    writer), the directory's settings (``settings.json``, or for a directory
+    from before it, every record in it) against the grid's, and the records
+    of the grid's runs. A corrupt record of the grid (see
+    :func:`moo.store.validate_record`) is recomputed, with a line on stderr
+    (listed in ``corrupt``).
 
     Raises
     ------
     ValueError, TypeError
-        A bad argument, an unusable ``out``, or ``out`` holding a run of the
-        grid with other settings (the message names the file).
+        A bad argument, an unusable or busy ``out``, or ``out`` holding runs
+        with other settings (the message names the file and the setting).
     """
-    from moo.problems import make_problem
     from moo.runner import check_budget, setup_name
 
     specs = plan(problem, algorithms, runs=runs, evals=evals, n_obj=n_obj, base_seed=base_seed,
                  pop_size=pop_size, max_leaders=max_leaders, variants=variants, setup=setup)
-    prob = make_problem(problem, n_obj, setup=setup)
+    key = specs[0].problem
+    prob = build_problem(key, n_obj, setup=setup)
     name = setup_name(prob)
     # a record without a set-up was written before set-ups existed, with the problem's default one
-    legacy = name if setup is None else setup_name(make_problem(problem, n_obj))
-    pop_sizes = {name: int(check_budget(prob, name, evals=specs[0].evals, pop_size=specs[0].pop_size).pop_size)
-                 for name in dict.fromkeys(s.algorithm for s in specs)}
+    legacy = name if setup is None else setup_name(build_problem(key, n_obj))
+    pop_sizes = {alg: int(check_budget(prob, alg, evals=specs[0].evals, pop_size=specs[0].pop_size).pop_size)
+                 for alg in dict.fromkeys(s.algorithm for s in specs)}
     out = prepare_results_dir(out)
-    todo = tuple(s for s in specs if not _is_done(s, out, _expected(s, prob.n_obj, pop_sizes, name), legacy))
+    settings = {"problem": key, "problem_dir": problem_dir(key, n_obj), "n_obj": int(prob.n_obj), "setup": name,
+                "budget": specs[0].evals, "pop_size": specs[0].pop_size,
+                "max_leaders": max_leaders,
+                "base_seed": check_int(base_seed, "base_seed", 0)}
+    with lock_results_dir(out):            # refuse now (before any work) if another writer holds it
+        recorded = read_settings(out)
+        if recorded is not None:
+            check_settings(out, recorded, settings)
+        else:
+            _check_legacy_dir(out, settings, legacy)
+        expected = {s: _expected(s, prob.n_obj, pop_sizes, name) for s in specs}
+        corrupt: list[tuple[Path, str]] = []
+        todo = tuple(s for s in specs if not _is_done(s, out, expected[s], legacy, corrupt))
+    for _path, reason in corrupt:
+        print(f"moo.experiment: {reason}; recomputing it", file=sys.stderr)
     retried = sum(s.failed_path(out).is_file() for s in todo)
-    return PreparedExperiment(specs=tuple(specs), out=out, todo=todo, retried=retried)
+    return PreparedExperiment(specs=tuple(specs), out=out, todo=todo, retried=retried, settings=settings,
+                              expected={s: expected[s] for s in todo}, corrupt=tuple(corrupt))
 
 
 def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int,

@@ -50,6 +50,7 @@ from moo.stats import (
     run_indicators,
     true_front,
 )
+from moo.store import atomic_path
 
 __all__ = ["FORMATS", "check_formats", "hv_history", "indicator_boxplots", "fronts", "cd_diagram", "plot_results"]
 
@@ -170,7 +171,8 @@ def _median_run(recs: Sequence[dict]) -> dict | None:
 
 
 def _reference(problem: str, n_obj: int) -> np.ndarray | None:
-    return true_front(problem, n_obj) if problem.startswith(("zdt", "dtlz")) else None
+    known = ":" not in problem and problem.startswith(("zdt", "dtlz"))       # not a user's import path
+    return true_front(problem, n_obj) if known else None
 
 
 def fronts(records: Sequence[dict], algorithm: str | None = None, title: str = "") -> Figure:
@@ -304,7 +306,8 @@ def _save(fig: Figure, stem: Path, formats: Sequence[str]) -> list[Path]:
     paths = []
     for fmt in formats:
         path = stem.with_name(f"{stem.name}.{fmt}")
-        fig.savefig(path, format=fmt, dpi=150)
+        with atomic_path(path) as tmp:           # a full disk leaves no truncated figure
+            fig.savefig(tmp, format=fmt, dpi=150)
         paths.append(path)
     return paths
 

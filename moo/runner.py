@@ -1,10 +1,11 @@
-"""One optimisation run: problem and MOEA by name, optional MO-LSP, an evaluation budget.
+"""One optimisation run: problem and MOEA by name or import path, optional MO-LSP, an evaluation budget.
 
 :func:`prepare` checks every argument and builds the problem and the algorithm
 once (a bad argument raises ``ValueError``/``TypeError`` naming it, before any
 work); :meth:`PreparedRun.run` then runs it. :func:`run` does both. In detail,
-:func:`prepare` builds the problem (:func:`moo.problems.make_problem`) and the
-algorithm (:func:`moo.algorithms.make_algorithm`), wraps it with MO-LSP
+:func:`prepare` builds the problem (:func:`moo.problems.make_problem`, or a
+user's factory ``package.module:factory``, see :mod:`moo._imports`) and the
+algorithm (:func:`moo.algorithms.make_algorithm`, or a user's factory), wraps it with MO-LSP
 (:func:`moo.molsp.molsp`, reference point ``problem.molsp_ref_point``) if
 asked, runs it with pymoo's ``("n_eval", evals)`` termination and records the
 hypervolume of the non-dominated set after every generation (reference point
@@ -25,11 +26,13 @@ The record
 ``python -m moo experiment`` write (plain JSON types; arrays as nested lists):
 
 =================  ==========================================================
-``problem``        problem name (lower case), ``n_obj`` its objectives
+``problem``        problem name (lower case; an import path as given),
+                   ``n_obj`` its objectives
 ``setup``          the problem's set-up (``applied``: ``"ours"`` or
                    ``"authors"``, see :mod:`moo.problems.applied`); null for
                    problems without one
-``algorithm``      registry name; ``molsp`` true for the MO-LSP version
+``algorithm``      registry name (or import path); ``molsp`` true for the
+                   MO-LSP version
 ``max_leaders``    MO-LSP's cap on candidates per generation (null: none)
 ``seed``           the run's seed
 ``pop_size``       population size used (reference-direction algorithms
@@ -66,12 +69,11 @@ from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
 from pymoo.core.problem import Problem
 
+from moo._imports import build_algorithm, build_problem, check_algorithm_name, check_problem_name
 from moo._validation import check_int
-from moo.algorithms import make_algorithm
 from moo.algorithms.operators import POP_SIZE
 from moo.indicators import hypervolume
 from moo.molsp import molsp as add_molsp
-from moo.problems import make_problem
 
 __all__ = ["RunResult", "PreparedRun", "prepare", "run", "check_budget", "setup_name"]
 
@@ -194,7 +196,7 @@ def check_budget(problem, algorithm: str, *, evals: int, pop_size: int = POP_SIZ
 
     Raises ``ValueError`` if ``evals`` is below the population size it uses.
     """
-    alg = make_algorithm(algorithm, n_obj=problem.n_obj, pop_size=pop_size)
+    alg = build_algorithm(algorithm, n_obj=problem.n_obj, pop_size=pop_size)
     if evals < alg.pop_size:
         raise ValueError(f"evals must be at least the population size of {algorithm} ({alg.pop_size}), "
                          f"got {evals}")
@@ -258,9 +260,12 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
     Parameters
     ----------
     problem : str
-        A name of :data:`moo.problems.PROBLEMS`.
+        A name of :data:`moo.problems.PROBLEMS`, or the import path
+        ``package.module:factory`` of a user's problem factory
+        (:mod:`moo._imports`: called with no argument, or ``n_obj=``).
     algorithm : str
-        A name of :data:`moo.algorithms.ALGORITHMS`.
+        A name of :data:`moo.algorithms.ALGORITHMS`, or the import path of a
+        user's algorithm factory, called as ``factory(n_obj=M, pop_size=P)``.
     seed : int
         Non-negative seed of the run's Generator.
     evals : int
@@ -299,11 +304,12 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
         max_leaders = check_int(max_leaders, "max_leaders", 1)
         if not molsp:
             raise ValueError("max_leaders needs molsp=True")
-    prob = make_problem(problem, n_obj, setup=setup)
-    alg = check_budget(prob, algorithm, evals=evals, pop_size=pop_size)
+    problem_key, algorithm_key = check_problem_name(problem), check_algorithm_name(algorithm)
+    prob = build_problem(problem_key, n_obj, setup=setup)
+    alg = check_budget(prob, algorithm_key, evals=evals, pop_size=pop_size)
     if molsp:
         alg = add_molsp(alg, ref_point=np.asarray(prob.molsp_ref_point, dtype=float), max_leaders=max_leaders)
-    return PreparedRun(problem_name=problem.lower(), algorithm_name=algorithm.lower(), seed=seed, evals=evals,
+    return PreparedRun(problem_name=problem_key, algorithm_name=algorithm_key, seed=seed, evals=evals,
                        molsp=bool(molsp), max_leaders=max_leaders, problem=prob, algorithm=alg,
                        setup=setup_name(prob))
 

@@ -86,7 +86,6 @@ import warnings
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass, fields, replace
-from pathlib import Path
 
 import moocore
 import numpy as np
@@ -96,6 +95,7 @@ from scipy import stats as sps
 from moo import indicators as ind
 from moo.algorithms import ALGORITHMS
 from moo.experiment import problem_dir
+from moo.store import write_text_atomic
 
 __all__ = ["INDICATORS", "HIGHER_IS_BETTER", "LABELS", "RunIndicators", "Comparison", "FriedmanResult", "true_front",
            "reference_sets", "run_indicators", "pairwise_test", "rank_sum_test", "holm", "friedman_test",
@@ -283,7 +283,7 @@ def reference_sets(records: Iterable[dict]) -> dict[tuple[str, int], np.ndarray]
         union[(rec["problem"], int(rec["n_obj"]))].append(_front(rec))
     out = {}
     for (problem, m), parts in union.items():
-        if problem.startswith(("zdt", "dtlz")):
+        if ":" not in problem and problem.startswith(("zdt", "dtlz")):     # an import path is the user's
             out[(problem, m)] = true_front(problem, m)
             continue
         P = np.vstack(parts)
@@ -544,7 +544,7 @@ def to_csv(rows: Sequence[Comparison] | Sequence[RunIndicators], path: str | os.
             writer.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in asdict(r).items()})
     text = buf.getvalue()
     if path is not None:
-        Path(path).write_text(text, encoding="utf-8")
+        write_text_atomic(path, text)
     return text
 
 
@@ -782,5 +782,5 @@ def ranks_to_csv(results: Sequence[FriedmanResult], path: str | os.PathLike | No
                              repr(r.p_value), repr(r.cd), repr(r.alpha), marks == "n"])
     text = buf.getvalue()
     if path is not None:
-        Path(path).write_text(text, encoding="utf-8")
+        write_text_atomic(path, text)
     return text

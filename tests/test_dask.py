@@ -149,3 +149,61 @@ def test_cli_dask_argument_errors(tmp_path, capsys):
         err = capsys.readouterr().err
         assert message in err and err.count("\n") == 1, err
     assert not (tmp_path / "r").exists()
+
+
+@pytest.fixture
+def scheduler_and_worker(tmp_path):
+    """A `dask scheduler` and one `dask worker` (processes); yields (address, scheduler process)."""
+    sched_file = tmp_path / "scheduler.json"
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    procs = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
+                               "--no-dashboard", "--scheduler-file", str(sched_file)],
+                              cwd=REPO, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        deadline = time.monotonic() + 60
+        while not sched_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
+                                       "--nthreads", "1", "--no-dashboard", "--host", "127.0.0.1"], cwd=REPO,
+                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        with distributed.Client(scheduler_file=str(sched_file), timeout=60) as client:
+            client.wait_for_workers(1, timeout=60)
+            address = client.scheduler.address
+        yield address, procs[0]
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.wait(timeout=20)
+
+
+@pytest.mark.slow
+def test_lost_scheduler_is_one_short_message_and_the_records_stay(tmp_path, scheduler_and_worker):
+    address, scheduler = scheduler_and_worker
+    out = tmp_path / "res"
+    cmd = [sys.executable, "-m", "moo", "experiment", "--problem", "zdt1", "--algorithms", "nsga2", "--runs", "3",
+           "--evals", "3000000", "--pop-size", "20", "--out", str(out), "--executor", "dask", "--scheduler", address]
+    env = dict(os.environ, OMP_NUM_THREADS="1", DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT="3s")
+    proc = subprocess.Popen(cmd, cwd=REPO, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(8)                                    # the runs are submitted and running
+        scheduler.kill()
+        _, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode == 1, err
+    assert "Traceback" not in err and "CancelledError" not in err, err
+    last = err.strip().splitlines()[-1]
+    assert f"lost the Dask scheduler at {address}" in last and "the records written are kept" in last
+    assert "rerun the same command to resume" in last
+    assert len(err.strip().splitlines()) <= 5, err
+
+
+def test_unparsable_scheduler_is_a_usage_error(tmp_path, capsys):
+    from moo.__main__ import main
+
+    for bad in ("not an address", "http://host:8786", "tcp://host:port"):
+        assert main(["experiment", *CLI_GRID, "--out", str(tmp_path / "r"), "--executor", "dask",
+                     "--scheduler", bad]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "--scheduler must be an address such as 'tcp://HOST:8786'" in err, err
+    assert not (tmp_path / "r").exists()

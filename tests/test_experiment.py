@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import multiprocessing
@@ -255,6 +256,10 @@ def test_python_dash_m_exit_code_and_one_line(tmp_path):
 
 def test_rerun_with_another_pop_size_is_an_error_not_a_skip(tmp_path, fake_run):
     run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path, progress=False)
+    with pytest.raises(ValueError, match=r"settings\.json: the directory holds runs with other settings: "
+                                         r"pop_size 92 \(this grid: 50\)"):
+        run_experiment("zdt1", "nsga2", runs=1, evals=300, pop_size=50, out=tmp_path, progress=False)
+    (tmp_path / "settings.json").unlink()          # a directory from before settings.json: its records say
     with pytest.raises(ValueError, match=r"seed_\d+\.json holds a run with other settings: pop_size 92 "
                                          r"\(this grid: 50\)"):
         run_experiment("zdt1", "nsga2", runs=1, evals=300, pop_size=50, out=tmp_path, progress=False)
@@ -266,8 +271,8 @@ def test_cli_rerun_with_other_evals_is_a_one_line_usage_error(tmp_path, fake_run
     capsys.readouterr()
     assert main([*args, "--evals", "400"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "holds a run with other settings: budget 300 (this grid: 400)" in err
-    assert "seed_" in err and "Traceback" not in err
+    assert err.count("\n") == 1 and "holds runs with other settings: budget 300 (this grid: 400)" in err
+    assert "settings.json" in err and "Traceback" not in err
 
 
 @pytest.fixture
@@ -468,3 +473,60 @@ def test_every_help_has_an_example_and_the_exit_codes(command, capsys):
     out = capsys.readouterr().out
     assert info.value.code == 0 and "example" in out and "python -m moo " + " ".join(command) in out
     assert "exit codes: 0 done; 1 the work failed" in out and "2 bad arguments" in out
+
+
+def _children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (from /proc)."""
+    kids = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                stat = Path(f"/proc/{entry}/stat").read_text()
+            except OSError:
+                continue
+            fields = stat[stat.rindex(")") + 2:].split()
+            if int(fields[1]) == pid and fields[0] != "Z":
+                kids.append(int(entry))
+    return kids
+
+
+def _alive(pid: int) -> bool:
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat[stat.rindex(")") + 2:].split()[0] != "Z"          # a zombie has exited
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc")
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL])
+def test_pool_processes_exit_with_a_killed_driver(tmp_path, sig):
+    """SIGTERM or SIGKILL to the driver of --workers 2: its pool processes exit too (issue 23, item 5)."""
+    cmd = [sys.executable, "-m", "moo", "experiment", "--problem", "zdt1", "--algorithms", "nsga2", "--runs", "2",
+           "--evals", "10000000", "--pop-size", "20", "--workers", "2", "--out", str(tmp_path / "res")]
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    driver = subprocess.Popen(cmd, cwd=Path(__file__).resolve().parents[1], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    pool: list[int] = []
+    try:
+        deadline = time.monotonic() + 60
+        while len(pool) < 2 and time.monotonic() < deadline:
+            time.sleep(0.2)
+            pool = [p for p in _children(driver.pid)
+                    if "resource_tracker" not in Path(f"/proc/{p}/cmdline").read_bytes().decode(errors="replace")]
+        assert len(pool) >= 2, "the pool's processes did not start"
+        time.sleep(2.0)                                  # the workers are in their runs
+        os.kill(driver.pid, sig)
+        driver.wait(timeout=30)
+        deadline = time.monotonic() + 15
+        while any(_alive(p) for p in pool) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        left = [p for p in pool if _alive(p)]
+        assert not left, f"pool processes {left} outlived their driver"
+    finally:                                             # never leave a stray process behind
+        for p in [driver.pid, *pool]:
+            if p == driver.pid or _alive(p):
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(p, signal.SIGKILL)
+        driver.wait(timeout=30)
