@@ -160,6 +160,11 @@ def test_bad_synthesis_names_the_argument():
         rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, synthesis="fast")
     with pytest.raises(TypeError, match=r"^synthesis must be one of"):
         rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, synthesis=1)
+    # the fast path checks the solver's name without importing cvxpy
+    with pytest.raises(ValueError, match=r"^solver must name a cvxpy SDP solver, one of \['CLARABEL'"):
+        rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, synthesis="riccati", solver="clarabell")
+    with pytest.raises(TypeError, match=r"^solver must be a string"):
+        rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, synthesis="riccati", solver=3)
 
 
 @pytest.mark.parametrize("synthesis", ["lmi", "riccati"])

@@ -17,7 +17,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -147,7 +147,8 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         (:mod:`robustctl.hinf._riccati_path`); if that certificate is not
         strictly positive the SDP is solved instead. ``info["synthesis"]``
         says which path returned the gain (``info["fallback"]`` why the SDP
-        was needed).
+        was needed). With ``"riccati"`` cvxpy is imported, and ``solver``
+        checked to be installed, only if the SDP runs.
 
     Returns
     -------
@@ -207,13 +208,15 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     synthesis = check_choice(synthesis, "synthesis", ("lmi", "riccati"))
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
                        w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
-                       uncertainty=uncertainty)
+                       uncertainty=uncertainty, defer_solver=synthesis == "riccati")
     if synthesis == "riccati":
         check_plain(problem)
     w_scale, z_unit = channel_scales(problem.Bw, problem.Cz, problem.Dzu, problem.Dzw, problem.w_energy)
     balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
                           problem.Dzu, problem.Dzw, w_scale, problem.uncertainty, z_unit=z_unit)
     fast = _riccati(problem, balanced) if synthesis == "riccati" else None
+    if fast is not None and fast.gain is None:  # the SDP is needed after all: check the solver now
+        problem = replace(problem, solver=_cvx.check_solver(problem.solver))
     solves: tuple[dict, ...]
     if fast is not None and fast.gain is not None:
         gain, gamma_opt, used_backoff, solves = fast.gain, fast.gamma_opt, problem.backoff, ()
