@@ -26,7 +26,7 @@ scaled by hand (:func:`units`: the synthesis scales them inside, so both are
 the same problem for the solver). Robust against polytopic H-infinity on the
 truck is in ``bench_analysis.py``.
 
-Usage: python benchmarks/bench_hinf.py [--sizes 4 10 20 50] [--reps 3] [--seeds 5] [--sdp-max-n 50]
+Usage: python -m benchmarks.bench_hinf [--sizes 4 10 20 50] [--reps 3] [--seeds 5] [--sdp-max-n 50]
 """
 
 from __future__ import annotations

@@ -124,6 +124,16 @@ def test_fallback_to_the_sdp_when_the_certificate_fails(monkeypatch):
     assert cl_norm(plant, ctrl.K, Bw, Cz, Dzu) <= ctrl.gamma
 
 
+def test_backoff_zero_falls_back_to_the_sdp_optimum():
+    """No strictly positive certificate exists at the optimum itself: the SDP's optimal point is returned."""
+    plant, Bw, Cz, Dzu = random_case(0, 5)
+    ctrl = rc.hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, synthesis="riccati", backoff=0)
+    assert ctrl.info["synthesis"] == "lmi" and ctrl.info["gain_from"] == "optimum"
+    assert ctrl.gamma == ctrl.gamma_opt
+    assert dare_feasible(plant, Bw, Cz, Dzu, ctrl.gamma_opt * (1 + 1e-6))
+    assert cl_norm(plant, ctrl.K, Bw, Cz, Dzu) <= ctrl.gamma * (1 + 1e-6)
+
+
 def test_fallback_when_the_bisection_finds_no_level(monkeypatch):
     plant, Bw, Cz, Dzu = random_case(4, 4)
     def no_level(*args, **kwargs):
