@@ -36,6 +36,13 @@ IEEE TAC 34(8), 1989 (continuous-time Hamiltonian test).
 
 Notes
 -----
+The discrete equation is solved by SLICOT's ``SG02AD`` (through slycot, the
+optional ``robustctl[slycot]`` extra) when it is installed, by
+``scipy.linalg.solve_discrete_are`` otherwise or when SG02AD fails; scipy's
+Python-level QZ reordering made the bisection two to three times slower.
+:func:`bisect_level` is the library's one bisection on this equation: the
+``synthesis="riccati"`` path of :func:`robustctl.hinf` uses it too (the LMI
+path does not, so the tests can still compare the two).
 ``scipy.linalg.solve_discrete_are`` may return a wrong matrix for an
 indefinite ``R`` without raising; every solution is therefore accepted only
 after its relative residual, symmetry, sign and the closed-loop spectrum are
