@@ -1,12 +1,17 @@
-"""Benchmark: LMI H-infinity synthesis (robustctl.hinf) against the game-Riccati bisection.
+"""Benchmark: H-infinity state feedback, both paths of robustctl.hinf, against an independent peer.
 
-Both run in the same process on the same plants. The peer is
-``robustctl.hinf_riccati.hinf_riccati`` with ``rtol=1e-8`` (about the
-accuracy of the LMI optimum at Clarabel's 1e-8 tolerance), i.e. ~35
-Riccati solves with residual checks. For these discrete plants the LMI path
-is one cvxpy/Clarabel solve (minimise gamma) and a Riccati-built certificate
-of the optimum's gain at the backed-off level, including cvxpy's
-compilation; the centring solve runs only when that certificate fails.
+All run in the same process on the same plants. The peer is written here and
+shares no code with robustctl: a geometric bisection (``rtol=1e-8``) on the
+game Riccati equation solved by python-control's ``dare`` (SLICOT SG02AD
+through slycot), feasibility read from its closed-loop eigenvalues, the
+sign of the solution and the disturbance block (about 30 DARE solves).
+``synthesis="riccati"`` is the fast path (validation, balancing, the
+bisection, the saddle-point gain and its LMI certificate checked by
+eigenvalues); ``synthesis="lmi"`` (the default) is one cvxpy/Clarabel solve
+(minimise gamma) and a Riccati-built certificate of the optimum's gain at
+the backed-off level, including cvxpy's compilation. ``norm/gamma`` is
+python-control's ``linfnorm`` of the fast path's closed loop over its
+guaranteed level (< 1).
 
 Plants: random discrete-time (``--seeds`` of them per size), slightly unstable, m = 2 inputs, q = 2
 disturbances, p = 4 performance outputs (2 state combinations and the
@@ -21,7 +26,7 @@ scaled by hand (:func:`units`: the synthesis scales them inside, so both are
 the same problem for the solver). Robust against polytopic H-infinity on the
 truck is in ``bench_analysis.py``.
 
-Usage: python benchmarks/bench_hinf.py [--sizes 4 10 20] [--reps 3] [--seeds 5]
+Usage: python -m benchmarks.bench_hinf [--sizes 4 10 20 50] [--reps 3] [--seeds 5] [--sdp-max-n 50]
 """
 
 from __future__ import annotations
@@ -33,12 +38,55 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import time  # noqa: E402
+import warnings  # noqa: E402
 
+import control  # noqa: E402
 import numpy as np  # noqa: E402
 
 from robustctl import Plant  # noqa: E402
 from robustctl.hinf import hinf  # noqa: E402
-from robustctl.hinf_riccati import hinf_riccati  # noqa: E402
+
+
+# ---------------------------------------------------------------- the independent peer
+def peer_level(F, G, Bw, Cz, Dzu, Dzw, gamma):
+    """One level of the peer: python-control's ``dare`` (SLICOT SG02AD) on the game Riccati equation.
+
+    Feasible iff the stabilising solution exists, is >= 0, its closed loop is stable and the disturbance
+    block ``Bw'PBw + Dzw'Dzw - gamma^2 I`` is negative definite (state feedback). Returns the gain or None.
+    """
+    m, q = G.shape[1], Bw.shape[1]
+    B, D = np.hstack([G, Bw]), np.hstack([Dzu, Dzw])
+    R = D.T @ D - np.diag(np.r_[np.zeros(m), np.full(q, gamma**2)])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            X, L, Kg = control.dare(F, B, Cz.T @ Cz, R, Cz.T @ D)
+    except (ArithmeticError, ValueError, RuntimeError, Warning):  # slycot errors, results-as-warnings: none
+        return None
+    if not np.all(np.isfinite(X)) or np.max(np.abs(L)) >= 1.0:
+        return None
+    if np.linalg.eigvalsh(0.5 * (X + X.T)).min() < -1e-8 * max(1.0, float(np.abs(X).max())):
+        return None
+    if np.linalg.eigvalsh(Bw.T @ X @ Bw + Dzw.T @ Dzw - gamma**2 * np.eye(q)).max() >= 0.0:
+        return None
+    return -Kg[:m]
+
+
+def peer_hinf(plant, Bw, Cz, Dzu, rtol=1e-8):
+    """The peer: geometric bisection on ``gamma`` (start at 1, doubled until feasible) with :func:`peer_level`."""
+    F, G = plant.F, plant.G
+    Dzw = np.zeros((Cz.shape[0], Bw.shape[1]))
+    lo, hi = 0.0, 1.0
+    while (K := peer_level(F, G, Bw, Cz, Dzu, Dzw, hi)) is None:
+        lo, hi = hi, 2.0 * hi
+    while hi - lo > rtol * hi:
+        mid = np.sqrt(lo * hi) if lo > 0 else 0.5 * hi
+        Km = peer_level(F, G, Bw, Cz, Dzu, Dzw, mid)
+        if Km is None:
+            lo = mid
+        else:
+            hi, K = mid, Km
+    return hi, K
 
 
 def case(n: int, seed: int = 0):
@@ -81,37 +129,56 @@ def units(reps: int) -> dict:
     s = 1.0 / np.sqrt(R[0, 0])
     raw, t_raw = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu), reps)
     by_hand, t_hand = best_time(lambda: hinf(plant, Bw=Bw, Cz=s * Cz, Dzu=s * Dzu), reps)
-    ric = hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    ric, _ = peer_hinf(plant, Bw, Cz, Dzu)
     return dict(t_raw=t_raw, t_hand=t_hand, gamma_raw=raw.gamma_opt, gamma_hand=by_hand.gamma_opt / s,
-                gamma_ric=ric.gamma)
+                gamma_ric=ric)
+
+
+def cl_norm(plant, K, Bw, Cz, Dzu) -> float:
+    """||T_zw||_inf of the closed loop by python-control (SLICOT AB13DD)."""
+    sys = control.ss(plant.F + plant.G @ K, Bw, Cz + Dzu @ K, np.zeros((Cz.shape[0], Bw.shape[1])), plant.dt)
+    return float(control.linfnorm(sys, tol=1e-10)[0])
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[4, 10, 20])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[4, 10, 20, 50])
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--seeds", type=int, default=5, help="random plants per size (one for n > 10)")
+    ap.add_argument("--sdp-max-n", type=int, default=50, help="largest n for the SDP path (about 90 s at n = 50)")
     args = ap.parse_args(argv)
 
     warm = case(3)
-    hinf(warm[0], Bw=warm[1], Cz=warm[2], Dzu=warm[3])  # import cvxpy, JIT nothing, fill caches
+    for synthesis in ("lmi", "riccati"):  # import cvxpy, fill caches
+        hinf(warm[0], Bw=warm[1], Cz=warm[2], Dzu=warm[3], synthesis=synthesis)
+    peer_hinf(*warm)
 
-    print(f"{'n':>4} {'seed':>4} {'LMI [s]':>9} {'solver [s]':>10} {'Riccati [s]':>11} {'ratio':>7} "
-          f"{'gamma LMI':>13} {'gamma Ric':>13} {'rel diff':>9}  gain from")
+    print(f"{'n':>4} {'seed':>4} {'peer [s]':>9} {'riccati [s]':>11} {'ratio':>6} {'SDP [s]':>8} {'ratio':>7} "
+          f"{'gamma peer':>13} {'rel fast':>9} {'rel SDP':>9} {'norm/gamma':>10}  fast path")
     summary = []
     for n in args.sizes:
         reps, seeds = (args.reps, args.seeds) if n <= 10 else (1, 1)
-        ratios = []
+        r_fast, r_sdp = [], []
         for seed in range(seeds):
             plant, Bw, Cz, Dzu = case(n, seed)
-            ctrl, t_lmi = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu), reps)
-            ref, t_ric = best_time(lambda: hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, rtol=1e-8), max(reps, 3))
-            ratios.append(t_lmi / t_ric)
-            print(f"{n:4d} {seed:4d} {t_lmi:9.3f} {ctrl.info['solve_time']:10.3f} {t_ric:11.3f} "
-                  f"{t_lmi / t_ric:7.2f} {ctrl.gamma_opt:13.8g} {ref.gamma:13.8g} "
-                  f"{ctrl.gamma_opt / ref.gamma - 1:9.1e}  {ctrl.info['gain_from']}")
-        summary.append(f"n = {n}: ratio median {np.median(ratios):.2f}, max {max(ratios):.2f} "
-                       f"over {seeds} plant{'s' if seeds > 1 else ''}")
+            (g_peer, _), t_peer = best_time(lambda: peer_hinf(plant, Bw, Cz, Dzu), max(reps, 3))
+            fast, t_fast = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, synthesis="riccati"), max(reps, 3))
+            r_fast.append(t_fast / t_peer)
+            if n <= args.sdp_max_n:
+                sdp, t_sdp = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu), reps)
+                r_sdp.append(t_sdp / t_peer)
+                sdp_cols = f"{t_sdp:8.3f} {t_sdp / t_peer:7.1f}"
+                rel_sdp = f"{sdp.gamma_opt / g_peer - 1:9.1e}"
+            else:
+                sdp_cols, rel_sdp = f"{'-':>8} {'-':>7}", f"{'-':>9}"
+            norm = cl_norm(plant, fast.K, Bw, Cz, Dzu)
+            print(f"{n:4d} {seed:4d} {t_peer:9.4f} {t_fast:11.4f} {t_fast / t_peer:6.2f} {sdp_cols} "
+                  f"{g_peer:13.8g} {fast.gamma_opt / g_peer - 1:9.1e} {rel_sdp} {norm / fast.gamma:10.6f}  "
+                  f"{fast.info['synthesis']}")
+        line = f"n = {n}: riccati/peer median {np.median(r_fast):.2f} (max {max(r_fast):.2f})"
+        if r_sdp:
+            line += f", SDP/peer median {np.median(r_sdp):.1f} (max {max(r_sdp):.1f})"
+        summary.append(line + f" over {seeds} plant{'s' if seeds > 1 else ''}")
     print("\n".join(summary))
 
     ctrl, t_truck = truck_case(args.reps)
@@ -120,7 +187,7 @@ def main(argv=None) -> None:
     un = units(args.reps)
     print(f"truck, authors' weights (R = 33535, Bw = ones), unscaled vs z / sqrt(r) by hand: time {un['t_raw']:.3f} s "
           f"vs {un['t_hand']:.3f} s (ratio {un['t_raw'] / un['t_hand']:.2f}); gamma_opt {un['gamma_raw']:.10g} vs "
-          f"{un['gamma_hand']:.10g}, Riccati bisection (unscaled) {un['gamma_ric']:.10g}")
+          f"{un['gamma_hand']:.10g}, peer bisection (unscaled) {un['gamma_ric']:.10g}")
 
 
 if __name__ == "__main__":

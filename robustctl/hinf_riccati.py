@@ -36,6 +36,13 @@ IEEE TAC 34(8), 1989 (continuous-time Hamiltonian test).
 
 Notes
 -----
+The discrete equation is solved by SLICOT's ``SG02AD`` (through slycot, the
+optional ``robustctl[slycot]`` extra) when it is installed, by
+``scipy.linalg.solve_discrete_are`` otherwise or when SG02AD fails; scipy's
+Python-level QZ reordering made the bisection two to three times slower.
+:func:`bisect_level` is the library's one bisection on this equation: the
+``synthesis="riccati"`` path of :func:`robustctl.hinf` uses it too (the LMI
+path does not, so the tests can still compare the two).
 ``scipy.linalg.solve_discrete_are`` may return a wrong matrix for an
 indefinite ``R`` without raising; every solution is therefore accepted only
 after its relative residual, symmetry, sign and the closed-loop spectrum are
@@ -57,6 +64,7 @@ optimum; with unit-sized channels the residuals are ~1e-14.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,7 +76,12 @@ from .errors import InfeasibleError
 from .plant import Plant, check_plant
 from .stability import is_stable
 
-__all__ = ["RiccatiHinf", "hinf_riccati", "riccati_level"]
+__all__ = ["RiccatiHinf", "hinf_riccati", "riccati_level", "bisect_level", "level_gain"]
+
+try:  # SLICOT's generalised DARE solver (the optional robustctl[slycot] extra): no Python-level QZ reordering
+    from slycot import sg02ad as _SG02AD
+except ImportError:  # pragma: no cover - scipy is used instead
+    _SG02AD = None
 
 # Relative residual accepted from scipy's DARE. A genuine stabilising solution
 # has ~1e-14; just below the optimal level scipy still returns a matrix with
@@ -127,15 +140,35 @@ def _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma):
     return B, Cz.T @ Cz, R, Cz.T @ D
 
 
-def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
-    _n, m = G.shape
-    B, Q, R, S = _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma)
+def _dare(F, B, Q, R, S) -> np.ndarray | None:
+    """Stabilising solution of the DARE with indefinite ``R``: SLICOT ``SG02AD`` if slycot is installed, else scipy.
+
+    ``None`` if the solver fails or returns non-finite values. Either answer is
+    checked by the caller (residual, sign, closed loop), not trusted.
+    """
+    n, k = B.shape
+    if _SG02AD is not None:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                out = _SG02AD("D", "B", "N", "U", "N", "N", "S", "R", n, k, 0, F, np.eye(n), B, Q, R, S)
+            P = np.asarray(out[1], dtype=float)
+            return P if np.all(np.isfinite(P)) else None
+        except (ArithmeticError, ValueError, RuntimeError, np.linalg.LinAlgError):
+            pass  # slycot's errors and warnings-as-errors: try scipy
     try:
         with np.errstate(all="ignore"):
             P = scipy.linalg.solve_discrete_are(F, B, Q, R, s=S)
     except (np.linalg.LinAlgError, ValueError):
         return None
-    if not np.all(np.isfinite(P)):
+    return P if np.all(np.isfinite(P)) else None
+
+
+def _level_discrete(F, G, Bw, Cz, Dzu, Dzw, gamma):
+    _n, m = G.shape
+    B, Q, R, S = _game_matrices(G, Bw, Cz, Dzu, Dzw, gamma)
+    P = _dare(F, B, Q, R, S)
+    if P is None:
         return None
     P = 0.5 * (P + P.T)
     H = R + B.T @ P @ B
@@ -192,6 +225,11 @@ def _level_continuous(F, G, Bw, Cz, Dzu, Dzw, gamma):
     return L[:m], P
 
 
+def level_gain(data: _Data, gamma: float, *, discrete: bool) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`riccati_level` on validated arrays ``(F, G, Bw, Cz, Dzu, Dzw)`` (no rescaling)."""
+    return (_level_discrete if discrete else _level_continuous)(*data, gamma)
+
+
 def riccati_level(plant: Plant, gamma: float, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike,
                   Dzw: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """Test one level: ``(K, P)`` if a gain with ``||T_zw||_inf < gamma`` exists, else ``None``.
@@ -243,8 +281,26 @@ def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, 
     data, b, c = _data(plant, Bw, Cz, Dzu, Dzw)
     rtol = check_positive_scalar(rtol, "rtol")
     gamma_max = check_positive_scalar(gamma_max, "gamma_max")
-    level = _level_discrete if plant.is_discrete else _level_continuous
-    lo = float(np.linalg.norm(data[-1], 2))      # the scaled data from here on
+    try:
+        hi, lo, K, P, its = bisect_level(data, discrete=plant.is_discrete, rtol=rtol, gamma_max=gamma_max)
+    except InfeasibleError as exc:
+        raise InfeasibleError(f"no stabilising game-Riccati solution for gamma up to {gamma_max * b * c:g} "
+                              f"(gamma_max = {gamma_max:g} times the size of the channels; is (F, G) "
+                              "stabilisable?)") from exc
+    return RiccatiHinf(gamma=float(hi * b * c), gamma_low=float(lo * b * c), K=K, P=c**2 * P, iterations=its)
+
+
+def bisect_level(data: _Data, *, discrete: bool, rtol: float, gamma_max: float
+                 ) -> tuple[float, float, np.ndarray, np.ndarray, int]:
+    """The bisection of :func:`hinf_riccati` on validated arrays ``(F, G, Bw, Cz, Dzu, Dzw)``.
+
+    The channels should be of unit size (the bracket starts at
+    ``[||Dzw||, max(1, 2 ||Dzw||)]``). Returns ``(gamma_high, gamma_low, K,
+    P, iterations)``: ``K`` and ``P`` of the level ``gamma_high``, the smallest
+    found feasible. Raises InfeasibleError if no level up to ``gamma_max`` is.
+    """
+    level = _level_discrete if discrete else _level_continuous
+    lo = float(np.linalg.norm(data[-1], 2))
     hi = max(1.0, 2.0 * lo)
     its = 0
     while True:
@@ -254,9 +310,7 @@ def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, 
             break
         lo, hi = hi, 2.0 * hi
         if hi > gamma_max:
-            raise InfeasibleError(f"no stabilising game-Riccati solution for gamma up to {gamma_max * b * c:g} "
-                                  f"(gamma_max = {gamma_max:g} times the size of the channels; is (F, G) "
-                                  "stabilisable?)")
+            raise InfeasibleError(f"no stabilising game-Riccati solution for gamma up to {gamma_max:g}")
     best = sol
     while hi - lo > rtol * hi:
         mid = np.sqrt(lo * hi) if lo > 0 else 0.5 * hi
@@ -266,5 +320,4 @@ def hinf_riccati(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, 
             lo = mid
         else:
             hi, best = mid, sol
-    return RiccatiHinf(gamma=float(hi * b * c), gamma_low=float(lo * b * c), K=best[0], P=c**2 * best[1],
-                       iterations=its)
+    return float(hi), float(lo), best[0], best[1], its

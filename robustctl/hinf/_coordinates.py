@@ -114,7 +114,14 @@ def channel_scales(Bw: np.ndarray, Cz: np.ndarray, Dzu: np.ndarray, Dzw: np.ndar
     else:
         w_scale = float(np.sqrt(w_energy))
     size = float(np.linalg.norm(np.hstack([Cz, Dzu, Dzw * w_scale]), 2))
-    return w_scale, size if size > 0 else 1.0
+    z_unit = size if size > 0 else 1.0
+    w_name, w_what = ("Bw", "1 / ||Bw||_2") if w_energy is None else ("w_energy", "sqrt(w_energy)")
+    for name, value, what in ((w_name, w_scale, w_what), ("Cz, Dzu, Dzw", z_unit, "||[Cz Dzu Dzw]||_2")):
+        if not tol.CHANNEL_RANGE[0] <= value <= tol.CHANNEL_RANGE[1]:
+            raise ValueError(f"{name} is scaled out of range: {what} = {value:.3g}; the level and the Lyapunov "
+                             f"matrix scale with its square, which float64 cannot hold (allowed "
+                             f"{tol.CHANNEL_RANGE[0]:g} to {tol.CHANNEL_RANGE[1]:g}); rescale the channel")
+    return w_scale, z_unit
 
 
 def normalised(F: Sequence[np.ndarray], G: Sequence[np.ndarray], Bw: np.ndarray, Cz: np.ndarray,

@@ -42,6 +42,7 @@ from ._lmis import Point, blocks, is_strict, variables
 from ._problem import Problem
 
 __all__ = ["Gain", "Attempt", "gain_near_optimum", "gain_at_level", "at_optimum", "optimum_certified",
+           "riccati_certified",
            "centred", "conditioned", "conditioned_recentred", "STRATEGIES"]
 
 
@@ -92,32 +93,43 @@ def optimum_certified(problem: Problem, opt: Optimum, backoff: float) -> Attempt
     """The optimum's gain ``K`` with a Riccati-built strictly feasible ``(X, K X)`` at the backed-off level.
 
     Discrete time, one vertex, standard LMI, no uncertainty (otherwise not
-    applicable). With
-    ``(A, B, C, D) = (F + G K, Bw, b (Cz + Dzu K), b Dzw)`` at the output
-    scaling ``b`` of level 1, the Schur complement of the H-infinity block
-    with respect to its last two block rows is ``X - A X A' - B B' -
-    (A X C' + B D') (I - C X C' - D D')^-1 (.)'``; the stabilising solution
-    of the Riccati equation setting it to ``eps I`` (``scipy.linalg.
-    solve_discrete_are`` with the indefinite weight ``D D' - I``) makes
-    every block strictly positive when ``||T_zw(K)||_inf`` is below the
-    level. ``eps`` is tried at ``CERTIFY_EPS`` times ``backoff``. The point
-    is accepted only if the smallest eigenvalue of *every* LMI block (input
-    bounds included) evaluated at it exceeds ``STRICT``: the certificate
-    does not rely on the Riccati solver. The margin is the smallest
-    eigenvalue of the H-infinity block.
+    applicable); :func:`riccati_certified` builds and checks the point.
     """
     if not problem.discrete or problem.extended or problem.polytopic or problem.uncertainty is not None:
         return Attempt()
-    data = opt.data
-    z_scale = 1.0 / (data.level_scale * opt.gamma_opt * (1.0 + backoff))
-    K = opt.point.gain()
+    gain = riccati_certified(problem, opt.data, opt.point.gain(), opt.gamma_opt * (1.0 + backoff), backoff,
+                             "optimum-certified")
+    return Attempt(gain)
+
+
+def riccati_certified(problem: Problem, data: Coordinates, K: np.ndarray, gamma: float, backoff: float,
+                      route: str) -> Gain | None:
+    """A strictly feasible ``(X, K X)`` of the LMI blocks at the level ``gamma`` for a given gain, or ``None``.
+
+    One plant, standard LMI, no uncertainty. With
+    ``(A, B, C, D) = (F + G K, Bw, b (Cz + Dzu K), b Dzw)`` at the output
+    scaling ``b`` of level 1, the Schur complement of the H-infinity block
+    with respect to its last block row is, in discrete time, ``X - A X A' -
+    B B' - (A X C' + B D') (I - C X C' - D D')^-1 (.)'`` and in continuous
+    time ``-(A X + X A') - B B' - (X C' + B D') (I - D D')^-1 (.)'``; the
+    stabilising solution of the Riccati equation setting it to ``eps I``
+    (scipy's ``solve_discrete_are`` / ``solve_continuous_are`` with the
+    indefinite weight ``D D' - I``) makes every block strictly positive
+    when ``||T_zw(K)||_inf`` is below the level. ``eps`` is tried at
+    ``CERTIFY_EPS`` times ``backoff``. The point is accepted only if the
+    smallest eigenvalue of *every* LMI block (input bounds included)
+    evaluated at it exceeds ``STRICT``: the certificate does not rely on the
+    Riccati solver. The margin is the smallest eigenvalue of the
+    H-infinity block.
+    """
+    z_scale = 1.0 / (data.level_scale * gamma)
     A = data.F[0] + data.G[0] @ K
     B, C, D = data.Bw, z_scale * (data.Cz + data.Dzu @ K), z_scale * data.Dzw
+    are = scipy.linalg.solve_discrete_are if problem.discrete else scipy.linalg.solve_continuous_are
     for eps in tol.CERTIFY_EPS:
         try:
             with np.errstate(all="ignore"):
-                X = scipy.linalg.solve_discrete_are(A.T, C.T, B @ B.T + eps * backoff * np.eye(data.n),
-                                                    D @ D.T - np.eye(data.p), s=B @ D.T)
+                X = are(A.T, C.T, B @ B.T + eps * backoff * np.eye(data.n), D @ D.T - np.eye(data.p), s=B @ D.T)
         except (ValueError, np.linalg.LinAlgError):
             continue
         if not np.all(np.isfinite(X)):
@@ -126,8 +138,8 @@ def optimum_certified(problem: Problem, opt: Optimum, backoff: float) -> Attempt
         point = Point(X=X, Y=K @ X)
         cert = _cvx.certificate(blocks(problem, data, point, 1.0, z_scale=z_scale))
         if min(cert.values()) > tol.STRICT:
-            return Attempt(Gain(point, data, cert, cert["hinf[0]"], "optimum-certified"))
-    return Attempt()
+            return Gain(point, data, cert, cert["hinf[0]"], route)
+    return None
 
 
 def centred(problem: Problem, opt: Optimum, backoff: float) -> Attempt:

@@ -81,6 +81,18 @@ def variables(n: int, m: int, vertices: int, extended: bool, uncertain: bool = F
     return Point(X=cp.Variable((n, n), symmetric=True, name="X"), Y=cp.Variable((m, n), name="Y"), eps=eps)
 
 
+def _bmat(rows):
+    """``np.block`` when every entry is a number or an array (a candidate point), else ``cvxpy.bmat``.
+
+    Evaluating a certificate at arrays then needs no cvxpy (nor its import).
+    """
+    if all(isinstance(x, (np.ndarray, float, int, np.floating)) for row in rows for x in row):
+        return np.block(rows)
+    import cvxpy as cp
+
+    return cp.bmat(rows)
+
+
 def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin=0.0,
                 z_scale: float = 1.0) -> list[_cvx.LMI]:
     """The bounded-real-lemma block of every vertex, ``hinf[i]``, at the scaled level ``level_sq``.
@@ -91,8 +103,6 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
     linear). With an uncertainty in ``data`` (and multipliers in ``V``) the
     block is the robust one of :mod:`robustctl.hinf` (S-procedure).
     """
-    import cvxpy as cp
-
     Ip = np.eye(data.p)
     Cz, Dzu, Dzw = z_scale * data.Cz, z_scale * data.Dzu, z_scale * data.Dzw
     Bw = data.Bw
@@ -102,21 +112,21 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
         if V.extended:
             P, S, L = V.P[i], V.S, V.L
             AS, CS = F @ S + G @ L, Cz @ S + Dzu @ L
-            M = cp.bmat([[P - BB, AS, -BD],
-                         [AS.T, S + S.T - P, CS.T],
-                         [-BD.T, CS, level_sq * Ip - DD]])
+            M = _bmat([[P - BB, AS, -BD],
+                       [AS.T, S + S.T - P, CS.T],
+                       [-BD.T, CS, level_sq * Ip - DD]])
         else:
             X, Y = V.X, V.Y
             AX, CX = F @ X + G @ Y, Cz @ X + Dzu @ Y
             if V.eps:
                 M = _robust_block(data, V.eps[i], X, Y, AX, CX, level_sq * Ip - DD, BB, BD, discrete)
             elif discrete:
-                M = cp.bmat([[X - BB, AX, -BD],
-                             [AX.T, X, CX.T],
-                             [-BD.T, CX, level_sq * Ip - DD]])
+                M = _bmat([[X - BB, AX, -BD],
+                           [AX.T, X, CX.T],
+                           [-BD.T, CX, level_sq * Ip - DD]])
             else:  # -(continuous bounded-real lemma) >= 0
-                M = cp.bmat([[-(AX + AX.T) - BB, -CX.T - BD],
-                             [-CX - BD.T, level_sq * Ip - DD]])
+                M = _bmat([[-(AX + AX.T) - BB, -CX.T - BD],
+                           [-CX - BD.T, level_sq * Ip - DD]])
         out.append(_cvx.LMI(f"hinf[{i}]", M, margin))
     return out
 
@@ -213,3 +223,4 @@ def blocks(problem, data: Coordinates, V: Point, level_sq, *, margin=0.0, z_scal
 def is_strict(certificate) -> bool:
     """Every H-infinity and pole-region block and the Lyapunov (slack) matrix strictly positive definite."""
     return all(v > 0 for k, v in certificate.items() if k.startswith(("hinf", "X", "S", "poles")) and k != "X_upper")
+

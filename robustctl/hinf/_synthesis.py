@@ -17,14 +17,15 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _cvx
+from .._validation import check_choice
 from ..controller import Controller
-from ..errors import ConvergenceError
+from ..errors import ConvergenceError, InfeasibleError
 from ..plant import Plant
 from ..regions import Region
 from ..stability import is_stable
@@ -34,6 +35,7 @@ from ._coordinates import channel_scales, lqr_coordinates, normalised
 from ._gains import Gain, gain_at_level, gain_near_optimum
 from ._level import minimise_level
 from ._problem import Problem, validate, vertex_name
+from ._riccati_path import RiccatiPath, check_plain, riccati_synthesis
 
 __all__ = ["hinf", "HinfController", "check_closed_loop", "guaranteed_input_bound"]
 
@@ -49,7 +51,9 @@ class HinfController(Controller):
         the plant (and every plant of the hull of ``vertices``). Equals
         ``(1 + backoff) * gamma_opt``, or the requested ``gamma``.
     gamma_opt : float or None
-        The optimal level of the LMI problem (``None`` when ``gamma`` was fixed).
+        The optimal level of the LMI problem (``None`` when ``gamma`` was fixed);
+        with ``synthesis="riccati"`` the upper end of the bisection's final
+        bracket (relative width 1e-9), the same infimum.
     """
 
     gamma: float = float("nan")
@@ -65,7 +69,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
          vertices: Sequence[Plant] | None = None, gamma: float | None = None, u_max: ArrayLike | None = None,
          w_energy: float | None = None, backoff: float = 1e-3, extended: bool = False,
          poles: Region | Sequence[Region] | None = None, uncertainty: NormBounded | None = None,
-         solver: str = "CLARABEL") -> HinfController:
+         solver: str = "CLARABEL", synthesis: str = "lmi") -> HinfController:
     r"""H-infinity state feedback ``u = K x`` by LMI optimisation.
 
     Finds ``K`` minimising ``gamma`` such that ``||T_zw||_inf < gamma`` for
@@ -135,6 +139,18 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         cvxpy SDP solver. Clarabel is run with explicit tolerances (1e-8 for
         the level of one plant, 1e-10 with vertices, 1e-7 for centring);
         other solvers use their defaults and may not reach 1e-5 accuracy.
+    synthesis : {"lmi", "riccati"}, default "lmi"
+        ``"lmi"``: the SDP (every variant). ``"riccati"``: the plain problem
+        only (one plant, free level, no ``u_max``, ``poles`` or
+        ``uncertainty``, standard LMI; anything else is a ValueError): the
+        optimal level by bisection on the game Riccati equation, the gain of
+        its saddle point at ``(1 + backoff / 2) gamma_opt``, and the same LMI
+        certificate at ``(1 + backoff) gamma_opt`` checked by eigenvalues
+        (:mod:`robustctl.hinf._riccati_path`); if that certificate is not
+        strictly positive the SDP is solved instead. ``info["synthesis"]``
+        says which path returned the gain (``info["fallback"]`` why the SDP
+        was needed). With ``"riccati"`` cvxpy is imported, and ``solver``
+        checked to be installed, only if the SDP runs.
 
     Returns
     -------
@@ -155,7 +171,11 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         one, ``multipliers`` (the S-procedure multipliers). Each entry of
         ``solves`` has the solver's ``status``, ``value``, ``tol``,
         ``solve_time``, ``iterations`` and ``certificate``; centring solves
-        also name their ``centring`` variant.
+        also name their ``centring`` variant. ``synthesis`` (``"lmi"`` or
+        ``"riccati"``: the path that returned the gain) and, with
+        ``synthesis="riccati"``, ``riccati`` (bisection ``iterations`` and
+        the bracket ``gamma_low``) and ``fallback`` (why the SDP was solved,
+        or ``None``).
 
     Raises
     ------
@@ -187,25 +207,51 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     >>> bool(abs(ctrl.gamma_opt / hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu).gamma - 1) < 1e-6)
     True
     """
+    synthesis = check_choice(synthesis, "synthesis", ("lmi", "riccati"))
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
                        w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
-                       uncertainty=uncertainty)
+                       uncertainty=uncertainty, defer_solver=synthesis == "riccati")
+    if synthesis == "riccati":
+        check_plain(problem)
     w_scale, z_unit = channel_scales(problem.Bw, problem.Cz, problem.Dzu, problem.Dzw, problem.w_energy)
     balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
                           problem.Dzu, problem.Dzw, w_scale, problem.uncertainty, z_unit=z_unit)
-    lqr = None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
-    if problem.gamma is not None:
-        gain, solves = gain_at_level(problem, lqr or balanced, problem.gamma)
+    fast = _riccati(problem, balanced) if synthesis == "riccati" else None
+    if fast is not None and fast.gain is None:  # the SDP is needed after all: check the solver now
+        problem = replace(problem, solver=_cvx.check_solver(problem.solver))
+    solves: tuple[dict, ...]
+    if fast is not None and fast.gain is not None:
+        gain, gamma_opt, used_backoff, solves = fast.gain, fast.gamma_opt, problem.backoff, ()
+        level = gamma_opt * (1.0 + used_backoff)
+    elif problem.gamma is not None:
+        gain, solves = gain_at_level(problem, _lqr(problem, balanced) or balanced, problem.gamma)
         level, gamma_opt, used_backoff = problem.gamma, None, None
     else:
-        opt = minimise_level(problem, balanced, lqr)
+        opt = minimise_level(problem, balanced, _lqr(problem, balanced))
         gain, used_backoff, centring = gain_near_optimum(problem, opt)
         level, gamma_opt, solves = opt.gamma_opt * (1.0 + used_backoff), opt.gamma_opt, opt.solves + centring
     K, X = gain.data.to_original(gain.point.gain(), gain.point.nominal_lyapunov())
-    X = X * (problem.w_energy or 1.0) / w_scale**2  # the reachable set of disturbances of energy w_energy (1)
+    X = X * (problem.w_energy or 1.0) / w_scale / w_scale  # the reachable set of disturbances of energy w_energy
     check_closed_loop(K, problem.plants, problem.regions)
     info = _info(problem, gain, K, X, level, gamma_opt, used_backoff, solves)
+    info["synthesis"] = "riccati" if fast is not None and fast.gain is not None else "lmi"
+    if fast is not None:
+        info["riccati"] = {"iterations": fast.iterations, "gamma_low": fast.gamma_low}
+        info["fallback"] = None if fast.gain is not None else fast.reason
     return HinfController(K=K, method="hinf", plant=plant, info=info, gamma=float(level), gamma_opt=gamma_opt)
+
+
+def _lqr(problem: Problem, balanced):
+    """The LQR coordinates of a single plant (``None`` for a polytope or if they fail)."""
+    return None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
+
+
+def _riccati(problem: Problem, balanced) -> RiccatiPath:
+    """The fast path; a bisection that finds no level becomes a fallback reason (the SDP then decides)."""
+    try:
+        return riccati_synthesis(problem, balanced)
+    except InfeasibleError as exc:
+        return RiccatiPath(None, float("nan"), float("nan"), 0, str(exc))
 
 
 def check_closed_loop(K: np.ndarray, plants, regions: Sequence[Region] = ()) -> None:
@@ -240,7 +286,8 @@ def _info(problem: Problem, gain: Gain, K, X, level, gamma_opt, backoff, solves)
     info = {
         "gamma": level, "gamma_opt": gamma_opt, "backoff": backoff,
         "lmi": ("extended" if problem.extended else "standard") + ("-discrete" if problem.discrete else "-continuous"),
-        "vertices": len(problem.plants), "status": solves[-1]["status"], **_cvx.totals(solves),
+        "vertices": len(problem.plants), "status": solves[-1]["status"] if solves else "certified",
+        **_cvx.totals(solves),
         "certificate": gain.certificate, "gain_from": gain.route, "X_min_eig": float(np.linalg.eigvalsh(Xs).min()),
         "margin": float(gain.margin), "solves": list(solves), "X": Xs, "scaling": gain.data.balancing,
         "solver": problem.solver, "poles": problem.regions, "uncertainty": problem.uncertainty,

@@ -12,6 +12,10 @@ from __future__ import annotations
 # robustctl.stability (UNSTABLE_TOL, PBH_TOL, STABILITY_MARGIN).
 
 # ---------------------------------------------------------------- coordinates
+#: Range of the channel scales ``1 / ||Bw||`` (``sqrt(w_energy)``) and
+#: ``||[Cz Dzu Dzw]||``: the level and the Lyapunov matrix scale with their
+#: squares, which must stay finite and nonzero in float64 (about 1e+-308).
+CHANNEL_RANGE = (1e-150, 1e150)
 #: Singular values of ``[Cz Dzu Dzw]`` below ``Z_RANK * sigma_max`` are
 #: dropped when ``z`` is replaced by a factor with the same Gram matrix.
 Z_RANK = 1e-13
