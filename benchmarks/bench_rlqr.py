@@ -14,9 +14,9 @@ calls on the same plant. Three batches:
 * ``92``: one population (92 designs) and one design per call, for the fixed
   cost of a call.
 
-Then the plain recursion alone (``robustctl.rlqr._steady.recursion``, the
+Then the plain recursion alone (``robustctl._rlqr._steady.recursion``, the
 fallback of designs the doubling leaves unsettled), the compiled kernel
-(``robustctl.rlqr._kernel``, what ``rlqr_gains`` runs) against the numpy
+(``robustctl._rlqr._kernel``, what ``rlqr_gains`` runs) against the numpy
 reference in the same process, best of ``--repeat`` interleaved:
 
 * the generic MOP's fallback designs (``z`` uniform in its search space,
@@ -31,19 +31,17 @@ reference in the same process, best of ``--repeat`` interleaved:
 from __future__ import annotations
 
 import argparse
-import importlib
 import time
 
 import control
 import numpy as np
 
 import robustctl as rc
+from robustctl._rlqr import _kernel as kernel
+from robustctl._rlqr import _steady as steady
+from robustctl._rlqr._model import build
+from robustctl._rlqr._step import kkt_step
 from robustctl.models.truck import lqr_weights, truck_plant
-from robustctl.rlqr._model import build
-from robustctl.rlqr._step import kkt_step
-
-steady = importlib.import_module("robustctl.rlqr._steady")   # robustctl.rlqr is also a function's name
-kernel = importlib.import_module("robustctl.rlqr._kernel")
 
 
 def best_of(fn, repeat: int) -> float:

@@ -16,6 +16,7 @@ Sign convention everywhere: ``u = K x``.
 """
 
 from ._margins_report import MarginsReport, margins_report
+from ._rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule, rlqr_step, rlqr_step_block
 from .analysis import (
     CostBound,
     HinfBound,
@@ -44,13 +45,12 @@ from .lqr import lqr
 from .performance import lq_output
 from .plant import Plant
 from .regions import ConicSector, Disk, HalfPlane
-from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
 from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
 
 __all__ = [
     "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
-    "rlqr_schedule", "RLQRSchedule", "hinf", "HinfController",
+    "rlqr_schedule", "RLQRSchedule", "rlqr_step", "rlqr_step_block", "hinf", "HinfController",
     "h2", "H2Controller", "Disk", "HalfPlane", "ConicSector",
     "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",

@@ -12,7 +12,7 @@ __all__ = ["design", "METHODS"]
 # name -> "module:function"; imported lazily (cvxpy takes a second to import).
 METHODS = {
     "lqr": "robustctl.lqr:lqr",
-    "rlqr": "robustctl.rlqr:rlqr",
+    "rlqr": "robustctl._rlqr:rlqr",
     "hinf": "robustctl.hinf:hinf",
     "h2": "robustctl.h2:h2",
 }

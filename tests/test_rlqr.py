@@ -7,7 +7,7 @@ import scipy.linalg
 from conftest import GENERIC_F, GENERIC_G, GENERIC_Z_STAR, random_plant
 
 import robustctl as rc
-from robustctl.rlqr import rlqr_step, rlqr_step_block
+from robustctl import rlqr_step, rlqr_step_block
 
 
 def _random_case(rng, n=None, m=None, l=None, p=None):

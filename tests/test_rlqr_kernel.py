@@ -1,4 +1,4 @@
-"""The compiled RLQR step and plain recursion (robustctl/rlqr/_kernel.py) against the numpy reference.
+"""The compiled RLQR step and plain recursion (robustctl/_rlqr/_kernel.py) against the numpy reference.
 
 What is guaranteed, and tested here:
 
@@ -29,7 +29,6 @@ with Zen kernels on more verdicts than the kernel does.
 
 from __future__ import annotations
 
-import importlib
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 
@@ -38,12 +37,11 @@ import pytest
 from conftest import GENERIC_F, GENERIC_G
 
 import robustctl as rc
+from robustctl._rlqr import _kernel as kernel
+from robustctl._rlqr import _steady as steady
+from robustctl._rlqr._model import build
+from robustctl._rlqr._step import kkt_step
 from robustctl.models.truck import lqr_weights, truck_plant
-from robustctl.rlqr._model import build
-from robustctl.rlqr._step import kkt_step
-
-steady = importlib.import_module("robustctl.rlqr._steady")   # robustctl.rlqr is also a function's name
-kernel = importlib.import_module("robustctl.rlqr._kernel")
 
 TOL = 1e-10
 
@@ -405,7 +403,7 @@ def test_generic_mop_objectives_match_the_numpy_path(monkeypatch):
 # -- compilation --------------------------------------------------------------------------------------
 def _recursion_in_worker():
     """Run rlqr_gains and the compiled recursion in this (spawned) process; report where the kernels came from."""
-    k = importlib.import_module("robustctl.rlqr._kernel")
+    from robustctl._rlqr import _kernel as k
     z = np.array([[50.0, 20.0, 80.0, 1.0, 150.0], [10.0, 10.0, 10.0, 10.0, 4.0]])
     out = rc.rlqr_gains(rc.Plant(GENERIC_F, GENERIC_G, 1.0), z[:, None, :3], z[:, None, 3:4],
                         [np.inf, 10 ** np.sqrt(z[1, 4])], max_iter=50)

@@ -12,9 +12,9 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import robustctl as rc
+from robustctl import rlqr_step, rlqr_step_block
 from robustctl.hinf_riccati import hinf_riccati
 from robustctl.lqr import dare
-from robustctl.rlqr import rlqr_step, rlqr_step_block
 from robustctl.stability import unstabilizable_modes
 
 dims = st.integers(1, 4)

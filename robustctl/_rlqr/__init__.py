@@ -61,7 +61,7 @@ first refined by Newton's method (``fallback="newton"``): ``f``'s derivative
 at ``P`` is ``X -> L' X L``, so each Newton (Kleinman-Hewer) step is one
 Stein equation ``X = L' X L + f(P) - P``, solved by Smith's doubling.
 The doubling steps, the plain recursion and the evaluation of their results
-run in a compiled numba kernel (:mod:`robustctl.rlqr._kernel`: the same
+run in a compiled numba kernel (:mod:`robustctl._rlqr._kernel`: the same
 steps, operation for operation, and the same stopping rules; numpy's
 per-call overhead, about 80 us a step on the MOPs' small systems, made the
 recursion the cost of the fallback and the doubling a fifth of a MOP

@@ -1,8 +1,8 @@
 """Compiled (numba) kernels of the RLQR step, the plain recursion and the doubling steps.
 
 :func:`kkt_step`, :func:`recursion` and :func:`doubling` compute, design by
-design in one compiled loop, what ``robustctl.rlqr._step.kkt_step``,
-``robustctl.rlqr._steady.recursion`` and ``robustctl.rlqr._steady.doubling_loop``
+design in one compiled loop, what ``robustctl._rlqr._step.kkt_step``,
+``robustctl._rlqr._steady.recursion`` and ``robustctl._rlqr._steady.doubling_loop``
 compute with stacked numpy calls (those stay the references the tests
 compare with). On the small systems of the MOPs (``n = 3`` or 4, ``m = l = 1``
 or 2) numpy's cost is its per-call overhead, about 75 us per step whatever
@@ -21,10 +21,10 @@ Same arithmetic, same rules:
 * the solves are LU with partial pivoting (as LAPACK's ``getrf``: the first
   largest pivot, multipliers scaled by the pivot's reciprocal); an exactly
   zero pivot is a singular system and gives NaN for that solve's result of
-  that design only, as ``robustctl.rlqr._step.solve`` does;
+  that design only, as ``robustctl._rlqr._step.solve`` does;
 * the recursion stops a design when one step changes ``P`` by less than
   ``tol`` (relative Frobenius norm) or ``P`` is not healthy (an entry not
-  below ``robustctl.rlqr._steady.DIVERGED`` in magnitude, or NaN), after
+  below ``robustctl._rlqr._steady.DIVERGED`` in magnitude, or NaN), after
   at most ``max_iter`` steps; the doubling likewise with its own ``tol``
   (on ``H``) and ``max_steps``.
 
@@ -250,7 +250,7 @@ def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, ti
 
 @_jit
 def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
-    """The doubling loop of ``robustctl.rlqr._steady.doubling`` for every ``active`` design.
+    """The doubling loop of ``robustctl._rlqr._steady.doubling`` for every ``active`` design.
 
     ``A``, ``Gs``, ``H`` (B, n, n) are overwritten with each design's last iterate; per step
     ``W = I + Gs H``, ``[WA, WG] = W^-1 [A, Gs]``, ``H <- sym(H + (A'H) WA)``, ``A <- A WA``,
@@ -300,7 +300,7 @@ def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
 
 def doubling(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, max_steps: int, diverged: float,
              active: np.ndarray):
-    """The doubling loop of ``robustctl.rlqr._steady.doubling``, compiled, from ``(A, Gs, H)`` (B, n, n).
+    """The doubling loop of ``robustctl._rlqr._steady.doubling``, compiled, from ``(A, Gs, H)`` (B, n, n).
 
     ``active``: the designs to iterate (the others are returned as given, 0 steps).
     Returns ``(H, steps, settled)`` as the numpy loop does.
@@ -329,7 +329,7 @@ def _run(d: Model, P: np.ndarray, tol: float, max_iter: int, diverged: float):
 
 
 def kkt_step(P: np.ndarray, d: Model) -> Step:
-    """The numpy ``robustctl.rlqr._step.kkt_step``, compiled: one step for every design of ``d``."""
+    """The numpy ``robustctl._rlqr._step.kkt_step``, compiled: one step for every design of ``d``."""
     P, K, L, _, _ = _run(d, P, 0.0, 1, np.inf)
     return Step(P, K, L)
 

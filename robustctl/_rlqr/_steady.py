@@ -132,8 +132,8 @@ def _compiled(step: StepFunction) -> StepFunction:
 def plain(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter: int):
     """:func:`recursion` and the :func:`evaluate` of its result: ``(iterations, settled, Evaluation)``.
 
-    With :func:`~robustctl.rlqr._step.kkt_step` both run in the compiled kernel
-    (:mod:`robustctl.rlqr._kernel`, the same step and stopping rule; the numpy
+    With :func:`~robustctl._rlqr._step.kkt_step` both run in the compiled kernel
+    (:mod:`robustctl._rlqr._kernel`, the same step and stopping rule; the numpy
     :func:`recursion` is the reference its tests compare with).
     """
     if step is kkt_step:
@@ -184,7 +184,7 @@ def standard_form(d: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def doubling_loop(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, active: np.ndarray):
     """The doubling steps of :func:`doubling` from :func:`standard_form`, with stacked numpy calls.
 
-    The reference of the compiled loop (``robustctl.rlqr._kernel.doubling``, same
+    The reference of the compiled loop (``robustctl._rlqr._kernel.doubling``, same
     operations in the same order). Returns ``(H, steps, settled)``.
     """
     A, Gs, H, active = A.copy(), Gs.copy(), H.copy(), active.copy()
