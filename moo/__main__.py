@@ -1,4 +1,4 @@
-"""Command line: ``python -m moo run | experiment | stats | plot``.
+"""Command line: ``python -m moo run | experiment | stats | plot | select``.
 
 ::
 
@@ -12,6 +12,8 @@
     python -m moo stats DIR [--out FILE.csv|.md|.tex] [--ranks-out FILE.csv|.md|.tex]
                       [--runs-out FILE.csv] [--alpha A]
     python -m moo plot DIR --out FIGDIR [--format png,pdf]
+    python -m moo select SOURCE --problem P [--n-obj M] [--setup S] [--algorithm NAME [--molsp]]
+                      [--n-sims N] --seed S [--out FILE.json]
 
 ``--problem`` and ``--algorithm``/``--algorithms`` take a registry name or the
 import path ``package.module:factory`` of a user's problem or MOEA (see
@@ -29,6 +31,11 @@ process, a local process pool, or on a Dask cluster (:mod:`moo.executors`).
 ``stats`` computes the indicators per run and the comparisons of
 :mod:`moo.stats`, prints the tables as Markdown and writes them in the format
 of the file's extension. ``plot`` draws the figures of :mod:`moo.plots`.
+``select`` picks one design of a recorded front by the Monte Carlo selection
+(:func:`moo.record_selection.select_from_records`): SOURCE is a run record or
+a results directory (the non-dominated union of the fronts of its runs of
+the problem, or of one algorithm's with ``--algorithm``); the problem, which
+must be a ``moo.tuning.TuningProblem``, is rebuilt from ``--problem``.
 
 The CLI is a thin layer: every check is the library's (:func:`moo.runner.prepare`,
 :func:`moo.experiment.prepare`, :func:`moo.executors.open_executor`,
@@ -55,7 +62,9 @@ Exit codes (the same for every command):
   or ``--algorithm`` import path that does not import or whose factory
   returns something else, an unparsable ``--scheduler``, and a corrupt
   record, a duplicate run or a directory mixing two settings read by
-  ``stats`` or ``plot`` (the file is named);
+  ``stats``, ``plot`` or ``select`` (the file is named), and a ``select``
+  whose problem is not a ``moo.tuning.TuningProblem`` or whose SOURCE holds
+  no run of it;
 * 130 - interrupted (Ctrl-C); the records already written stay.
 
 Progress bars go to stderr when stderr is a terminal.
@@ -108,7 +117,9 @@ def _parser() -> argparse.ArgumentParser:
                             f"  {_PROG} run --problem zdt1 --algorithm nsga2 --seed 0 --evals 2000 --out run.json\n"
                             f"  {_PROG} experiment --problem generic --runs 50 --evals 10000 --out results/generic\n"
                             f"  {_PROG} stats results/generic --out table.md\n"
-                            f"  {_PROG} plot results/generic --out figures\n\n" + _EXIT_CODES)
+                            f"  {_PROG} plot results/generic --out figures\n"
+                            f"  {_PROG} select results/generic --problem generic --seed 0 --out design.json\n\n"
+                            + _EXIT_CODES)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     r = _subparser(sub, "run", "one run of a MOEA on a problem, recorded as JSON",
@@ -163,6 +174,27 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="figure directory (created)")
     p.add_argument("--format", default="png,pdf", help="comma-separated file formats (default png,pdf)")
     p.add_argument("--alpha", type=float, default=0.05, help="significance level of the CD diagrams")
+
+    c = _subparser(sub, "select", "pick one design of a recorded front by the Monte Carlo selection over the "
+                   "problem's scenarios (the paper's two problems: the paper's selection)",
+                   f"{_PROG} select results/tune --problem mypkg.plant:problem --algorithm nsga2 --molsp "
+                   f"--n-sims 1000 --seed 0 --out design.json\n"
+                   f"  {_PROG} select run.json --problem mypkg.plant:problem --seed 0")
+    c.add_argument("source", metavar="SOURCE",
+                   help="a run record (from 'run --out') or a results directory (from 'experiment'): the "
+                        "candidates are the non-dominated union of the final fronts of its runs of the problem")
+    c.add_argument("--problem", required=True,
+                   help="the problem of the runs (a moo.tuning.TuningProblem): generic, applied, or "
+                        "package.module:factory")
+    c.add_argument("--n-obj", type=int, default=None, help="number of objectives (as given to run/experiment)")
+    c.add_argument("--setup", default=None, help=_SETUP_HELP)
+    c.add_argument("--algorithm", default=None,
+                   help="only this algorithm's runs (name or package.module:factory; default: every run)")
+    c.add_argument("--molsp", action="store_true",
+                   help="with --algorithm: its MO-LSP runs (default: its plain runs); alone: every MO-LSP run")
+    c.add_argument("--n-sims", type=int, default=1000, help="number of simulations (default 1000, the paper's)")
+    c.add_argument("--seed", type=int, required=True, help="seed of the draws (integer >= 0)")
+    c.add_argument("--out", default=None, help="write the selection to FILE.json (checked before the work)")
     return parser
 
 
@@ -171,7 +203,8 @@ def _parser() -> argparse.ArgumentParser:
 _FLAGS = {"seed": "--seed", "base_seed": "--seed", "evals": "--evals", "pop_size": "--pop-size",
           "max_leaders": "--max-leaders", "n_obj": "--n-obj", "runs": "--runs", "workers": "--workers",
           "scheduler": "--scheduler", "executor": "--executor", "alpha": "--alpha", "algorithms": "--algorithms",
-          "out": "--out", "setup": "--setup"}
+          "out": "--out", "setup": "--setup", "n_sims": "--n-sims", "problem": "--problem",
+          "algorithm": "--algorithm", "source": "SOURCE"}
 
 
 def _flagged(message: str) -> str:
@@ -405,7 +438,60 @@ def _cmd_plot(args) -> int:
     return 0
 
 
-_COMMANDS = {"run": _cmd_run, "experiment": _cmd_experiment, "stats": _cmd_stats, "plot": _cmd_plot}
+def _vector(values) -> str:
+    import numpy as np
+
+    return np.array2string(np.asarray(values, dtype=float), precision=6, max_line_width=100, separator=", ")
+
+
+def _cmd_select(args) -> int:
+    from moo._imports import build_problem, check_algorithm_name, check_problem_name
+    from moo._validation import check_int
+    from moo.record_selection import front_from_records, load_source, select_on_front
+    from moo.runner import setup_name
+    from moo.store import check_output_file, write_json_atomic
+    from moo.tuning import TuningProblem
+
+    with _usage():
+        out = None if args.out is None else check_output_file(args.out, "--out")
+        check_int(args.seed, "seed", 0)
+        check_int(args.n_sims, "n_sims", 1)
+        name = check_problem_name(args.problem)
+        algorithm = None if args.algorithm is None else check_algorithm_name(args.algorithm)
+        molsp = True if args.molsp else (False if algorithm is not None else None)
+        problem = build_problem(name, args.n_obj, setup=args.setup)
+        if not isinstance(problem, TuningProblem):
+            raise TypeError(f"select needs a moo.tuning.TuningProblem; --problem {args.problem!r} is a "
+                            f"{type(problem).__name__}")
+        records = load_source(args.source)
+        front = front_from_records(records, problem, problem_name=name, algorithm=algorithm, molsp=molsp)
+    try:
+        sel = select_on_front(problem, front, n_sims=args.n_sims, seed=args.seed)
+    except Exception as exc:  # noqa: BLE001 - as in _cmd_run
+        return _failure(exc, "the selection failed")
+    where = "" if sel.index is None else f" ({sel.front.origin[sel.index][0]}, row {sel.front.origin[sel.index][1]})"
+    rule = ("the paper's (moo.problems.selection.select_design)" if sel.rule == "paper"
+            else "the problem's scenarios (moo.tuning.selection)")
+    print(f"selected design {sel.label} of {len(sel.labels)} candidates{where}")
+    print(f"  front: {len(sel.front)} non-dominated designs of {len(sel.front.records)} run record(s)")
+    print(f"  rule: {rule}; {args.n_sims} simulations, seed {args.seed}")
+    print(f"  wins: {sel.wins}/{sel.n_sims} ({100 * sel.share:.1f} %)")
+    print(f"  z = {_vector(sel.z)}")
+    print(f"  K = {_vector(sel.K).replace(chr(10), chr(10) + '      ')}")
+    if sel.margin is not None:
+        print(f"  certified robust margin (NormBounded uncertainty): {sel.margin:.6g}")
+    if out is not None:
+        data = {"source": str(args.source), "problem": name, "n_obj": problem.n_obj, "setup": setup_name(problem),
+                "algorithm": algorithm, "molsp": molsp, "seed": args.seed, **sel.to_dict()}
+        try:
+            write_json_atomic(out, data)
+        except OSError as exc:
+            return _write_failed(exc, str(out))
+    return 0
+
+
+_COMMANDS = {"run": _cmd_run, "experiment": _cmd_experiment, "stats": _cmd_stats, "plot": _cmd_plot,
+             "select": _cmd_select}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

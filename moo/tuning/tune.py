@@ -23,12 +23,52 @@ from ..runner import PreparedRun, RunResult, check_budget
 from .problem import TuningProblem
 from .selection import Selection, select
 
-__all__ = ["tune", "TuningResult"]
+__all__ = ["tune", "TuningResult", "select_front"]
 
 
 def _method(family) -> str:
     name = type(family).__name__
     return {"RLQRFamily": "rlqr", "LQRFamily": "lqr"}.get(name, "tuned")
+
+
+def _design_plant(problem: TuningProblem) -> rc.Plant:
+    """The family's design plant (``family.plant``), else the first scenario."""
+    plant = getattr(problem.family, "plant", None)
+    return plant if isinstance(plant, rc.Plant) else problem.scenarios[0]
+
+
+def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=None,
+                 sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None) -> Selection:
+    """The Monte Carlo selection (:func:`moo.tuning.selection.select`) of one design of a front ``X``.
+
+    What :meth:`TuningResult.select` does, for decision vectors from anywhere
+    (e.g. a run record's ``X``, as ``python -m moo select`` reads them): the
+    gains are ``problem.gains(X).K``, the controller's plant is the family's
+    ``plant`` (else the first scenario) and its method the family's
+    (``"rlqr"``, ``"lqr"``, else ``"tuned"``).
+
+    Parameters
+    ----------
+    problem : TuningProblem
+    X : (N, n_var) array_like
+        Decision vectors of the front (N >= 1).
+    F : (N, n_obj) array_like, optional
+        Their objectives (for the default weights; default: evaluated).
+    n_sims, seed, sampler, weights
+        As in :func:`moo.tuning.selection.select`.
+
+    Returns
+    -------
+    Selection
+        Its ``index`` is a row of ``X``.
+    """
+    if not isinstance(problem, TuningProblem):
+        raise TypeError(f"problem must be a moo.tuning.TuningProblem, got {type(problem).__name__}")
+    if len(X) == 0:
+        raise ValueError("the front is empty (no design stabilised every scenario): nothing to select")
+    X = problem.population(X, "X")
+    return select(problem, problem.gains(X).K, F=F, n_sims=n_sims, seed=seed, sampler=sampler, weights=weights,
+                  plant=_design_plant(problem), method=_method(problem.family))
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -57,8 +97,7 @@ class TuningResult:
         return self.problem.gains(self.X).K
 
     def _plant(self) -> rc.Plant:
-        plant = getattr(self.problem.family, "plant", None)
-        return plant if isinstance(plant, rc.Plant) else self.problem.scenarios[0]
+        return _design_plant(self.problem)
 
     def controllers(self) -> list[rc.Controller]:
         """One :class:`robustctl.Controller` per front design (its ``info`` holds ``z`` and the objectives).
@@ -76,10 +115,8 @@ class TuningResult:
 
         ``index`` of the returned :class:`~moo.tuning.selection.Selection` is a row of ``X``/``F``.
         """
-        if len(self.X) == 0:
-            raise ValueError("the front is empty (no design stabilised every scenario): nothing to select")
-        return select(self.problem, self.gains, F=self.F, n_sims=n_sims, seed=seed, sampler=sampler,
-                      weights=weights, plant=self._plant(), method=_method(self.problem.family))
+        return select_front(self.problem, self.X, self.F, n_sims=n_sims, seed=seed, sampler=sampler,
+                            weights=weights)
 
     def plot(self, selection: Selection | None = None, *, x0=None, steps: int = 50):
         """Figure: the front (pairwise objectives) and a design's closed-loop response on every scenario.
