@@ -83,7 +83,7 @@ def _main_many(argvs, env, cwd):
 def _user():
     """The user module's names, run here (no sys.path edit)."""
     ns: dict = {}
-    exec(compile(textwrap.dedent(USER_MODULE), "userplant.py", "exec"), ns)  # noqa: S102 - the test's own text
+    exec(compile(textwrap.dedent(USER_MODULE), "userplant.py", "exec"), ns)
     return ns
 
 
@@ -115,7 +115,7 @@ def _nondominated(F):
     """Rows of ``F`` not dominated by another, of equal rows the first (a plain O(n^2) filter)."""
     keep = []
     for i, f in enumerate(F):
-        dominated = np.any(np.all(F <= f, axis=1) & np.any(F < f, axis=1))
+        dominated = np.any(np.all(f >= F, axis=1) & np.any(f > F, axis=1))
         duplicate = np.any(np.all(F[:i] == f, axis=1))
         keep.append(not dominated and not duplicate)
     return np.flatnonzero(keep)
