@@ -18,7 +18,9 @@ with the function the package re-exports (``robustctl.design``,
 
 Two event handlers keep the references right:
 
-* ``missing-reference``: a docstring's short reference (``:class:`Controller```)
+* ``missing-reference``: a full name other than the one an object is
+  documented under (``moo.runner.run``, documented as ``moo.run``) links to
+  its page; a docstring's short reference (``:class:`Controller```)
   means the name as seen from the module where the docstring is written. An
   object documented under its package name (``robustctl.rlqr`` from ``robustctl._rlqr``) is rendered in
   the package's context, so a short name that Sphinx cannot find there is
@@ -218,7 +220,11 @@ def _documented_object(docname: str):
         return sys.modules.get(docname[len(OUT_DIR) + 1:])
     if not docname.startswith(prefix):
         return None
-    full = docname[len(prefix):]
+    return _import_dotted(docname[len(prefix):])
+
+
+def _import_dotted(full: str):
+    """The object a dotted name (``moo.runner.run``) names, or None."""
     for split in range(full.count("."), 0, -1):
         parts = full.split(".")
         try:
@@ -249,14 +255,18 @@ def _missing_reference(app, env, node, contnode):
     if node.get("refdomain") != "py" or node.get("refspecific"):
         return None
     target = node["reftarget"]
-    obj = _documented_object(node.get("refdoc", ""))
-    module = obj if inspect.ismodule(obj) else sys.modules.get(getattr(obj, "__module__", "") or "")
-    if module is None or not target or target.startswith("_"):
-        return None
-    head, *rest = target.split(".")
-    if head not in vars(module) or (owner := _name_of(vars(module)[head])) is None:
-        return None
-    base = ".".join([owner, *rest])
+    if target.split(".")[0] in PACKAGES and (named := _import_dotted(target)) is not None \
+            and id(named) in _DOCUMENTED:
+        base = _DOCUMENTED[id(named)]       # a full name other than the one it is documented under
+    else:
+        obj = _documented_object(node.get("refdoc", ""))
+        module = obj if inspect.ismodule(obj) else sys.modules.get(getattr(obj, "__module__", "") or "")
+        if module is None or not target or target.startswith("_"):
+            return None
+        head, *rest = target.split(".")
+        if head not in vars(module) or (owner := _name_of(vars(module)[head])) is None:
+            return None
+        base = ".".join([owner, *rest])
     if base == target:
         return None
     py = env.domains["py"]
