@@ -121,7 +121,8 @@ def truck_case(reps: int):
 
 def units(reps: int) -> dict:
     """The truck with ``Q = diag(1, 1, 25000, 100)``, ``R = 33535``, ``Bw = ones``: unscaled vs ``z / sqrt(r)``."""
-    from robustctl.models.truck import authors_weights, truck_plant
+    from robustctl.models.morais2022 import authors_weights
+    from robustctl.models.truck import truck_plant
 
     plant = truck_plant(0.0)
     Q, R = authors_weights()

@@ -26,7 +26,7 @@
    true norm-bounded uncertainty ``H Delta [EF_true EG_true]``.
 
 ``--setup`` (applied problem only): ``authors`` (default) or ``ours``, the
-loop, initial state and weights of :data:`robustctl.pathfollow.SETUPS`, for
+loop, initial state and weights of :data:`robustctl.models.morais2022.SETUPS`, for
 the MOEA, the candidate designs and the selection alike
 (``make_problem("applied", setup=...)``). The default is that of
 ``paper_repro/mse_table.py`` (``DEFAULT_SETUP`` of ``mse_designs.py``,
@@ -71,7 +71,7 @@ from moo.problems.applied import AppliedRLQRProblem
 from moo.problems.generic import GenericRLQRProblem
 from moo.problems.selection import DesignSelection, error_scales, select_design
 from moo.runner import run as run_moea
-from robustctl.pathfollow import SETUPS
+from robustctl.models.morais2022 import SETUPS
 
 DEFAULT_SIMS = {"generic": 1000, "applied": 200}
 PAPER = {"generic": "paper: design 49 of 92 won 222/1000; random 1, nominal 0",
@@ -161,7 +161,7 @@ def main(argv=None) -> int:
     ap.add_argument("--problem", choices=("generic", "applied"), required=True)
     ap.add_argument("--setup", choices=tuple(SETUPS), default=None,
                     help=f"applied problem: the set-up (default {DEFAULT_SETUP}, as paper_repro/mse_table.py; "
-                         "robustctl.pathfollow.SETUPS)")
+                         "robustctl.models.morais2022.SETUPS)")
     ap.add_argument("--algorithm", choices=tuple(ALGORITHMS), default="nsga2", help="MOEA (default nsga2)")
     ap.add_argument("--molsp", action=argparse.BooleanOptionalAction, default=True,
                     help="wrap the MOEA with MO-LSP (default on)")

@@ -75,6 +75,7 @@ from moo.stats import (
 )
 from moo.store import load_records
 from moo.tables import markdown_table, write_csv
+from robustctl.models.morais2022 import SETUPS
 
 
 @dataclass(frozen=True)
@@ -180,8 +181,8 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--executor", choices=("process", "dask"), default="process",
                     help="'process' (default) or 'dask' (a local cluster, or the one at --scheduler)")
     ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (with --executor dask)")
-    ap.add_argument("--setup", choices=("ours", "authors"), default=None,
-                    help="applied MOP set-up (robustctl.pathfollow.PathFollowingSetup; default: the MOP's own)")
+    ap.add_argument("--setup", choices=tuple(SETUPS), default=None,
+                    help="applied MOP set-up (robustctl.models.morais2022.SETUPS; default: the MOP's own)")
     ap.add_argument("--no-plots", action="store_true", help="do not draw the figures")
     return ap
 

@@ -17,17 +17,16 @@ from truck_margins import appendix_uncertainty
 
 import robustctl as rc
 from robustctl.hinf_game import hinf_game
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
+from robustctl.models.morais2022 import CODE_GAMMA, SETUPS, code_manoeuvre
 from robustctl.path import default_route
-from robustctl.pathfollow import SETUPS, PathFollowingSetup, code_manoeuvre
+from robustctl.pathfollow import PathFollowingSetup
 
 # "ours" H-infinity disturbance channels (columns of Bw): a 1 m lateral-displacement
 # impulse (the run's initial offset) and the path curvature scaled by the
 # tightest curve of the route (1/200 m).
 HINF_RHO_IMPULSE = 1.0
 HINF_KAPPA_SCALE = 1.0 / 200.0
-#: The authors' game-Riccati level (``standard_formulation/h_infinity.m``: ``gamma = 14350``).
-CODE_GAMMA = 14350.0
 #: The uncertainty input ``H`` of the appendix and of the authors' code (``parameters.m``: ones).
 H_ONES = np.ones((4, 1))
 
@@ -64,7 +63,7 @@ class TableSetup:
 
     @property
     def authors_weights(self) -> bool:
-        return self.loop.Q_diag == truck.AUTHORS_Q_DIAG and self.loop.r == truck.AUTHORS_R_DOUBLED / 2
+        return self.loop.Q_diag == morais2022.AUTHORS_Q_DIAG and self.loop.r == morais2022.AUTHORS_R_DOUBLED / 2
 
     def path(self, duration: float | None = None):
         path = default_route() if self.course == "route" else code_manoeuvre()
@@ -181,7 +180,7 @@ def available_controllers(setup: str | TableSetup, uncertainty: str = "printed")
     return CONTROLLERS + tuple(extras)
 
 
-def design_controllers(setup: str | TableSetup, z=truck.RLQR_MOP_Z, uncertainty: str = "printed",
+def design_controllers(setup: str | TableSetup, z=morais2022.RLQR_MOP_Z, uncertainty: str = "printed",
                        controllers: tuple[str, ...] | list[str] | None = None) -> list[Design]:
     """Design the named controllers (default: all of :func:`available_controllers`) on the nominal model."""
     if uncertainty not in ("printed", "computed"):
@@ -200,14 +199,14 @@ def design_controllers(setup: str | TableSetup, z=truck.RLQR_MOP_Z, uncertainty:
         if name not in names:
             continue
         if name == "RLQR_MOP":
-            EF, EG, mu = truck.uncertainty_from_z(z)
+            EF, EG, mu = morais2022.uncertainty_from_z(z)
             designs.append(_rlqr(name, ts, EF[0], EG[0], mu[0], "RLQR, doubled column, z = "
                                  + np.array2string(np.asarray(z, float), precision=5)))
         elif name.startswith("RLQR_A"):
             src = {"RLQR_A_computed": "computed", "RLQR_A_printed": "printed"}.get(name, uncertainty)
             eg = {"RLQR_A_code_EG": "code", "RLQR_A_printed_EG": "printed"}.get(name, ts.rlqr_a_eg)
-            u = truck.algebraic_uncertainty(src)
-            EG = np.array([truck.CODE_EG]) if eg == "code" else u.EG
+            u = morais2022.algebraic_uncertainty(src)
+            EG = np.array([morais2022.CODE_EG]) if eg == "code" else u.EG
             designs.append(_rlqr(name, ts, u.EF, EG, u.mu,
                                  f"RLQR, doubled column, Appendix A uncertainty ({src}"
                                  f"{', the code' + chr(39) + 's EG' if eg == 'code' else ''}): "
@@ -247,7 +246,7 @@ def rlqr_a_limit(ts: TableSetup) -> dict:
     against ``mu ||EG||^2``: returned are both gains, the eigenvalue of each
     closest to 1 and the spectral radii.
     """
-    u = truck.algebraic_uncertainty("printed")
+    u = morais2022.algebraic_uncertainty("printed")
     e = float(u.EG[0, 0])
     p = truck.truck_plant(0.0)
     K_lim = -u.EF / e

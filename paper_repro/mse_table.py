@@ -40,7 +40,7 @@ its initial state nor its H-infinity formulation):
 
 Course (``--course``): ``route`` (default, both set-ups), the 9 km route
 (:func:`robustctl.path.default_route`); ``code``, the code's 30 s manoeuvre
-(two 5 s sine steering lane changes, :func:`robustctl.pathfollow.code_manoeuvre`).
+(two 5 s sine steering lane changes, :func:`robustctl.models.morais2022.code_manoeuvre`).
 
 Controllers, all designed on the nominal (0 %) model with the set-up's Q, R:
 
@@ -136,11 +136,11 @@ from truck_margins import MARGINS_NOTE, truck_margins
 
 import robustctl as rc
 from robustctl.batchsim import BACKENDS
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 from robustctl.pathfollow import PathFollowing, PathFollowingResult
 
 
-def design_controllers(z=truck.RLQR_MOP_Z, uncertainty: str = "printed",
+def design_controllers(z=morais2022.RLQR_MOP_Z, uncertainty: str = "printed",
                        controllers: tuple[str, ...] | list[str] | None = None,
                        setup: str | TableSetup = DEFAULT_SETUP) -> list[Design]:
     """:func:`mse_designs.design_controllers` (every controller of the set-up by default) on the nominal model."""
@@ -154,7 +154,7 @@ def simulate_designs(designs: list[Design], ts: TableSetup, path, *, keep_trajec
     return sim.run_laws([d.law for d in designs], keep_trajectories=keep_trajectories, backend=backend)
 
 
-def table_for(ts: TableSetup, *, z=truck.RLQR_MOP_Z, uncertainty: str = "printed", measure: str = "tracking",
+def table_for(ts: TableSetup, *, z=morais2022.RLQR_MOP_Z, uncertainty: str = "printed", measure: str = "tracking",
               duration: float | None = None, backend: str = "numba") -> dict:
     """The paper's four controllers in set-up ``ts``: ``{objective: {controller: (4,)}}`` (no outputs)."""
     designs = design_controllers(z, uncertainty, list(CONTROLLERS), ts)
@@ -196,7 +196,7 @@ def _write_designs(out: Path, ts: TableSetup, path, designs: list[Design], limit
         fh.write("\n" + limit_text(limit) + "\n")
 
 
-def run(out: Path, *, setup: str | TableSetup = DEFAULT_SETUP, course: str | None = None, z=truck.RLQR_MOP_Z,
+def run(out: Path, *, setup: str | TableSetup = DEFAULT_SETUP, course: str | None = None, z=morais2022.RLQR_MOP_Z,
         uncertainty: str = "printed", measure: str = "tracking", duration: float | None = None,
         figures: bool = True, controllers: tuple[str, ...] | list[str] | None = None, backend: str = "numba",
         with_margins: bool = True, compare: bool = False, log=print) -> dict:
@@ -318,9 +318,9 @@ def main(argv=None) -> int:
                     help="controllers to run (default all): RLQR_MOP RLQR_A Hinf LQR and the set-up's extras "
                          "(module docstring)")
     args = ap.parse_args(argv)
-    z = truck.RLQR_MOP_Z if args.z is None else tuple(args.z)
+    z = morais2022.RLQR_MOP_Z if args.z is None else tuple(args.z)
     try:
-        truck.uncertainty_from_z(z)
+        morais2022.uncertainty_from_z(z)
         if args.duration is not None and not args.duration > 0:
             raise ValueError(f"--duration must be > 0 seconds, got {args.duration}")
         controllers = args.controllers

@@ -7,7 +7,7 @@ The report itself is :func:`robustctl.analysis.margins_report`.
 from __future__ import annotations
 
 import robustctl as rc
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 
 #: The models' names, the columns of the report.
 MARGINS = ("polytope 0-300 %", "appendix (printed)", "appendix (computed)")
@@ -18,7 +18,7 @@ MARGINS_NOTE = ("Margin: the largest r for which stability is certified for r ti
 
 def appendix_uncertainty(source: str = "printed") -> rc.NormBounded:
     """The appendix's norm-bounded model on the plain truck (alpha = u1 + u2: one of the equal EG entries)."""
-    u = truck.algebraic_uncertainty(source)
+    u = morais2022.algebraic_uncertainty(source)
     return rc.NormBounded(u.H, u.EF, u.EG[:, :1])
 
 

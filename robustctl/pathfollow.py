@@ -17,38 +17,22 @@ for a plain gain, ``[[1, 1]]`` for the doubled steering column
 
 Set-ups
 -------
-The paper states neither its reference, its initial state nor its weights.
-A :class:`PathFollowingSetup` fixes them, together with the design weights
-``Q``, ``R`` that the controllers of a study share; :data:`SETUPS` holds two:
-
-``"ours"`` (the default; the engineering set-up)
-    ``x_ref`` and ``alpha_ff`` are the nominal model's steady cornering along
-    the path (:func:`robustctl.models.truck.reference_states`; ``x_ref =
-    [beta_1 v, v, 0, -beta_1] kappa``), with the steady-state steering as
-    feedforward: the nominal plant follows a constant-curvature path with
-    zero error, and errors come from transients, the initial offset and the
-    payload mismatch; every state is a *tracking* error. Bryson's weights
-    (:func:`robustctl.models.truck.lqr_weights`) and a 1 m initial offset.
-``"authors"`` (the set-up of the authors' published code)
-    Barbosa et al. (2019), GitHub ``barbosafilipe/robust_lqr``:
-    ``u = K (x - x_ref)`` with no steering feedforward and ``x_ref = [0, 0,
-    rho_ref, theta_ref]`` (``standard_formulation/main.m``: the lateral
-    velocity and the yaw rate are regulated to zero, the paper's
-    "regulation errors" f2-f4), the reference ``rho_ref, theta_ref`` of the
-    nominal truck driven open loop by a smooth steering command
-    (``standard_formulation/parameters.m``; here the path's steady-cornering
-    steering, :func:`robustctl.models.truck.open_loop_reference`), the
-    initial state ``[0, 0, 0.3, -0.1]`` and the weights ``Q = diag(1, 1,
-    25000, 100)``, ``R = 67070 I2`` on the doubled column (``parameters.m``,
-    ``alternative_formulation/model.m``;
-    :func:`robustctl.models.truck.authors_weights`).
-
-Not taken from the code: its sampling time (0.01 s; the paper's 0.1 s is
-kept), its Tustin discretisation (ZOH kept), its per-column saturation at
-0.22 rad (the paper's 0.45 rad on the steering angle is kept), its
-30 s manoeuvre on a straight road (the path is a parameter; the default
-route is ours) and its RLQR gains recomputed online from ``P = I`` (the
-controllers here are steady-state gains; its gains settle within seconds).
+A :class:`PathFollowingSetup` fixes the reference, the loop and the
+initial state, together with the design weights ``Q``, ``R`` that the
+controllers of a study share. The default, :data:`DEFAULT_SETUP` (the
+engineering set-up): ``x_ref`` and ``alpha_ff`` are the nominal model's
+steady cornering along the path
+(:func:`robustctl.models.truck.reference_states`; ``x_ref = [beta_1 v, v, 0,
+-beta_1] kappa``), with the steady-state steering as feedforward: the
+nominal plant follows a constant-curvature path with zero error, and errors
+come from transients, the initial offset and the payload mismatch; every
+state is a *tracking* error. Bryson's weights
+(:func:`robustctl.models.truck.lqr_weights`) and a 1 m initial offset.
+The other reference, ``"open_loop"``, follows the nominal truck driven open
+loop by the path's steady-cornering steering
+(:func:`robustctl.models.truck.open_loop_reference`) and regulates the
+lateral velocity and the yaw rate to zero. The set-ups of the paper and of
+its authors' code are in :mod:`robustctl.models.morais2022`.
 
 :class:`PathFollowing` discretises the scenarios and builds the reference
 once (an optimiser's problem keeps one); :func:`simulate` is the one-call form.
@@ -62,9 +46,6 @@ References
 Morais et al. (2022), Section 4.5.2 (the four objectives f1..f4 and the
 payload cases). K. J. Astrom & R. M. Murray, *Feedback Systems*, 2nd ed.,
 Princeton 2021, Sec. 8.5 (feedforward plus feedback on the tracking error).
-F. M. Barbosa et al., "Robust path-following control for articulated
-heavy-duty vehicles", *Control Engineering Practice* 85 (2019) 246-256, and
-its code, https://github.com/barbosafilipe/robust_lqr (the authors' set-up).
 """
 
 from __future__ import annotations
@@ -81,12 +62,12 @@ from ._validation import as_batch, as_float_array, check_bool, check_choice, che
 from .batchsim import DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
 from .input_memory import InputMemoryFeedback
 from .models import truck as _truck
-from .path import LaneChange, ReferencePath, Straight
+from .path import ReferencePath
 
-__all__ = ["PathFollowing", "PathFollowingResult", "PathFollowingSetup", "SETUPS", "get_setup", "simulate",
-           "DEFAULT_INITIAL_ERROR", "code_manoeuvre"]
+__all__ = ["PathFollowing", "PathFollowingResult", "PathFollowingSetup", "DEFAULT_SETUP", "simulate",
+           "DEFAULT_INITIAL_ERROR"]
 
-#: Initial path-following error of the ``"ours"`` set-up: the truck starts 1 m to the
+#: Initial path-following error of the default set-up: the truck starts 1 m to the
 #: left of the path, parallel to it, at steady speed ([ydot, psidot, rho, theta]).
 DEFAULT_INITIAL_ERROR = (0.0, 0.0, 1.0, 0.0)
 
@@ -144,30 +125,21 @@ class PathFollowingSetup:
         return Q, (2.0 * self.r * np.eye(2) if doubled else np.array([[float(self.r)]]))
 
 
-_Q_OURS, _R_OURS = _truck.lqr_weights()
-#: The two set-ups (module docstring): ``"ours"`` (default) and ``"authors"``.
-SETUPS = {
-    "ours": PathFollowingSetup(
-        "ours", "steady", True, DEFAULT_INITIAL_ERROR, tuple(np.diag(_Q_OURS).tolist()), float(_R_OURS[0, 0]),
-        "steady-cornering tracking with feedforward, Bryson's weights (robustctl.models.truck.lqr_weights), "
-        "1 m initial offset"),
-    "authors": PathFollowingSetup(
-        "authors", "open_loop", False, _truck.AUTHORS_X0, _truck.AUTHORS_Q_DIAG, _truck.AUTHORS_R_DOUBLED / 2.0,
-        "Barbosa et al. (2019)'s code, github.com/barbosafilipe/robust_lqr: standard_formulation/main.m "
-        "(loop), parameters.m (reference, x0, Q, R), alternative_formulation/model.m (x0, Q, R)"),
-}
+_Q_DEFAULT, _R_DEFAULT = _truck.lqr_weights()
+#: The default set-up (module docstring): steady-cornering tracking with feedforward,
+#: Bryson's weights, a 1 m initial offset.
+DEFAULT_SETUP = PathFollowingSetup(
+    "engineering", "steady", True, DEFAULT_INITIAL_ERROR, tuple(np.diag(_Q_DEFAULT).tolist()),
+    float(_R_DEFAULT[0, 0]),
+    "steady-cornering tracking with feedforward, Bryson's weights (robustctl.models.truck.lqr_weights), "
+    "1 m initial offset")
 
 
-def get_setup(setup: str | PathFollowingSetup) -> PathFollowingSetup:
-    """A :class:`PathFollowingSetup` by name (a key of :data:`SETUPS`), or ``setup`` itself."""
-    if isinstance(setup, PathFollowingSetup):
-        return setup
-    if not isinstance(setup, str):
-        raise TypeError(f"setup must be a name ({', '.join(SETUPS)}) or a PathFollowingSetup, "
-                        f"got {type(setup).__name__}")
-    if setup not in SETUPS:
-        raise ValueError(f"unknown setup {setup!r}; valid: {', '.join(SETUPS)}")
-    return SETUPS[setup]
+def _check_setup(setup) -> PathFollowingSetup:
+    if not isinstance(setup, PathFollowingSetup):
+        raise TypeError(f"setup must be a PathFollowingSetup (the paper's set-ups by name: "
+                        f"robustctl.models.morais2022.get_setup), got {type(setup).__name__}")
+    return setup
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -281,29 +253,6 @@ def _scenarios(overloads, T: int) -> tuple:
     return tuple(out)
 
 
-def code_manoeuvre(*, params: _truck.TruckParameters | None = None) -> ReferencePath:
-    """The reference manoeuvre of the authors' code, as a path: 30 s with two sine lane changes.
-
-    ``standard_formulation/parameters.m`` of Barbosa et al. (2019)'s code
-    (GitHub ``barbosafilipe/robust_lqr``) drives the nominal vehicle open
-    loop for 30 s on a straight road with the steering command ``0.01
-    sin(0.4 pi t)`` rad for 5 s from ``t = 10 s`` (a lane change to the left)
-    and its negative from ``t = 20 s`` (back). This is the path whose
-    steady-cornering steering (``alpha_per_kappa kappa``,
-    :func:`robustctl.models.truck.steady_state_cornering`, nominal payload)
-    is that command: straights and two :class:`~robustctl.path.LaneChange`
-    elements of ``5 v`` metres and offset ``0.01 L^2 / (2 pi alpha_per_kappa)``
-    (``L = 5 v``), so the ``"open_loop"`` reference of :data:`SETUPS` along it
-    is the code's ``x_ref`` (at our 0.1 s sampling, ZOH model).
-    """
-    p = _truck._params(params)
-    _, a_per_kappa = _truck.steady_state_cornering(0.0, params=p)
-    L = 5.0 * p.v
-    offset = 0.01 * L**2 / (2.0 * np.pi * a_per_kappa)
-    return ReferencePath.from_segments([Straight(2 * L), LaneChange(offset, L), Straight(L), LaneChange(-offset, L)],
-                                       duration=30.0, speed=p.v, dt=p.dt, name="code manoeuvre")
-
-
 class PathFollowing:
     """The truck along ``path`` at S payload scenarios, ready to simulate gains (checked once).
 
@@ -314,8 +263,8 @@ class PathFollowing:
     overloads : float, or sequence of S floats / (T,) arrays
         Payload overload of each scenario in percent (>= 0); an array gives a
         time-varying payload (e.g. unloading at a stop), sample by sample.
-    setup : str or PathFollowingSetup
-        Reference, loop and initial state (module docstring; default ``"ours"``).
+    setup : PathFollowingSetup
+        Reference, loop and initial state (module docstring; default :data:`DEFAULT_SETUP`).
     params : TruckParameters, optional
     nominal_overload : float
         Overload of the model the reference and feedforward are computed on.
@@ -335,12 +284,12 @@ class PathFollowing:
         ``DeprecationWarning`` (the earlier, implicit behaviour).
     """
 
-    def __init__(self, path: ReferencePath, overloads=0.0, *, setup: str | PathFollowingSetup = "ours",
+    def __init__(self, path: ReferencePath, overloads=0.0, *, setup: PathFollowingSetup = DEFAULT_SETUP,
                  params: _truck.TruckParameters | None = None, nominal_overload: float = 0.0,
                  steer_limit: float | None = _truck.STEER_LIMIT, feedforward: bool | None = None, x0=None,
                  bound: float = DEFAULT_BOUND, input_map=None):
         p = _truck._params(params)
-        self.setup = get_setup(setup)
+        self.setup = _check_setup(setup)
         if not isinstance(path, ReferencePath):
             raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
         if abs(path.speed - p.v) > 1e-9 * p.v or abs(path.dt - p.dt) > 1e-12:
@@ -524,7 +473,7 @@ class PathFollowing:
                 f"input_map={'given' if self._given_map else 'default'})")
 
 
-def simulate(K, path: ReferencePath, overloads=0.0, *, setup: str | PathFollowingSetup = "ours",
+def simulate(K, path: ReferencePath, overloads=0.0, *, setup: PathFollowingSetup = DEFAULT_SETUP,
              params: _truck.TruckParameters | None = None, nominal_overload: float = 0.0,
              steer_limit: float | None = _truck.STEER_LIMIT, feedforward: bool | None = None, x0=None,
              bound: float = DEFAULT_BOUND, keep_trajectories: bool = True,

@@ -13,7 +13,7 @@ import scipy.optimize
 
 import robustctl as rc
 from robustctl.errors import InfeasibleError
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 
 
 # ---------------------------------------------------------------- helpers
@@ -233,7 +233,7 @@ def truck_designs():
     plant = truck.truck_plant(0.0)
     Q, R = truck.lqr_weights()
     lqr = rc.design("lqr", plant, Q=Q, R=R)
-    u = truck.algebraic_uncertainty("printed")
+    u = morais2022.algebraic_uncertainty("printed")
     Q2, R2 = truck.lqr_weights(doubled=True)
     rlqr = rc.design("rlqr", truck.truck_plant(0.0, doubled=True), u.EF, u.EG, u.mu, Q=Q2, R=R2, H=u.H)
     return plant, lqr, rlqr, u
@@ -347,7 +347,7 @@ def test_bounds_do_not_depend_on_the_units_of_the_weights_and_channels():
     References: the LQ cost (scipy's Lyapunov solver) and linfnorm at every constant Delta of a grid.
     """
     plant = truck.truck_plant(0.0)
-    Q, R = truck.authors_weights()
+    Q, R = morais2022.authors_weights()
     ctrl = rc.lqr(plant, Q=Q, R=R)
     unc = rc.NormBounded(plant.G, [[0.1, 0.0, 0.0, 0.0]], [[0.1]])
     x0 = np.array([0.1, 0.0, 0.05, 0.01])

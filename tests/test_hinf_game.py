@@ -14,7 +14,7 @@ from robustctl import InfeasibleError, NormBounded, Plant, lq_output
 from robustctl.errors import ConvergenceError
 from robustctl.hinf_game import hinf_game, with_input_memory
 from robustctl.hinf_riccati import hinf_riccati, riccati_level
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 
 
 def _random_case(seed, n=4, m=2, q=2):
@@ -53,7 +53,7 @@ def test_stationary_solution_equals_the_game_riccati_equation(seed):
 def test_truck_at_the_codes_level_equals_the_game_riccati_equation():
     """The authors' gamma = 14350 with their Q, R and H = 1 on our truck (scaled reference, same gain)."""
     plant = truck.truck_plant(0.0)
-    Q, R = truck.authors_weights()
+    Q, R = morais2022.authors_weights()
     H = np.ones((4, 1))
     g = hinf_game(plant, Bw=H, Q=Q, R=R, gamma=14350.0, P_final=np.eye(4))
     s = 1.0 / np.sqrt(R[0, 0])                    # z scaled by hand (no longer needed: test_hinf_scaling)

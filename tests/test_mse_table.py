@@ -15,7 +15,7 @@ from truck_margins import truck_margins
 
 import robustctl as rc
 from robustctl.hinf_game import hinf_game
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 from robustctl.path import default_route
 from robustctl.pathfollow import simulate
 
@@ -151,10 +151,11 @@ def test_authors_run_outputs_and_lqr_row(authors_run):
     rows = _read(authors_run / "mse_table.csv")
     assert {r["controller"] for r in rows} - set(CONTROLLERS) == {
         "RLQR_A_code_EG", "RLQR_A_computed", "Hinf_polytopic", "Hinf_robust", "Hinf_game"}
-    Q, R = truck.authors_weights()
+    Q, R = morais2022.authors_weights()
     plant = truck.truck_plant(0.0)
     K = -control.dlqr(plant.F, plant.G, Q, R)[0]
-    res = simulate(K, default_route(duration=20.0), [0.0, 100.0, 200.0, 300.0], setup="authors")
+    res = simulate(K, default_route(duration=20.0), [0.0, 100.0, 200.0, 300.0],
+                   setup=morais2022.SETUPS["authors"])
     lqr = {(r["objective"], int(r["overload"])): float(r["mse"]) for r in rows if r["controller"] == "LQR"}
     for j, obj in enumerate(OBJECTIVES):
         for s, ov in enumerate(OVERLOADS):
@@ -171,7 +172,7 @@ def test_authors_run_outputs_and_lqr_row(authors_run):
 
 def test_authors_designs_use_the_codes_values():
     d = {x.name: x for x in mse_table.design_controllers(setup="authors")}
-    Q, R = truck.authors_weights()
+    Q, R = morais2022.authors_weights()
     plant = truck.truck_plant(0.0)
     np.testing.assert_allclose(d["LQR"].K, -control.dlqr(plant.F, plant.G, Q, R)[0], rtol=1e-8)
     g = hinf_game(plant, Bw=np.ones((4, 1)), Q=Q, R=R, gamma=14350.0, P_final=np.eye(4))
@@ -207,7 +208,7 @@ def test_agreement_measures_on_known_tables():
 
 def test_printed_rlqr_a_is_forced_to_a_unit_eigenvalue_as_mu_grows():
     """Equal EG entries and mu -> inf: K1 + K2 -> -EF/EG, no rho feedback, an eigenvalue at exactly 1."""
-    u = truck.algebraic_uncertainty("printed")
+    u = morais2022.algebraic_uncertainty("printed")
     assert u.EG[0, 0] == u.EG[0, 1] and u.EF[0, 2] == 0.0
     p = truck.truck_plant(0.0)
     K_lim = -u.EF / u.EG[0, 0]
@@ -250,7 +251,7 @@ def test_margins_of_a_design_match_the_analysis_engine():
     ref = rc.robust_stability((plant, d.K_steer), vertices=[truck.truck_plant(k) for k in (100.0, 200.0, 300.0)])
     assert m["polytope 0-300 %"].margin == pytest.approx(ref.margin, rel=1e-6)
     # the norm-bounded margin is the small-gain value 1 / ||E (zI - A)^-1 H||_inf (python-control's linfnorm)
-    u = truck.algebraic_uncertainty("printed")
+    u = morais2022.algebraic_uncertainty("printed")
     A, E = plant.F + plant.G @ d.K_steer, u.EF + u.EG[:, :1] @ d.K_steer
     gain = control.linfnorm(control.ss(A, u.H, E, np.zeros((1, 1)), plant.dt))[0]
     assert m["appendix (printed)"].margin == pytest.approx(1.0 / gain, rel=1e-4)

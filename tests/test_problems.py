@@ -258,7 +258,7 @@ def test_generic_bad_population(generic):
 
 # ------------------------------------------------------------------ applied --
 from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
-from robustctl.models import truck  # noqa: E402
+from robustctl.models import morais2022, truck  # noqa: E402
 from robustctl.path import default_route  # noqa: E402
 
 SHORT_PATH_S = 120.0      # a 2-minute stretch of the default route keeps the plain-loop reference quick
@@ -513,7 +513,7 @@ def applied_authors():
 
 def test_applied_authors_setup_matches_reference(applied_authors):
     p = applied_authors
-    Q, R = truck.authors_weights(doubled=True)
+    Q, R = morais2022.authors_weights(doubled=True)
     np.testing.assert_array_equal(p.Q, Q)
     np.testing.assert_array_equal(p.R, R)
     z = APPLIED_Z[:4]

@@ -32,7 +32,7 @@ from moo.problems.selection import (
     overload_from_delta,
     select_design,
 )
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 from robustctl.path import default_route
 from robustctl.pathfollow import simulate
 
@@ -186,7 +186,7 @@ def test_generic_errors_match_an_independent_loop(generic):
 def test_applied_errors_match_direct_simulations(applied, monkeypatch):
     Q, R = truck.lqr_weights(doubled=True)
     K_lqr2 = -control.dlqr(applied.plant.F, applied.plant.G, Q, R)[0]
-    K_mop = applied.gains(np.array(truck.RLQR_MOP_Z)).K[0]
+    K_mop = applied.gains(np.array(morais2022.RLQR_MOP_Z)).K[0]
     K = np.stack([K_lqr2, K_mop, 0.3 * K_lqr2])
     deltas = np.array([-1.0, 0.0, 0.6])                        # 0, 150, 240 % overload
     path = applied.path
@@ -220,11 +220,11 @@ def test_applied_errors_scales_and_plain_truck_gains(applied):
 
 def test_applied_errors_in_the_authors_setup(applied):
     """The authors' loop and 1 / sqrt(Q_ii) of their Q as scales: E = sum_k e' Q e, from a direct run."""
-    Q, R = truck.authors_weights()
+    Q, R = morais2022.authors_weights()
     K = -control.dlqr(truck.truck_plant().F, truck.truck_plant().G, Q, R)[0]
     deltas = [-1.0, 0.3]
     E = applied_errors(K[None], deltas, path=applied.path, setup="authors")
-    res = simulate(K, applied.path, list(overload_from_delta(deltas)), setup="authors")
+    res = simulate(K, applied.path, list(overload_from_delta(deltas)), setup=morais2022.SETUPS["authors"])
     ref = np.einsum("stj,jk,stk->s", res.errors[0], Q, res.errors[0])
     np.testing.assert_allclose(E[0], ref, rtol=1e-10)
     np.testing.assert_allclose(error_scales("authors"), [1 / np.sqrt(25000.0), 1.0, 1.0, 0.1])
@@ -233,11 +233,11 @@ def test_applied_errors_in_the_authors_setup(applied):
 
 def test_select_design_uses_the_problems_setup():
     prob = AppliedRLQRProblem(setup="authors", path=default_route(duration=15.0))
-    X = np.array([truck.RLQR_MOP_Z, [10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 100.0]])
+    X = np.array([morais2022.RLQR_MOP_Z, [10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 100.0]])
     sel = select_design(prob, X, n_sims=5, seed=2)
     np.testing.assert_allclose(sel.errors, applied_errors(sel.designs.K, sel.deltas, path=prob.path,
                                                           setup="authors"), rtol=1e-12)
-    Q, R = truck.authors_weights(doubled=True)
+    Q, R = morais2022.authors_weights(doubled=True)
     np.testing.assert_allclose(sel.designs.K[sel.designs.index("nominal")], rc.lqr(prob.plant, Q=Q, R=R).K)
 
 
@@ -265,7 +265,7 @@ def test_generic_design_set(generic):
 
 
 def test_applied_design_set(applied):
-    X = np.array([truck.RLQR_MOP_Z])
+    X = np.array([morais2022.RLQR_MOP_Z])
     ds = build_designs(applied, X, seed=0)
     assert ds.labels == ("1", "nominal", "RLQR^A", "random")
     assert ds.ok.all()
@@ -275,7 +275,7 @@ def test_applied_design_set(applied):
     # the doubled-column LQR splits the plain truck's LQR steering gain in two equal halves
     K1 = -control.dlqr(truck.truck_plant().F, truck.truck_plant().G, *truck.lqr_weights())[0]
     np.testing.assert_allclose(ds.K[1].sum(axis=0), K1[0], rtol=1e-8)
-    np.testing.assert_allclose(ds.z[2], [*truck.PRINTED_EF, *truck.PRINTED_EG, 81.0], rtol=1e-14)
+    np.testing.assert_allclose(ds.z[2], [*morais2022.PRINTED_EF, *morais2022.PRINTED_EG, 81.0], rtol=1e-14)
     # RLQR^A's z decodes (H = 1, mu = 10**9) to the same gain as the problem's own decoding
     np.testing.assert_allclose(ds.K[2], applied.gains(ds.z[2]).K[0], rtol=1e-9, atol=1e-12)
     assert np.all((ds.z[3] > 0) & (ds.z[3] <= 500))
@@ -303,7 +303,7 @@ def test_select_design_is_deterministic_and_consistent(generic):
 
 
 def test_select_design_applied_is_deterministic(applied):
-    X = np.array([truck.RLQR_MOP_Z])
+    X = np.array([morais2022.RLQR_MOP_Z])
     path = applied.path.truncated(3.0)
     a = select_design(applied, X, n_sims=4, seed=2, path=path)
     b = select_design(applied, X, n_sims=4, seed=2, path=path)
@@ -395,7 +395,7 @@ def test_script_authors_setup_records_setup_and_margins(tmp_path, capsys):
     assert set(m) == {"polytope 0-300 %", "appendix (printed)", "appendix (computed)"}
     assert "winner's certified robust-stability margin" in text
     # the margin of the winner's steering gain, recomputed with the analysis engine
-    Q, R = truck.authors_weights()
+    Q, R = morais2022.authors_weights()
     if rec["winner"]["kind"] == "nominal":
         K = rc.lqr(truck.truck_plant(), Q=Q, R=R).K
     else:

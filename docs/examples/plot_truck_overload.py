@@ -10,7 +10,7 @@ changes the plant's mass and yaw inertia.
 
 * **LQR** with Bryson's-rule weights (:func:`robustctl.models.truck.lqr_weights`).
 * **RLQR^MOP**: the robust LQR with the uncertainty the paper's MOEA found,
-  its printed decision vector :data:`robustctl.models.truck.RLQR_MOP_Z`, on the
+  its printed decision vector :data:`robustctl.models.morais2022.RLQR_MOP_Z`, on the
   doubled steering column (two inputs whose sum is the steering angle).
 * **H-infinity** by LMIs, with a lateral-displacement impulse and the path
   curvature as disturbances and the guaranteed input bound
@@ -24,7 +24,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import robustctl as rc
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 from robustctl.path import default_route
 from robustctl.pathfollow import simulate
 
@@ -34,7 +34,7 @@ lqr = rc.design("lqr", plant, Q=Q, R=R)
 
 plant2 = truck.truck_plant(0.0, doubled=True)   # G2 = [G G], alpha = u1 + u2
 Q2, R2 = truck.lqr_weights(doubled=True)
-EF, EG, mu = truck.uncertainty_from_z(truck.RLQR_MOP_Z)
+EF, EG, mu = morais2022.uncertainty_from_z(morais2022.RLQR_MOP_Z)
 rlqr = rc.design("rlqr", plant2, EF[0], EG[0], mu[0], Q=Q2, R=R2,
                  H=np.ones((4, 1)))
 

@@ -32,13 +32,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import robustctl as rc
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
 
 plant = truck.truck_plant(0.0)       # nominal, x = [ydot, psidot, rho, theta]
 Q, R = truck.lqr_weights()
 lqr = rc.design("lqr", plant, Q=Q, R=R)
 
-EF, EG, mu = truck.uncertainty_from_z(truck.RLQR_MOP_Z)
+EF, EG, mu = morais2022.uncertainty_from_z(morais2022.RLQR_MOP_Z)
 Q2, R2 = truck.lqr_weights(doubled=True)
 rlqr = rc.design("rlqr", truck.truck_plant(0.0, doubled=True),
                  EF[0], EG[0], mu[0], Q=Q2, R=R2, H=np.ones((4, 1)))
@@ -65,7 +65,7 @@ colors = {"LQR": "tab:green", "RLQR^MOP": "tab:blue", "H-infinity": "tab:red"}
 # equal ``EG``). :func:`robustctl.worst_case` searches the unit ball of the
 # norm-bounded model for the largest spectral radius: a lower bound, which
 # must stay below 1 where the margin is at least 1.
-appendix = truck.algebraic_uncertainty("printed")
+appendix = morais2022.algebraic_uncertainty("printed")
 model = rc.NormBounded(appendix.H, appendix.EF, appendix.EG[:, :1])
 vertices = [truck.truck_plant(p) for p in (100.0, 200.0, 300.0)]
 

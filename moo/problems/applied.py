@@ -34,9 +34,10 @@ import numpy as np
 
 import robustctl as rc
 from robustctl.batchsim import BACKENDS, DEFAULT_BOUND
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
+from robustctl.models.morais2022 import get_setup
 from robustctl.path import ReferencePath, default_route
-from robustctl.pathfollow import PathFollowing, PathFollowingSetup, get_setup
+from robustctl.pathfollow import PathFollowing, PathFollowingSetup
 from robustctl.validation import check_positive_scalar
 
 from ..tuning import RLQRFamily, TuningProblem
@@ -118,7 +119,7 @@ class AppliedRLQRProblem(TuningProblem):
        published code) follows the open-loop nominal truck's ``rho_ref,
        theta_ref`` with no feedforward and regulates the lateral velocity and
        yaw rate to zero, from ``[0, 0, 0.3, -0.1]``
-       (:mod:`robustctl.pathfollow`);
+       (:data:`robustctl.models.morais2022.SETUPS`);
     4. ``f_i = mean_s MSE_i(s)`` (``aggregate="mean"``) or ``max_s MSE_i(s)``
        (``"max"``), ``MSE_i(s) = (1/T) sum_k e_i[k]^2`` with ``e = x - x_ref`` of the
        objective's state, in the order ``rho, psidot, ydot, theta``.
@@ -137,14 +138,14 @@ class AppliedRLQRProblem(TuningProblem):
     setup : str or robustctl.pathfollow.PathFollowingSetup
         ``"ours"`` (default) or ``"authors"``: reference, loop, initial state,
         the default weights and reference points
-        (:data:`robustctl.pathfollow.SETUPS`; a set-up of another name gets
+        (:data:`robustctl.models.morais2022.SETUPS`; a set-up of another name gets
         the ``"ours"`` reference points unless they are given).
     Q : (4, 4) array_like, optional
         RLQR state weight. Default: the set-up's; ``"ours"``: the truck's
         Bryson's-rule weight used for every truck design of the project
         (:func:`robustctl.models.truck.lqr_weights`, ``diag(1 / [0.5, 0.1, 0.25,
         0.05]^2)``); ``"authors"``: ``diag(1, 1, 25000, 100)``
-        (:func:`robustctl.models.truck.authors_weights`).
+        (:func:`robustctl.models.morais2022.authors_weights`).
     R : (2, 2) array_like, optional
         RLQR input weight of the two steering columns. Default: the set-up's,
         ``2 r I`` with ``r`` its single-column weight (``"ours"``: ``2 / 0.1^2 I``,
@@ -228,7 +229,7 @@ class AppliedRLQRProblem(TuningProblem):
         The paper's printed ``z*`` (Section 4.5.1).
     """
 
-    paper_optimum = np.array(truck.RLQR_MOP_Z)
+    paper_optimum = np.array(morais2022.RLQR_MOP_Z)
 
     _HV_REF: ClassVar[dict[str, np.ndarray]] = {
         "ours": np.square([0.25, 0.0125, 0.15, 0.01]), "authors": np.square([0.25, 0.035, 0.35, 0.0125])}

@@ -37,7 +37,7 @@ Applied: the front, *nominal*, *RLQR^A*, *random* (``N + 3``, 95 in the paper).
   summed steering gain is the plain truck's LQR gain).
 * *random*: the RLQR of a ``z`` drawn uniformly from the problem's bounds.
 * *RLQR^A*: the RLQR with the appendix's printed algebraic uncertainty
-  (:func:`robustctl.models.truck.algebraic_uncertainty`, ``H = 1``, ``mu = 1e9``),
+  (:func:`robustctl.models.morais2022.algebraic_uncertainty`, ``H = 1``, ``mu = 1e9``),
   with the problem's ``Q``, ``R`` and ``alpha``; its ``z`` is recorded as
   ``[EF (4), EG (2), 81]`` (outside the MOP's bounds: EF, EG are negative).
 
@@ -65,9 +65,10 @@ import numpy as np
 
 import robustctl as rc
 from robustctl.batchsim import check_gains
-from robustctl.models import truck
+from robustctl.models import morais2022, truck
+from robustctl.models.morais2022 import get_setup
 from robustctl.path import ReferencePath, default_route
-from robustctl.pathfollow import PathFollowing, PathFollowingSetup, get_setup
+from robustctl.pathfollow import PathFollowing, PathFollowingSetup
 
 from .._validation import as_matrix, check_int
 from ..tuning import TuningProblem
@@ -254,7 +255,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None,
         ``sigma``; e.g. ``np.sqrt(AppliedRLQRProblem().hv_ref_point)`` weights
         the objectives by the problem's hypervolume reference point instead.
     setup : str or PathFollowingSetup
-        Loop, initial state and default scales (:data:`robustctl.pathfollow.SETUPS`).
+        Loop, initial state and default scales (:data:`robustctl.models.morais2022.SETUPS`).
 
     Returns
     -------
@@ -398,7 +399,7 @@ def build_designs(problem: TuningProblem, X_front, *, seed=None) -> DesignSet:
     labels = [str(i + 1) for i in range(N)] + ["nominal"]
     kinds = ["front"] * N + ["nominal"]
     if isinstance(problem, AppliedRLQRProblem):
-        u = truck.algebraic_uncertainty("printed")
+        u = morais2022.algebraic_uncertainty("printed")
         a = rc.rlqr_gains(problem.plant, u.EF, u.EG, np.array([u.mu]), Q=problem.Q, R=problem.R, H=u.H,
                           alpha=problem.alpha, max_iter=problem.max_iter)
         Ks.append(np.where(a.ok[:, None, None], a.K, np.nan))

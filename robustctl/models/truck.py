@@ -58,16 +58,14 @@ from dataclasses import dataclass, fields
 import numpy as np
 import scipy.linalg
 
-from .._validation import as_batch, check_choice, check_positive_scalar
+from .._validation import as_batch, check_positive_scalar
 from ..plant import Plant, _frozen
 
 __all__ = [
     "TruckParameters", "PAPER_PARAMETERS", "STATE_NAMES", "STATE_UNITS", "OBJECTIVE_STATES",
     "STEER_LIMIT", "continuous_model", "truck_plant", "discretise", "steady_state_cornering",
-    "reference_states", "AlgebraicUncertainty", "algebraic_uncertainty", "uncertainty_from_z",
-    "RLQR_MOP_Z", "PRINTED_EF", "PRINTED_EG", "PRINTED_LOG10_MU_SQ", "check_overload",
+    "reference_states", "AlgebraicUncertainty", "algebraic_uncertainty", "check_overload",
     "MAX_ERRORS", "MAX_STEER", "lqr_weights", "DOUBLED_INPUT_MAP", "open_loop_reference",
-    "AUTHORS_Q_DIAG", "AUTHORS_R_DOUBLED", "AUTHORS_X0", "CODE_EG", "authors_weights",
 ]
 
 #: State names, in the model's order.
@@ -80,14 +78,6 @@ STEER_LIMIT = 0.45
 #: Input map of the doubled steering column: the steering angle is ``alpha = u1 + u2``
 #: (``input_map`` of :func:`robustctl.pathfollow.simulate`).
 DOUBLED_INPUT_MAP = ((1.0, 1.0),)
-
-#: RLQR^A uncertainty as printed in the paper (Section 4.5, after Eq. 18).
-PRINTED_EF = (6.85718e-4, -8.62010e-4, 0.0, -6.6666e-3)
-PRINTED_EG = (-6.66666e-3, -6.66666e-3)
-PRINTED_LOG10_MU_SQ = 81.0
-#: RLQR^MOP decision vector z* printed in Section 4.5.2.1: [EF (4), EG (2), (log10 mu)^2].
-RLQR_MOP_Z = (4.45032, 57.84300, 21.90069, 455.67736, 48.05012, 44.98551, 280.28421)
-
 
 @dataclass(frozen=True)
 class TruckParameters:
@@ -401,9 +391,11 @@ class AlgebraicUncertainty:
     EG : (1, 2) ndarray
         For the doubled steering column.
     mu : float
-        Penalty parameter (``(log10 mu)^2 = 81``, i.e. ``mu = 1e9``).
+        Penalty parameter (the appendix's ``(log10 mu)^2 = 81``, i.e. ``mu = 1e9``).
     source : str
-        ``"printed"`` or ``"computed"``.
+        ``"computed"`` (from the model, :func:`algebraic_uncertainty`) or
+        ``"printed"`` (the paper's values,
+        :func:`robustctl.models.morais2022.algebraic_uncertainty`).
     """
 
     H: np.ndarray
@@ -418,40 +410,41 @@ class AlgebraicUncertainty:
                     f"EG={self.EG.ravel()}, H={self.H.ravel()}, mu={self.mu:.3g})")
 
 
-def algebraic_uncertainty(source: str = "printed", *, params: TruckParameters | None = None
-                          ) -> AlgebraicUncertainty:
-    """``H``, ``EF``, ``EG`` and ``mu`` of RLQR^A (Appendix A of the paper).
+def algebraic_uncertainty(*, mu: float = 1e9, params: TruckParameters | None = None) -> AlgebraicUncertainty:
+    """``H``, ``EF``, ``EG`` of RLQR^A computed from the model by the rule of the paper's Appendix A.
 
-    ``source="computed"`` follows the appendix: with ``F_min, G_min`` the
-    discretised model of the unloaded vehicle (mass ``m``) and ``F_max, G_max``
-    that at 100 % overload (``m + 2 payload``),
+    With ``F_min, G_min`` the discretised model of the unloaded vehicle (mass
+    ``m``) and ``F_max, G_max`` that at 100 % overload (``m + 2 payload``),
     ``Gamma_F = F_min - F_max``, ``Gamma_G = G_min - G_max``; the first row
     (lateral velocity, the one most affected by the mass) gives
     ``EF = [1, 1, 1, 0.1] .* Gamma_F[0, :]`` and
     ``EG = [0.1, 0.1] .* [Gamma_G[0], Gamma_G[0]]`` (the doubled column; the
     appendix's Eq. for E_G weights both entries by 0.1), ``H = [1, 1, 1, 1]^T``.
-    With our model ``Gamma_F[0, 2] = Gamma_F[0, 3] = 0`` (lateral velocity does
+    With this model ``Gamma_F[0, 2] = Gamma_F[0, 3] = 0`` (lateral velocity does
     not depend on ``rho`` or ``theta``), so EF has zeros there.
 
-    ``source="printed"`` returns the values the paper prints, which do not
-    follow from its own parameters (its ``EF[3] = -6.67e-3`` cannot arise from
-    Eq. 1): ``EF = [6.85718e-4, -8.62010e-4, 0, -6.6666e-3]``,
-    ``EG = [-6.66666e-3, -6.66666e-3]``. Both use ``(log10 mu)^2 = 81``.
+    Parameters
+    ----------
+    mu : float
+        The RLQR penalty parameter returned with them (the appendix's
+        ``(log10 mu)^2 = 81``, ``mu = 1e9``, by default).
+    params : TruckParameters, optional
+        Defaults to the model's reference vehicle.
+
+    Returns
+    -------
+    AlgebraicUncertainty
+        ``source = "computed"``. The values the paper prints instead are
+        :func:`robustctl.models.morais2022.algebraic_uncertainty`.
     """
-    check_choice(source, "source", ("printed", "computed"))
-    H = np.ones((4, 1))
-    mu = 10.0 ** np.sqrt(PRINTED_LOG10_MU_SQ)
-    if source == "printed":
-        EF = np.array([PRINTED_EF])
-        EG = np.array([PRINTED_EG])
-    else:
-        p = _params(params)
-        F, G, _ = _discrete_batch(p, np.array([0.0, 2.0]))
-        gF = F[0] - F[1]
-        gG = G[0] - G[1]
-        EF = (np.array([1.0, 1.0, 1.0, 0.1]) * gF[0])[None, :]
-        EG = (np.array([0.1, 0.1]) * gG[0, 0])[None, :]
-    return AlgebraicUncertainty(_frozen(H), _frozen(EF), _frozen(EG), float(mu), source)
+    mu = check_positive_scalar(mu, "mu")
+    p = _params(params)
+    F, G, _ = _discrete_batch(p, np.array([0.0, 2.0]))
+    gF = F[0] - F[1]
+    gG = G[0] - G[1]
+    EF = (np.array([1.0, 1.0, 1.0, 0.1]) * gF[0])[None, :]
+    EG = (np.array([0.1, 0.1]) * gG[0, 0])[None, :]
+    return AlgebraicUncertainty(_frozen(np.ones((4, 1))), _frozen(EF), _frozen(EG), float(mu), "computed")
 
 
 #: Acceptable errors of Bryson's rule: ydot 0.5 m/s, psidot 0.1 rad/s (5.7 deg/s),
@@ -479,67 +472,3 @@ def lqr_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
     Q = np.diag(1.0 / np.square(MAX_ERRORS))
     r = 1.0 / MAX_STEER**2
     return Q, (2.0 * r * np.eye(2) if doubled else np.array([[r]]))
-
-
-#: State weight of the authors' published code (Barbosa et al. 2019, GitHub
-#: ``barbosafilipe/robust_lqr``, ``standard_formulation/parameters.m`` and
-#: ``alternative_formulation/model.m``: ``Q = diag(1, 1, 1, 1, 25000, 100)`` on
-#: the articulated truck's six states), on ``[ydot, psidot, rho, theta]``.
-AUTHORS_Q_DIAG = (1.0, 1.0, 25000.0, 100.0)
-#: The code's input weight on the doubled steering column, ``R = 67070 I2`` (same files).
-AUTHORS_R_DOUBLED = 67070.0
-#: The code's initial state (same files: ``x0 = [0; 0; 0; 0; 0.3; -0.1]``): 0.3 m
-#: left of the path, heading -0.1 rad, velocities zero; ``[ydot, psidot, rho, theta]``.
-AUTHORS_X0 = (0.0, 0.0, 0.3, -0.1)
-#: RLQR^A's ``E_G`` in the code (``standard_formulation/parameters.m``,
-#: ``alternative_formulation/model.m``: ``Eg = [-0.0666666666666667 -0.0066666666666667]``,
-#: ``[-1/15, -1/150]`` to the 16 digits printed); the paper prints two equal entries, :data:`PRINTED_EG`.
-CODE_EG = (-0.0666666666666667, -0.0066666666666667)
-
-
-def authors_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """The weights of the authors' published code: ``Q = diag(1, 1, 25000, 100)``, ``R = 67070 I2``.
-
-    From Barbosa et al. (2019)'s code (GitHub ``barbosafilipe/robust_lqr``,
-    ``standard_formulation/parameters.m``, ``alternative_formulation/model.m``),
-    whose RLQR and H-infinity designs both use them; 25000 weighs the lateral
-    displacement ``rho``, 100 the orientation ``theta``, 1 the velocities (the
-    code's articulation states are dropped). ``R = 67070 I2`` is on the doubled
-    steering column; on the plain truck (``doubled=False``) the equivalent
-    weight is ``67070 / 2 = 33535``: the cheapest split of a steering angle
-    ``alpha`` is ``u1 = u2 = alpha/2`` at a cost ``67070 alpha^2 / 2`` (the rule
-    of :func:`lqr_weights`).
-
-    Returns
-    -------
-    Q : (4, 4) ndarray
-    R : (1, 1) or (2, 2) ndarray
-    """
-    Q = np.diag(AUTHORS_Q_DIAG)
-    return Q, (AUTHORS_R_DOUBLED * np.eye(2) if doubled else np.array([[AUTHORS_R_DOUBLED / 2.0]]))
-
-
-def uncertainty_from_z(z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Decode the applied MOP's decision vectors ``z = [EF (4), EG (2), (log10 mu)^2]``.
-
-    Parameters
-    ----------
-    z : (7,) or (B, 7) array_like
-        ``z[6] = (log10 mu)^2 >= 0``, so ``mu = 10**sqrt(z[6])`` (the sign of
-        ``log10 mu`` is taken positive, ``mu >= 1``).
-
-    Returns
-    -------
-    EF : (B, 1, 4) ndarray
-    EG : (B, 1, 2) ndarray
-    mu : (B,) ndarray
-        With ``H = ones((4, 1))`` they define the RLQR design on the
-        doubled-column plant (``truck_plant(doubled=True)``). A single z gives B = 1.
-    """
-    Z = np.asarray(z, dtype=float) if not isinstance(z, (str, bytes)) else None
-    if Z is None:
-        raise TypeError("z must be an array of numbers, got str")
-    Z = as_batch(Z[None] if Z.ndim == 1 else Z, "z", (None, 7), ("", "EF (4), EG (2), (log10 mu)^2"))
-    if np.any(Z[:, 6] < 0):
-        raise ValueError(f"z[6] = (log10 mu)^2 must be >= 0, got {Z[:, 6].min():g}")
-    return Z[:, None, :4].copy(), Z[:, None, 4:6].copy(), 10.0 ** np.sqrt(Z[:, 6])
