@@ -17,8 +17,8 @@ expect; each is loaded on first use, so ``import moo`` stays cheap:
 ``moo.run``               :func:`moo.runner.run`: one MOEA run
 ``moo.run_experiment``    :func:`moo.experiment.run_experiment`: a resumable grid
 ``moo.analyse``           :func:`moo.stats.analyse`: the paper's statistics
-``moo.make_algorithm``    :func:`moo.algorithms.make_algorithm` (``moo.ALGORITHMS``)
-``moo.make_problem``      :func:`moo.problems.make_problem` (``moo.PROBLEMS``)
+``moo.make_algorithm``    :func:`moo.algorithms.make_algorithm` (names: ``moo.algorithms.ALGORITHMS``)
+``moo.make_problem``      :func:`moo.problems.make_problem` (names: ``moo.problems.PROBLEMS``)
 ``moo.hypervolume``       :func:`moo.indicators.hypervolume` (and ``moo.igd``)
 ========================  =====================================================
 
@@ -37,19 +37,18 @@ _EXPORTS = {
     "tune": "moo.tuning", "TuningProblem": "moo.tuning", "TuningResult": "moo.tuning",
     "RLQRFamily": "moo.tuning", "LQRFamily": "moo.tuning",
     "run": "moo.runner", "run_experiment": "moo.experiment", "analyse": "moo.stats",
-    "make_algorithm": "moo.algorithms", "ALGORITHMS": "moo.algorithms",
-    "make_problem": "moo.problems", "PROBLEMS": "moo.problems",
+    "make_algorithm": "moo.algorithms", "make_problem": "moo.problems",
     "hypervolume": "moo.indicators", "igd": "moo.indicators",
 }
 
 __all__ = ["tune", "TuningProblem", "TuningResult", "RLQRFamily", "LQRFamily", "run", "run_experiment", "analyse",
-           "make_algorithm", "ALGORITHMS", "make_problem", "PROBLEMS", "hypervolume", "igd"]
+           "make_algorithm", "make_problem", "hypervolume", "igd"]
 
 if TYPE_CHECKING:
-    from .algorithms import ALGORITHMS, make_algorithm
+    from .algorithms import make_algorithm
     from .experiment import run_experiment
     from .indicators import hypervolume, igd
-    from .problems import PROBLEMS, make_problem
+    from .problems import make_problem
     from .runner import run
     from .stats import analyse
     from .tuning import LQRFamily, RLQRFamily, TuningProblem, TuningResult, tune

@@ -515,9 +515,9 @@ def prepare(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: 
             n_obj: int | None = None, base_seed: int = 0, pop_size: int = POP_SIZE,
             max_leaders: int | None = None, variants: Sequence[bool] = (False, True),
             setup: str | None = None) -> PreparedExperiment:
-    """Check the grid of :func:`plan`, create ``out`` and find the runs already recorded there.
+    """Check the grid of :func:`~moo.experiment.plan`, create ``out`` and find the runs already recorded there.
 
-    Every check happens here, before any run: the arguments of :func:`plan`,
+    Every check happens here, before any run: the arguments of :func:`~moo.experiment.plan`,
     the budget against each algorithm's population (the problem is built
     once), ``out`` (a directory that can be written, not locked by another
     writer), the directory's settings (``settings.json``, or for a directory
@@ -569,9 +569,9 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
                    max_leaders: int | None = None, variants: Sequence[bool] = (False, True),
                    workers: int = 1, executor: Executor | None = None, keep_going: bool = False,
                    progress: bool | None = None, setup: str | None = None) -> ExperimentReport:
-    """Run the grid of :func:`plan` into ``out``, skipping runs already recorded.
+    """Run the grid of :func:`~moo.experiment.plan` into ``out``, skipping runs already recorded.
 
-    Parameters are those of :func:`plan`, plus:
+    Parameters are those of :func:`~moo.experiment.plan`, plus:
 
     out : path-like
         Results directory (created if needed).

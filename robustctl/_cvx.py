@@ -35,7 +35,7 @@ from .errors import ConvergenceError, InfeasibleError
 if TYPE_CHECKING:  # cvxpy itself is imported on first use
     import cvxpy as cp
 
-__all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "value", "totals", "SOLVER_TOL"]
+__all__ = ["LMI", "SolveReport", "solve_sdp", "check_solver", "certificate", "value", "totals", "SOLVER_TOL"]
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati

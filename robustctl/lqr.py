@@ -219,7 +219,7 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     ------
     NotStabilizableError
         ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`,
-        on the plant with ``F`` balanced, :func:`check_stabilizable_balanced`);
+        on the plant with ``F`` balanced, ``check_stabilizable_balanced``);
         ``rlqr``, ``hinf`` and ``h2`` raise the same (it is also an ``InfeasibleError``).
     ConvergenceError
         No backend finds the stabilising solution of the Riccati equation,

@@ -240,6 +240,19 @@ def _import_dotted(full: str):
     return None
 
 
+def _documented_as(target: str) -> str | None:
+    """The documented name of a full name of ours that is not it (``moo.runner.run`` -> ``moo.run``,
+    ``moo.tuning.TuningResult.select`` -> ``moo.TuningResult.select``), or None."""
+    parts = target.split(".")
+    if parts[0] not in PACKAGES:
+        return None
+    for split in range(len(parts), 1, -1):
+        obj = _import_dotted(".".join(parts[:split]))
+        if obj is not None and id(obj) in _DOCUMENTED:
+            return ".".join([_DOCUMENTED[id(obj)], *parts[split:]])
+    return None
+
+
 def _name_of(obj) -> str | None:
     """Where ``obj`` is documented: our page, or the other project's public path."""
     if id(obj) in _DOCUMENTED:
@@ -255,16 +268,18 @@ def _missing_reference(app, env, node, contnode):
     if node.get("refdomain") != "py" or node.get("refspecific"):
         return None
     target = node["reftarget"]
-    if target.split(".")[0] in PACKAGES and (named := _import_dotted(target)) is not None \
-            and id(named) in _DOCUMENTED:
-        base = _DOCUMENTED[id(named)]       # a full name other than the one it is documented under
-    else:
+    if (base := _documented_as(target)) is None:
         obj = _documented_object(node.get("refdoc", ""))
         module = obj if inspect.ismodule(obj) else sys.modules.get(getattr(obj, "__module__", "") or "")
         if module is None or not target or target.startswith("_"):
             return None
         head, *rest = target.split(".")
-        if head not in vars(module) or (owner := _name_of(vars(module)[head])) is None:
+        if head not in vars(module):
+            return None
+        owner = _name_of(vars(module)[head])
+        if owner is None and head in getattr(module, "__all__", ()):
+            owner = f"{module.__name__}.{head}"          # data are documented where listed
+        if owner is None:
             return None
         base = ".".join([owner, *rest])
     if base == target:

@@ -66,7 +66,7 @@ _MAX_DTLZ_OBJ = 15
 _WFG = {f"wfg{i}": getattr(wfg, f"WFG{i}") for i in range(1, 10)}
 _WFG_L = 20
 
-#: Every name :func:`make_problem` accepts.
+#: Every name :func:`~moo.problems.make_problem` accepts.
 PROBLEMS: tuple[str, ...] = (*_CONTROL, *_ZDT, *_DTLZ, *_WFG)
 
 #: Relative margin of the ZDT/DTLZ reference points beyond the nadir.
