@@ -114,6 +114,7 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -122,6 +123,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
+from scipy.linalg import lapack
 
 from . import _cvx, _hinfnorm
 from ._validation import as_batch, as_float_array, as_matrix, as_rng, check_int, check_performance, check_spd
@@ -745,8 +747,14 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
     return RobustStabilityBatch(_frozen(margin), _ro(reason), "norm-bounded", certify)
 
 
-def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
-    """One gain: what :func:`_norm_bounded_batch` does for a stack, on 2-D arrays (less overhead)."""
+def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
+                            norm: str = "auto") -> RobustStability:
+    """One gain: what :func:`_norm_bounded_batch` does for a stack, on 2-D arrays (less overhead).
+
+    ``norm`` chooses the H-infinity norm (:func:`robustctl._hinfnorm.norm_one`):
+    SLICOT AB13DD when slycot is installed (``"auto"``) or the level-set
+    iteration of :mod:`robustctl._hinfnorm` (``"level-set"``).
+    """
     discrete = plant.is_discrete
     n = plant.n
     A = plant.F + plant.G @ K
@@ -756,29 +764,30 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     if not nominal < ((1.0 - STABILITY_MARGIN) if discrete else -STABILITY_MARGIN):
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
                                MappingProxyType({"nominal_radius": nominal}))
-    g, peak, iterations, h2 = _hinfnorm.hinf_norm_one(A, H, E, lam, discrete=discrete)
-    margin = 1.0 / g if g > 0 else np.inf
+    g, peak, iterations, h2, method = _hinfnorm.norm_one(A, H, E, lam, discrete=discrete, method=norm)
+    margin = 1.0 / g if g > 0 else math.inf
     r = 1.0 if margin > 1.0 else margin / (1.0 + _BACKOFF)
-    Hr = r * H
     gr = r * g
-    gam = np.sqrt(0.5 * (1.0 + gr * gr))
-    hn2, en2 = float((Hr * Hr).sum()), float((E * E).sum())
+    gam = math.sqrt(0.5 * (1.0 + gr * gr))
+    hn2, en2 = r * r * float(np.vdot(H, H)), float(np.vdot(E, E))
     c = (en2 / hn2) ** 0.25 if hn2 > 0 and en2 > 0 else 1.0
-    Hb, Eb = Hr * c, E / c
-    if h2 == 0.0:   # the norm did not evaluate the resolvent (E = 0): do it at the peak
+    Hb, Eb = (r * c) * H, E / c
+    if h2 == 0.0:   # the norm did not evaluate the resolvent (AB13DD, or E = 0): do it at the peak
         z = np.exp(1j * peak) if discrete else 1j * peak
-        X = _hinfnorm.solve((z * _hinfnorm.eye(n) - A)[None], H.astype(complex)[None])[0]
-        h2 = float((X.real ** 2 + X.imag ** 2).sum())
+        _, _, X, info = lapack.zgesv(z * _hinfnorm.eye(n) - A, H)
+        h2 = float(np.vdot(X, X).real) if info == 0 else 0.0
     h2 *= (r * c) ** 2   # ||(zI - A)^-1 H_b||_F^2 at the peak
     eps = min((gam * gam - gr * gr) / (4.0 * h2 if h2 > 0 else 1.0), max(1.0, en2 / c**2))
     best: tuple = (-np.inf, None, {})
     path = None
+    Ea = np.empty((Eb.shape[0] + n, n))
+    Ea[:Eb.shape[0]] = Eb
     for _ in range(_EPS_TRIES):
-        Ea = np.concatenate([Eb, np.sqrt(eps) * _hinfnorm.eye(n)], axis=0)
+        Ea[Eb.shape[0]:] = math.sqrt(eps) * _hinfnorm.eye(n)
         Pt = _hinfnorm.riccati_one(A, Hb, Ea, gam, discrete=discrete)
         if Pt is not None:
-            P = c * c * Pt
-            score, cert = _verify_one(_stability_blocks_fast(A, Hr, E, P, discrete))
+            P = (c * c) * Pt
+            score, cert = _certify_one(A, r * H, E, P, discrete)
             if score > best[0]:
                 best = (score, P, cert)
             if score > _STRICT:
@@ -791,15 +800,41 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
         except (InfeasibleError, ConvergenceError):
             res = None
         if res is not None and res.P is not None:
-            score, cert = _verify_one(_stability_blocks_fast(A, Hr, E, res.P, discrete))
+            score, cert = _verify_one(_stability_blocks_fast(A, r * H, E, res.P, discrete))
             if score > _STRICT or best[1] is None:
                 best = (score, res.P, cert)
                 path = "sdp" if score > _STRICT else None
     score, P, cert = best
-    info = {"path": path, "nominal_radius": nominal, "norm_iterations": iterations}
-    return RobustStability(bool(path is not None and r == 1.0), float(margin), float(r),
-                           None if P is None else _frozen(P), MappingProxyType(cert), "norm-bounded",
+    if P is not None:
+        P.flags.writeable = False
+    info = {"path": path, "nominal_radius": nominal, "norm_iterations": iterations, "norm": method}
+    return RobustStability(path is not None and r == 1.0, margin, r, P, MappingProxyType(cert), "norm-bounded",
                            MappingProxyType(info))
+
+
+def _certify_one(A, Hr, E, P, discrete: bool) -> tuple[float, dict[str, float]]:
+    """:func:`_verify_one` of :func:`_stability_blocks_fast` (``P`` symmetric), with fewer small array operations."""
+    n, p = A.shape[0], Hr.shape[1]
+    M = np.empty((n + p, n + p))
+    if discrete:
+        PA, PH = P @ A, P @ Hr
+        M[:n, :n] = P - A.T @ PA - E.T @ E
+        M[n:, :n] = -(Hr.T @ PA)
+        M[n:, n:] = _hinfnorm.eye(p) - Hr.T @ PH
+    else:
+        PA = P @ A
+        M[:n, :n] = -(PA + PA.T) - E.T @ E
+        M[n:, :n] = -(Hr.T @ P)
+        M[n:, n:] = _hinfnorm.eye(p)
+    score, cert = np.inf, {}
+    for key, S in (("P", P), ("lyapunov", M)):   # dsyevd reads the lower triangle
+        w, _, info = lapack.dsyevd(S, compute_v=0, lower=1)
+        if info != 0:
+            w = np.linalg.eigvalsh(S)
+        lo, hi = float(w[0]), float(w[-1])
+        cert[key] = lo
+        score = min(score, lo / max(1.0, abs(lo), abs(hi)))
+    return score, cert
 
 
 def _stability_blocks_fast(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
