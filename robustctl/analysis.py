@@ -150,6 +150,8 @@ _POLY_RMAX = 1e3
 _POLY_STEPS = 60
 # Riccati certificate: tries of the regularisation eps (each 100 times smaller) before the SDP.
 _EPS_TRIES = 3
+# One loop: state size from which the Riccati certificate is tried by the doubling algorithm first.
+_SDA_MIN_N = 14
 # Worst-case search: projected-gradient iterations per start.
 _ASCENT_ITER = 200
 
@@ -779,13 +781,19 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
     h2 *= (r * c) ** 2   # ||(zI - A)^-1 H_b||_F^2 at the peak
     eps = min((gam * gam - gr * gr) / (4.0 * h2 if h2 > 0 else 1.0), max(1.0, en2 / c**2))
     best: tuple = (-np.inf, None, {})
-    path = None
+    path = solver = None
     Ea = np.empty((Eb.shape[0] + n, n))
     Ea[:Eb.shape[0]] = Eb
+    solvers = ("doubling", "eigenvectors") if n >= _SDA_MIN_N else ("eigenvectors",)
     for _ in range(_EPS_TRIES):
         Ea[Eb.shape[0]:] = math.sqrt(eps) * _hinfnorm.eye(n)
-        Pt = _hinfnorm.riccati_one(A, Hb, Ea, gam, discrete=discrete)
-        if Pt is not None:
+        for solver in solvers:
+            if solver == "doubling":
+                Pt = _hinfnorm.riccati_doubling(A, Hb, Ea, gam, lam, discrete=discrete)
+            else:
+                Pt = _hinfnorm.riccati_one(A, Hb, Ea, gam, discrete=discrete)
+            if Pt is None:
+                continue
             P = (c * c) * Pt
             score, cert = _certify_one(A, r * H, E, P, discrete)
             if score > best[0]:
@@ -793,6 +801,8 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
             if score > _STRICT:
                 path = "riccati"
                 break
+        if path is not None:
+            break
         eps *= 1e-2
     if path is None:   # rare: the SDP
         try:
@@ -807,7 +817,8 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
     score, P, cert = best
     if P is not None:
         P.flags.writeable = False
-    info = {"path": path, "nominal_radius": nominal, "norm_iterations": iterations, "norm": method}
+    info = {"path": path, "nominal_radius": nominal, "norm_iterations": iterations, "norm": method,
+            "riccati": solver if path == "riccati" else None}
     return RobustStability(path is not None and r == 1.0, margin, r, P, MappingProxyType(cert), "norm-bounded",
                            MappingProxyType(info))
 
