@@ -55,13 +55,19 @@ The margin is the small-gain value ``1 / ||E (zI - A)^-1 H||_inf``,
 computed by a level-set H-infinity norm (Bruinsma & Steinbuch 1990;
 imaginary-axis eigenvalues of a Hamiltonian, the discrete case through a
 bilinear transform; :mod:`robustctl._hinfnorm`) to ``2e-10`` relative, on
-the whole stack of gains at once. The certificate ``P`` at the radius
+the whole stack of gains at once. One gain per call uses SLICOT's AB13DD
+(the same algorithm with a structure-preserving Hamiltonian eigensolver,
+through slycot) when slycot is installed, the level-set iteration without
+it (``info["norm"]``: ``"ab13dd"`` or ``"level-set"``). The certificate ``P`` at the radius
 ``r`` (1 if the margin exceeds 1, else ``margin / (1 + 1e-3)``) is the
 stabilising solution of the bounded-real Riccati equation of
 ``(A, r H, [E; sqrt(eps) I])`` at the level ``gamma`` with
 ``gamma^2 = (1 + (r / margin)^2) / 2``: between the norm of the scaled loop
 and 1, so that the LMI is strictly feasible (its Schur complement is at
-least ``eps I``). It is verified like any other certificate (eigenvalues of
+least ``eps I``); for one gain of state size 14 or more it is computed by the
+structure-preserving doubling algorithm (``n x n`` matrices only; Chu, Fan &
+Lin 2005), with the Hamiltonian's eigenvectors as the fallback
+(``info["riccati"]``). It is verified like any other certificate (eigenvalues of
 the LMI blocks at ``P`` in the plant's coordinates); only a design whose
 Riccati certificate fails that check goes to the SDP below (``info["path"]``
 says which: ``"riccati"`` or ``"sdp"``). Polytopes always use the SDP.
@@ -197,8 +203,12 @@ class RobustStability:
     info : Mapping
         ``"nominal_radius"`` (spectral radius or abscissa of ``F + G K``);
         norm-bounded: ``"path"`` (``"riccati"`` or ``"sdp"``: which
-        computation certified ``P``; None if neither passed the check) and
-        ``"norm_iterations"`` (level-set steps); polytope: solver
+        computation certified ``P``; None if neither passed the check),
+        ``"norm"`` (``"ab13dd"`` or ``"level-set"``: which computed the
+        H-infinity norm), ``"norm_iterations"`` (level-set steps; 0 for
+        AB13DD) and ``"riccati"`` (``"doubling"`` or ``"eigenvectors"``:
+        how the certifying Riccati solution was computed; None if the
+        Riccati path did not certify); polytope: solver
         diagnostics (``solve_time``, ``iterations``, ``solves``).
     """
 
@@ -255,6 +265,7 @@ class RobustStabilityBatch:
         ``"path"``: (B,) str ndarray, which computation certified ``P[b]``
         (``"riccati"``, ``"sdp"``; ``""`` where there is no verified ``P``);
         ``"nominal_radius"``: (B,) spectral radius (abscissa) of ``F + G K``;
+        ``"norm"``: ``"level-set"`` (the batched H-infinity norm);
         ``"norm_iterations"``: level-set steps of the H-infinity norm;
         ``"sdp_solves"``: designs that needed the SDP.
     """
@@ -741,8 +752,8 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
                 for key in cs:
                     cert[key][idx] = cs[key]
                 certified[idx] = ok & (r == 1.0)
-        info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
-                "sdp_solves": sdp}
+        info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm": "level-set",
+                "norm_iterations": iterations, "sdp_solves": sdp}
         return (_ro(certified), _frozen(radius), _frozen(P), MappingProxyType({k: _frozen(v) for k, v in cert.items()}),
                 MappingProxyType(info))
 
