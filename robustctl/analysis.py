@@ -139,7 +139,7 @@ from .plant import Plant, _frozen, check_vertices
 from .stability import STABILITY_MARGIN, is_stable, spectral_abscissa, spectral_radius
 from .uncertainty import NormBounded, check_norm_bounded
 
-__all__ = ["RobustStability", "RobustStabilityBatch", "CostBound", "HinfBound", "WorstCase",
+__all__ = ["RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase",
            "robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case"]
 
 # Regularisation (relative to the weight's norm) of the Lyapunov equation defining the coordinates.
@@ -156,6 +156,9 @@ _POLY_RMAX = 1e3
 _POLY_STEPS = 60
 # Riccati certificate: tries of the regularisation eps (each 100 times smaller) before the SDP.
 _EPS_TRIES = 3
+# Batched guaranteed cost: a Riccati solution counts when the LMI's smallest eigenvalue is at least
+# -_COST_LMI_TOL times its largest (rounding of a boundary point).
+_COST_LMI_TOL = 1e-9
 # One loop: state size from which the Riccati certificate is tried by the doubling algorithm first.
 _SDA_MIN_N = 14
 # Worst-case search: projected-gradient iterations per start.
@@ -353,6 +356,58 @@ class CostBound:
     def __repr__(self) -> str:
         x0 = "given" if self.x0 is not None else "worst unit"
         return f"CostBound(bound={self.bound:.6g}, multiplier={self.multiplier:.6g}, x0={x0!r})"
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class CostBoundBatch:
+    """Guaranteed LQ costs of a stack of gains ``K`` (B, m, n) on one plant (:func:`guaranteed_cost`).
+
+    Design ``b`` gets the bound of :class:`CostBound` (computed by Riccati
+    equations and a search over the multiplier instead of an SDP), as
+    entries of arrays.
+
+    Attributes
+    ----------
+    bound : (B,) ndarray
+        ``x0' P x0``, or ``lambda_max(P)`` when ``x0`` is not given; ``inf``
+        where no bound exists (``reason`` says why), ``nan`` where ``K[b]``
+        has a non-finite entry.
+    P : (B, n, n) ndarray
+        Quadratic cost bounds ``V(x) = x'Px`` (NaN where there is none).
+    multiplier : (B,) ndarray
+        S-procedure multiplier ``lam`` (0 where the uncertainty does not reach the loop).
+    reason : (B,) str ndarray
+        ``"ok"``, ``"unstable"`` (``F + G K`` is not stable), ``"not robustly
+        stable"`` (``||E (zI - A)^-1 H||_inf >= 1``: no bound exists) or
+        ``"not finite"``.
+    x0 : (n,) ndarray or None
+    certificate : Mapping[str, (B,) ndarray]
+        Smallest eigenvalue of each LMI block at ``(P, lam)`` in the plant's
+        coordinates: ``"cost"`` (the guaranteed-cost LMI) and ``"P"``
+        (``>= 0`` up to rounding: ``P`` solves the Riccati equation, on the
+        boundary of the LMI, as the SDP's optimum is).
+    info : Mapping
+        ``"path"``: ``"riccati"``; ``"search_steps"``: golden-section steps
+        of the multiplier search; ``"riccati_failures"``: designs whose
+        Riccati solution failed at the optimal multiplier (bound ``inf``).
+    """
+
+    bound: np.ndarray
+    P: np.ndarray
+    multiplier: np.ndarray
+    reason: np.ndarray
+    x0: np.ndarray | None
+    certificate: Mapping[str, np.ndarray]
+    info: Mapping[str, Any] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return self.bound.shape[0]
+
+    def __repr__(self) -> str:
+        ok = self.reason == "ok"
+        x0 = "given" if self.x0 is not None else "worst unit"
+        return (f"CostBoundBatch(B={len(self)}, ok={int(ok.sum())}, x0={x0!r}, "
+                f"largest bound={_fmt(float(self.bound[ok].max()) if ok.any() else None)})")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -1102,8 +1157,154 @@ def _multiplier(lam, p: int, c: float) -> float:
     return float(_cvx.value(lam)) / c**2 if p else 0.0
 
 
+def _psd_factor(M: np.ndarray) -> np.ndarray:
+    """``L`` with ``L'L = M`` for a symmetric positive semidefinite ``M`` (rows ``sqrt(w_i) v_i'``)."""
+    w, V = np.linalg.eigh(M)
+    return np.sqrt(np.clip(w, 0.0, None))[:, None] * V.T
+
+
+def _cost_objective(P: np.ndarray, x0: np.ndarray | None) -> np.ndarray:
+    """``x0' P x0`` or ``lambda_max(P)`` of a stack."""
+    if x0 is not None:
+        return np.einsum("i,bij,j->b", x0, P, x0)
+    return np.linalg.eigvalsh(0.5 * (P + P.mT))[:, -1]
+
+
+def _cost_lmi_eigs(A, H, E, QK, P, lam, discrete: bool) -> np.ndarray:
+    """Eigenvalues (S, n + p), ascending, of the guaranteed-cost LMI at ``(P, lam)`` for stacks."""
+    S, n = A.shape[0], A.shape[-1]
+    p = H.shape[-1]
+    AH = np.concatenate([A, np.broadcast_to(H, (S, n, p))], axis=-1)
+    if discrete:
+        M = -(AH.mT @ P @ AH)
+        M[:, :n, :n] += P
+    else:
+        Sx = P @ AH
+        M = np.zeros((S, n + p, n + p))
+        M[:, :n, :] = -Sx
+        M[:, :, :n] -= Sx.mT
+    M[:, :n, :n] -= QK + lam[:, None, None] * (E.mT @ E)
+    M[:, n:, n:] += lam[:, None, None] * np.eye(p)
+    return np.linalg.eigvalsh(0.5 * (M + M.mT))
+
+
+def _guaranteed_cost_batch(plant: Plant, K: np.ndarray, unc: NormBounded, Q: np.ndarray, R: np.ndarray,
+                           x0: np.ndarray | None) -> CostBoundBatch:
+    """:func:`guaranteed_cost` of a stack of gains by Riccati equations and a search over the multiplier.
+
+    For a fixed ``lam`` the smallest ``P`` of the guaranteed-cost LMI is the
+    stabilising solution ``P_lam`` of the bounded-real Riccati equation of
+    ``(A, H, C_lam)`` at the level ``sqrt(lam)``, ``C_lam'C_lam = Q_K + lam
+    E'E`` (the LMI's Schur complement at equality); both objectives grow
+    with ``P``, so the bound is ``min over lam`` of ``f(lam) = x0'P_lam x0``
+    (or ``lambda_max(P_lam)``), a convex function (the partial minimum of the
+    convex SDP) on ``lam > lam*``. With ``q = ||C_Q (zI - A)^-1 H||_inf``
+    (``C_Q'C_Q = Q_K``) and ``g = ||E (zI - A)^-1 H||_inf < 1``,
+    ``q^2 <= lam* <= q^2 / (1 - g^2)``; from ``P_lam >= P_Q + lam P_E``
+    (Lyapunov solutions of ``Q_K`` and ``E'E``) the minimiser is at most
+    ``(f(lam_1) - f_Q) / f_E`` for any feasible ``lam_1``. A golden-section
+    search on ``log lam`` over that bracket, all designs at once (one
+    batched Riccati solve per step), finds it.
+    """
+    discrete = plant.is_discrete
+    B, n = K.shape[0], plant.n
+    finite = np.isfinite(K).all(axis=(1, 2))
+    Kf = np.where(finite[:, None, None], K, 0.0)
+    A = plant.F + plant.G @ Kf
+    E = unc.EF + unc.EG @ Kf
+    H = unc.H
+    lam_A = _hinfnorm.eigvals(A)
+    if discrete:
+        stable = np.abs(lam_A).max(axis=1) < 1.0 - STABILITY_MARGIN
+    else:
+        stable = lam_A.real.max(axis=1) < -STABILITY_MARGIN
+    stable &= finite
+    reason = np.where(finite, np.where(stable, "ok", "unstable"), "not finite").astype("<U20")
+    bound = np.where(finite, np.inf, np.nan)
+    P_out = np.full((B, n, n), np.nan)
+    mult = np.full(B, np.nan)
+    cert = {"cost": np.full(B, np.nan), "P": np.full(B, np.nan)}
+    steps = failures = 0
+    idx = np.flatnonzero(stable)
+    if idx.size:
+        A, E = A[idx], E[idx]
+        S = idx.size
+        CQ = np.concatenate([np.broadcast_to(_psd_factor(Q), (S, n, n)), _psd_factor(R) @ Kf[idx]], axis=1)
+        QK = CQ.mT @ CQ
+        Hs = np.broadcast_to(H, (S, *H.shape))
+        reach = bool(np.any(H)) & (np.abs(E).max(axis=(1, 2)) > 0)
+        g = _hinfnorm.hinf_norm(A, Hs, E, discrete=discrete, poles=lam_A[idx])[0]
+        robust = ~reach | (g < 1.0)
+        reason[idx[~robust]] = "not robustly stable"
+        zero = np.zeros_like(Hs)
+        one = np.ones(S)
+        # Lyapunov solutions (the Riccati equation without H): P_Q, and P_E for the bracket
+        P_Q, ok_Q = _hinfnorm.bounded_real_riccati(A, zero, CQ, one, discrete=discrete)
+        f_Q = np.where(ok_Q, _cost_objective(P_Q, x0), np.inf)
+        best_f, best_P, best_lam = np.where(reach, np.inf, f_Q), P_Q.copy(), np.zeros(S)
+        live = np.flatnonzero(reach & robust)
+        if live.size:
+            Al, El, CQl, Hl, QKl = A[live], E[live], CQ[live], Hs[live], QK[live]
+            P_E, ok_E = _hinfnorm.bounded_real_riccati(Al, zero[live], El, one[live], discrete=discrete)
+            f_E = np.where(ok_E, _cost_objective(P_E, x0), 0.0)
+            q = _hinfnorm.hinf_norm(Al, Hl, CQl, discrete=discrete, poles=lam_A[idx[live]])[0]
+            gl = g[live]
+
+            def f(lam):
+                C = np.concatenate([CQl, np.sqrt(lam)[:, None, None] * El], axis=1)
+                P, ok = _hinfnorm.bounded_real_riccati(Al, Hl, C, np.sqrt(lam), discrete=discrete)
+                ok &= np.isfinite(P).all(axis=(1, 2))
+                P = np.where(ok[:, None, None], P, 0.0)
+                # a level at or below the norm can pass the eigenvalue count with imaginary-axis
+                # eigenvalues split by rounding: keep only P that satisfy the LMI (up to rounding)
+                ev = _cost_lmi_eigs(Al, H, El, QKl, P, lam, discrete)
+                ok &= ev[:, 0] >= -_COST_LMI_TOL * np.maximum(1.0, np.abs(ev).max(axis=1))
+                val = _cost_objective(P, x0)
+                val = np.where(ok & np.isfinite(val), val, np.inf)
+                better = val < best_f[live]
+                sel = live[better]
+                best_f[sel], best_P[sel], best_lam[sel] = val[better], P[better], lam[better]
+                return val
+
+            scale = np.where(q > 0, q * q, np.maximum(f_Q[live], 1e-300) / np.maximum(f_E, 1e-300))
+            lam1 = np.maximum(2.0 * q * q / (1.0 - gl * gl), 1e-12 * scale)
+            f1 = f(lam1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                up = np.where(f_E > 0, (f1 - f_Q[live]) / f_E, 1e6 * lam1)
+            up = np.where(np.isfinite(up) & (up > lam1), up, lam1)
+            lo = np.where(q > 0, q * q, 1e-12 * up)
+            a, b = np.log(lo), np.log(up) + 1e-12
+            gr = (math.sqrt(5.0) - 1.0) / 2.0
+            c, d = b - gr * (b - a), a + gr * (b - a)
+            fc, fd = f(np.exp(c)), f(np.exp(d))
+            width = float((b - a).max())
+            steps = max(0, math.ceil(math.log(1e-9 / width) / math.log(gr))) if width > 1e-9 else 0
+            for _ in range(min(steps, 100)):
+                left = fc < fd
+                b = np.where(left, d, b)
+                a = np.where(left, a, c)
+                c_new = np.where(left, b - gr * (b - a), d)
+                d_new = np.where(left, c, a + gr * (b - a))
+                x = np.where(left, c_new, d_new)
+                fx = f(np.exp(x))
+                fc, fd = np.where(left, fx, fd), np.where(left, fc, fx)
+                c, d = c_new, d_new
+        found = np.isfinite(best_f) & robust
+        failures = int((robust & ~found).sum())
+        rows = idx[found]
+        Pf, lf = best_P[found], best_lam[found]
+        bound[rows], P_out[rows], mult[rows] = best_f[found], Pf, lf
+        if rows.size:   # the LMI blocks at (P, lam), in the plant's coordinates
+            cert["cost"][rows] = _cost_lmi_eigs(A[found], H, E[found], QK[found], Pf, lf, discrete)[:, 0]
+            cert["P"][rows] = np.linalg.eigvalsh(Pf)[:, 0]
+    info = {"path": "riccati", "search_steps": steps, "riccati_failures": failures}
+    return CostBoundBatch(_frozen(bound), _frozen(P_out), _frozen(mult), _ro(reason),
+                          None if x0 is None else _frozen(x0),
+                          MappingProxyType({k: _frozen(v) for k, v in cert.items()}), MappingProxyType(info))
+
+
 def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertainty: NormBounded, Q: ArrayLike,
-                    R: ArrayLike, x0: ArrayLike | None = None) -> CostBound:
+                    R: ArrayLike, x0: ArrayLike | None = None) -> CostBound | CostBoundBatch:
     r"""Upper bound on the LQ cost of ``u = K x`` valid for every ``||Delta|| <= 1``.
 
     The guaranteed-cost LMI of Petersen & McFarlane (1994), for a fixed gain:
@@ -1118,16 +1319,18 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     minimises ``x0'P x0``, or ``lambda_max(P)`` (one ``P`` for every unit
     initial state) if ``x0`` is not given.
 
-    One gain per call (no stacks, unlike :func:`robust_stability`): the bound
-    is an optimisation over the multiplier ``lam`` as well as ``P``, one SDP
-    per design. (For a fixed ``lam`` the smallest ``P`` is the stabilising
-    solution of a Riccati equation and the bound is convex in ``lam``, so a
-    batched version would be a scalar search over ``lam`` with batched
-    Riccati solves; it is not implemented.)
+    One gain: one SDP. A stack of gains (B, m, n) is answered at once
+    without an SDP (:class:`CostBoundBatch`): for a fixed ``lam`` the
+    smallest ``P`` is the stabilising solution of a bounded-real Riccati
+    equation and the bound is convex in ``lam``, so a golden-section search
+    over ``log lam`` with batched Riccati solves gives every design's bound
+    (:func:`_guaranteed_cost_batch`); designs that are unstable, not
+    robustly stable or not finite are flagged (``reason``) instead of
+    raising.
 
     Parameters
     ----------
-    controller : Controller or (Plant, (m, n) array_like)
+    controller : Controller or (Plant, (m, n) or (B, m, n) array_like)
     uncertainty : NormBounded
     Q : (n, n) array_like, symmetric positive semidefinite
     R : (m, m) array_like, symmetric positive semidefinite
@@ -1136,15 +1339,26 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
 
     Returns
     -------
-    CostBound
+    CostBound or CostBoundBatch
+        The latter for a stack of gains.
 
     Raises
     ------
     InfeasibleError
-        The loop is not quadratically stable for ``||Delta|| <= 1`` (no bound exists).
+        One gain: the loop is not quadratically stable for ``||Delta|| <= 1`` (no bound exists).
     """
     import cvxpy as cp
 
+    plant, K = _loop(controller, batch=True)
+    if K.ndim == 3:
+        unc = check_norm_bounded(uncertainty, plant)
+        n, m = plant.n, plant.m
+        Qc = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
+                                 cols_what="the number of states"), "Q", semidefinite=True)
+        Rc = check_spd(as_matrix(R, "R", rows=m, cols=m, rows_what="the number of inputs",
+                                 cols_what="the number of inputs"), "R", semidefinite=True)
+        x0b = None if x0 is None else as_batch(x0, "x0", (n,), ("the number of states",))
+        return _guaranteed_cost_batch(plant, K, unc, Qc, Rc, x0b)
     plant, K, A, H, E = _robust_loop(controller, uncertainty, "guaranteed cost")
     n, m, p = plant.n, plant.m, H.shape[1]
     Q = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",

@@ -9,9 +9,11 @@ import pickle
 import control
 import numpy as np
 import pytest
+import scipy.linalg
 
 import robustctl as rc
 from robustctl import _hinfnorm, analysis
+from robustctl.errors import InfeasibleError
 
 
 @pytest.fixture(params=["ab13dd", "level-set"])
@@ -51,6 +53,12 @@ def lmi(plant, K, unc, P, r: float = 1.0) -> np.ndarray:
     if plant.is_discrete:
         return np.block([[P - A.T @ P @ A - E.T @ E, -A.T @ P @ H], [-H.T @ P @ A, np.eye(p) - H.T @ P @ H]])
     return np.block([[-(A.T @ P + P @ A) - E.T @ E, -P @ H], [-H.T @ P, np.eye(p)]])
+
+
+def spectral(A, discrete: bool) -> float:
+    """Spectral radius (discrete) or abscissa (continuous) by numpy."""
+    lam = np.linalg.eigvals(A)
+    return float(np.abs(lam).max() if discrete else lam.real.max())
 
 
 def gain_stack(plant, K, count: int, seed: int, spread: float = 0.3) -> np.ndarray:
@@ -257,3 +265,86 @@ def test_bad_input_names_the_argument():
         rc.robust_stability((plant, np.stack([K, K])), other)
     with pytest.raises(TypeError, match=r"uncertainty must be a robustctl\.NormBounded"):
         rc.robust_stability((plant, np.stack([K, K])), "big")
+
+
+# ---------------------------------------------------------------- guaranteed cost on stacks
+@pytest.mark.parametrize("discrete", [True, False])
+def test_guaranteed_cost_batch_equals_the_sdp_of_each_design(discrete):
+    """The Riccati search gives, design for design, the optimum of the single-gain SDP (Clarabel)."""
+    plant, K, unc = random_loop(1, 4, discrete, 2.0)
+    Ks = gain_stack(plant, K, 4, 1, 0.1)
+    Q, R = np.diag([1.0, 2.0, 0.5, 1.0]), 0.3 * np.eye(2)
+    for x0 in (None, np.array([1.0, -0.5, 0.2, 2.0])):
+        res = rc.guaranteed_cost((plant, Ks), unc, Q, R, x0)
+        assert isinstance(res, analysis.CostBoundBatch) and len(res) == 4 and res.P.shape == (4, 4, 4)
+        assert (res.reason == "ok").sum() >= 3
+        for b in range(4):
+            try:
+                one = rc.guaranteed_cost((plant, Ks[b]), unc, Q, R, x0)
+            except InfeasibleError:
+                assert res.reason[b] == "not robustly stable" and res.bound[b] == np.inf
+                continue
+            assert res.reason[b] == "ok" and res.bound[b] == pytest.approx(one.bound, rel=1e-6)
+            assert res.multiplier[b] == pytest.approx(one.multiplier, rel=1e-2)
+            P, lam = res.P[b], res.multiplier[b]
+            bound = x0 @ P @ x0 if x0 is not None else np.linalg.eigvalsh(P)[-1]
+            assert res.bound[b] == pytest.approx(bound, rel=1e-12)
+            # the LMI of the module docstring at (P, lam), written out here: PSD up to rounding
+            A, H, E = plant.F + plant.G @ Ks[b], unc.H, unc.EF + unc.EG @ Ks[b]
+            QK = Q + Ks[b].T @ R @ Ks[b]
+            if discrete:
+                M = np.block([[P - A.T @ P @ A - QK - lam * E.T @ E, -A.T @ P @ H],
+                               [-H.T @ P @ A, lam * np.eye(unc.p) - H.T @ P @ H]])
+            else:
+                M = np.block([[-(A.T @ P + P @ A) - QK - lam * E.T @ E, -P @ H], [-H.T @ P, lam * np.eye(unc.p)]])
+            ev = np.linalg.eigvalsh(M)
+            assert ev[0] >= -1e-9 * ev[-1] and np.linalg.eigvalsh(P)[0] > 0
+            assert res.certificate["cost"][b] == pytest.approx(ev[0], abs=1e-9 * ev[-1])
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_guaranteed_cost_batch_flags_designs_without_a_bound(discrete):
+    plant, K, unc = random_loop(2, 3, discrete, 1.5)
+    limit = 1.0 if discrete else 0.0
+    bad = next(c for c in (10.0, -10.0, 30.0, -30.0)
+               if spectral(plant.F + plant.G @ (0.0 * K + c), discrete) > limit)   # destabilising
+    Ks = np.stack([K, K, 0.0 * K + bad, K])
+    Ks[3, 0, 0] = np.nan
+    big = rc.NormBounded(3.0 * unc.H, unc.EF, unc.EG)      # margin 0.5: no bound
+    res = rc.guaranteed_cost((plant, Ks), unc, np.eye(3), np.eye(2))
+    assert list(res.reason) == ["ok", "ok", "unstable", "not finite"]
+    assert np.isfinite(res.bound[:2]).all() and res.bound[2] == np.inf and np.isnan(res.bound[3])
+    assert np.isnan(res.P[2:]).all() and res.info["path"] == "riccati"
+    res = rc.guaranteed_cost((plant, Ks[:2]), big, np.eye(3), np.eye(2))
+    assert (res.reason == "not robustly stable").all() and (res.bound == np.inf).all()
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_guaranteed_cost_batch_without_uncertainty_is_the_lyapunov_cost(discrete):
+    plant, K, unc = random_loop(3, 3, discrete)
+    Ks = gain_stack(plant, K, 3, 3, 0.05)
+    Q, R, x0 = np.eye(3), np.eye(2), np.array([1.0, 2.0, -1.0])
+    res = rc.guaranteed_cost((plant, Ks), rc.NormBounded(np.zeros_like(unc.H), unc.EF, unc.EG), Q, R, x0)
+    for b in range(3):
+        A, QK = plant.F + plant.G @ Ks[b], Q + Ks[b].T @ R @ Ks[b]
+        if discrete:
+            P = scipy.linalg.solve_discrete_lyapunov(A.T, QK)
+        else:
+            P = scipy.linalg.solve_continuous_lyapunov(A.T, -QK)
+        assert res.bound[b] == pytest.approx(x0 @ P @ x0, rel=1e-9) and res.multiplier[b] == 0.0
+
+
+def test_guaranteed_cost_batch_bad_input_names_the_argument():
+    plant, K, unc = random_loop(0, 3, True, 2.0)
+    Ks = np.stack([K, K])
+    with pytest.raises(ValueError, match=r"K must be a gain \(2, 3\) or a non-empty stack"):
+        rc.guaranteed_cost((plant, np.zeros((2, 3, 3))), unc, np.eye(3), np.eye(2))
+    with pytest.raises(ValueError, match="Q must have 3 rows"):
+        rc.guaranteed_cost((plant, Ks), unc, np.eye(2), np.eye(2))
+    with pytest.raises(ValueError, match="R must"):
+        rc.guaranteed_cost((plant, Ks), unc, np.eye(3), -np.eye(2))
+    with pytest.raises(ValueError, match="x0"):
+        rc.guaranteed_cost((plant, Ks), unc, np.eye(3), np.eye(2), np.ones(2))
+    with pytest.raises(ValueError, match="uncertainty is for n=4 states"):
+        rc.guaranteed_cost((plant, Ks), rc.NormBounded(np.ones((4, 1)), np.ones((1, 4)), np.ones((1, 2))),
+                           np.eye(3), np.eye(2))
