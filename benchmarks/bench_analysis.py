@@ -17,7 +17,8 @@ numpy/scipy level-set norm (``--no-pure`` skips it).
 2. A batch: ``B`` gains of one plant (n = 4, discrete) in one call
    ``robust_stability((plant, K_stack), unc)`` against ``B`` calls of
    ``linfnorm``.
-3. Robust H-infinity synthesis for a norm-bounded payload model of the
+3. ``guaranteed_cost`` on a stack of gains against one SDP per gain.
+4. Robust H-infinity synthesis for a norm-bounded payload model of the
    truck against the polytopic design (:func:`robust_vs_polytopic`).
 
 Loops: random plants, ``m = 2`` inputs, LQR gains (python-control ``dlqr`` /
@@ -189,11 +190,29 @@ def batch_row(B: int, reps: int) -> tuple[str, float]:
     return row, t / t_l
 
 
+def cost_row(B: int, reps: int) -> str:
+    """``guaranteed_cost`` on a stack of ``B`` gains (Riccati search) against ``B`` single-gain SDP calls."""
+    plant, K, unc = case(4, 0, True)
+    rng = np.random.default_rng(2)
+    Ks = K + 0.05 * np.abs(K).max() * rng.standard_normal((B, *K.shape))
+    Q, R = np.eye(4), np.eye(2)
+    res, t = best_time(lambda: rc.guaranteed_cost((plant, Ks), unc, Q, R), reps)
+    start = time.process_time()
+    ones = [rc.guaranteed_cost((plant, Ks[b]), unc, Q, R) for b in range(B)]
+    t_s = time.process_time() - start
+    diff = max(abs(res.bound[b] / ones[b].bound - 1.0) for b in range(B))
+    row = (f"| {B} | {1e3 * t:.1f} | {1e3 * t_s:.0f} | **{t / t_s:.3f}** | {diff:.1e} "
+           f"| {int((res.reason == 'ok').sum())} |")
+    print(row, flush=True)
+    return row
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=[4, 10, 20])
     ap.add_argument("--seeds", type=int, default=5, help="random loops per size and time domain")
     ap.add_argument("--reps", type=int, default=15, help="alternating timing rounds per loop")
+    ap.add_argument("--cost-batch", type=int, default=20, help="gains in the guaranteed-cost row")
     ap.add_argument("--no-pure", dest="pure", action="store_false",
                     help="skip the table with the pure numpy/scipy level-set norm")
     ap.add_argument("--batch", type=int, default=92, help="gains of one plant in the batch row")
@@ -228,6 +247,14 @@ def main(argv=None) -> int:
               "|---|---|---|---|---|---|---|---|---|"]
     row, _ = batch_row(args.batch, args.reps)
     lines.append(row)
+    lines += ["", ("`guaranteed_cost` (n = 4, discrete, Q = I, R = I, worst unit x0) on a stack of "
+                   f"{args.cost_batch} gains (bounded-real Riccati solutions, golden-section search over the "
+                   "multiplier, all designs at once) "
+                   f"against {args.cost_batch} single-gain calls (one SDP each, Clarabel, timed once), best of "
+                   f"{min(args.reps, 5)}:"), "",
+              "| B | stack, one call [ms] | single calls [ms] | **ratio** | max rel. bound difference | bounds |",
+              "|---|---|---|---|---|---|"]
+    lines.append(cost_row(args.cost_batch, min(args.reps, 5)))
     rb = robust_vs_polytopic(min(args.reps, 3))
     lines += ["", ("Robust H-infinity synthesis (`hinf(..., uncertainty=)`: a norm-bounded payload model of the truck, "
                    f"rank {rb['rank']}) against the polytopic design (4 payload vertices), no input bound, best of "
