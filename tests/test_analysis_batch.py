@@ -100,6 +100,22 @@ def test_single_loop_margins_equal_one_over_linfnorm(discrete, norm):
             assert res.certified == (res.margin > 1.0)
 
 
+@pytest.mark.parametrize("discrete", [True, False])
+def test_riccati_solvers_match_scipy(discrete):
+    """The doubling algorithm and the Hamiltonian eigenvectors give scipy's stabilising ARE solution
+    (the bounded-real equation is the LQ one with R = -gamma^2 I)."""
+    for n in (3, 16):
+        plant, K, unc = random_loop(0, n, discrete, 2.0)   # ||E (zI - A)^-1 H||_inf = 0.5
+        A, H, E = plant.F + plant.G @ K, unc.H, unc.EF + unc.EG @ K
+        gamma = 0.7
+        are = scipy.linalg.solve_discrete_are if discrete else scipy.linalg.solve_continuous_are
+        X = are(A, H, E.T @ E, -gamma**2 * np.eye(unc.p))
+        P_sda = _hinfnorm.riccati_doubling(A, H, E, gamma, np.linalg.eigvals(A), discrete=discrete)
+        P_eig = _hinfnorm.riccati_one(A, H, E, gamma, discrete=discrete)
+        for P in (P_sda, P_eig):
+            assert np.abs(P - X).max() <= 1e-8 * np.abs(X).max()
+
+
 def test_a_failing_ab13dd_falls_back_to_the_level_set_norm(monkeypatch):
     plant, K, unc = random_loop(2, 6, True, 1.7)
 
