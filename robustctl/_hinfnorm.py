@@ -512,14 +512,42 @@ def hinf_norm_one(A, B, C, lam, *, discrete: bool, tol: float = TOL) -> tuple[fl
     return lb, peak, iterations, h2 / (f * f)
 
 
+def _cayley_hamiltonian_one(A, B, C, gamma: float):
+    """``M(gamma)`` of the Cayley transform of one discrete loop (:func:`_cayley_one`, :func:`_hamiltonian_one`).
+
+    With ``Mi = (A + I)^-1``, ``X = Mi B``, ``Y = C Mi``, ``Z = C X`` and
+    ``R = gamma^2 I - Z'Z``, ``[T1, T2] = R^-1 [Z'Y, X']``, the blocks are
+    ``I - 2 (Mi + X T1)``, ``2 X T2`` and ``2 Y'(Y + Z T1)`` (fewer small
+    products than the two steps). None if ``A + I`` or ``R`` is singular.
+    """
+    n = A.shape[0]
+    I = eye(n)
+    _, _, Mi, info = lapack.dgesv(A + I, I)
+    if info != 0:
+        return None
+    X = Mi @ B
+    Y = C @ Mi
+    Z = C @ X
+    _, _, T, info = lapack.dgesv((gamma * gamma) * eye(B.shape[1]) - Z.T @ Z, np.concatenate([Z.T @ Y, X.T], axis=1))
+    if info != 0:
+        return None
+    T1 = T[:, :n]
+    Ah = I - 2.0 * (Mi + X @ T1)
+    M = np.empty((2 * n, 2 * n))
+    M[:n, :n] = Ah
+    M[:n, n:] = 2.0 * (X @ T[:, n:])
+    M[n:, :n] = -2.0 * (Y.T @ (Y + Z @ T1))
+    M[n:, n:] = -Ah.T
+    return M
+
+
 def riccati_one(A, B, C, gamma: float, *, discrete: bool):
     """:func:`bounded_real_riccati` of one realisation: ``P`` or None."""
     n = A.shape[0]
-    if discrete:
-        Ah, Bh, Ch, Dh = _cayley_one(A, B, C)
-    else:
-        Ah, Bh, Ch, Dh = A, B, C, None
-    wr, _, _, vr, info = lapack.dgeev(_hamiltonian_one(Ah, Bh, Ch, Dh, gamma), compute_vl=0, compute_vr=1)
+    M = _cayley_hamiltonian_one(A, B, C, gamma) if discrete else _hamiltonian_one(A, B, C, None, gamma)
+    if M is None:
+        return None
+    wr, _, _, vr, info = lapack.dgeev(M, compute_vl=0, compute_vr=1)
     if info != 0:
         return None
     order = np.argsort(wr, kind="stable")
