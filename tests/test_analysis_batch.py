@@ -101,6 +101,26 @@ def test_single_loop_margins_equal_one_over_linfnorm(discrete, norm):
 
 
 @pytest.mark.parametrize("discrete", [True, False])
+def test_doubling_certificate_near_the_boundary_and_for_slow_loops(discrete):
+    """n >= 14 (the doubling algorithm): margins either side of 1 and a loop with a pole near the boundary."""
+    for seed, margin in ((0, 0.5), (1, 1.0 - 1e-4), (2, 1.0 + 1e-4), (3, 3.0)):
+        plant, K, unc = random_loop(seed, 16, discrete, margin)
+        res = rc.robust_stability((plant, K), unc)
+        assert res.margin == pytest.approx(margin, rel=1e-8) and res.certified == (margin > 1)
+        assert res.info["riccati"] == "doubling" and min(res.certificate.values()) > 0
+        assert np.linalg.eigvalsh(lmi(plant, K, unc, res.P, res.radius))[0] > 0
+    n = 16
+    slow = (1.0 - 1e-5) if discrete else -1e-5
+    F = np.diag(np.linspace(0.2, slow, n)) if discrete else np.diag(np.linspace(-3.0, slow, n))
+    plant = rc.Plant(F, np.ones((n, 1)), 0.1 if discrete else None)
+    unc = rc.NormBounded(np.ones((n, 1)), 1e-6 * np.ones((1, n)), [[0.0]])
+    K = np.zeros((1, n))
+    res = rc.robust_stability((plant, K), unc)
+    assert res.margin * linf(plant, K, unc) == pytest.approx(1.0, rel=1e-8)
+    assert res.info["path"] == "riccati" and min(res.certificate.values()) > 0
+
+
+@pytest.mark.parametrize("discrete", [True, False])
 def test_riccati_solvers_match_scipy(discrete):
     """The doubling algorithm and the Hamiltonian eigenvectors give scipy's stabilising ARE solution
     (the bounded-real equation is the LQ one with R = -gamma^2 I)."""
