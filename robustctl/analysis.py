@@ -1019,9 +1019,10 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
     ``||Delta|| <= r``, ``A = F + G K``, ``E = EF + EG K``, by the
     S-procedure LMI of the module docstring. Its ``margin`` equals the
     small-gain value ``1 / ||E (zI - A)^-1 H||_inf`` (continuous time:
-    ``s``), computed by a level-set H-infinity norm; the certificate ``P``
-    comes from the bounded-real Riccati equation at a level between the
-    norm and 1 and is verified by eigenvalues (the SDP is the fallback).
+    ``s``), computed by a level-set H-infinity norm (for one gain SLICOT's
+    AB13DD when slycot is installed); the certificate ``P`` comes from the
+    bounded-real Riccati equation at a level between the norm and 1 and is
+    verified by eigenvalues (the SDP is the fallback).
     A stack of gains (B, m, n) is analysed at once (eigenvalue problems on
     (B, 2n, 2n) arrays, one level-set iteration for all); its certificates
     are computed when first asked for (:class:`RobustStabilityBatch`).
