@@ -6,28 +6,35 @@ equals ``1 / ||E (zI - A)^-1 H||_inf``, which python-control's ``linfnorm``
 loops; the ratio is ``robust_stability`` time over ``linfnorm`` time
 (building the ``StateSpace`` included). ``robust_stability`` also returns
 the Lyapunov matrix ``P`` and its verified eigenvalue certificate, which
-``linfnorm`` does not: a level-set H-infinity norm, one bounded-real Riccati
-solution and the certificate eigenvalues (the SDP only where the Riccati
-certificate fails; the table counts those).
+``linfnorm`` does not: the H-infinity norm (SLICOT AB13DD through slycot
+when installed, as ``linfnorm``; the level-set iteration of
+``robustctl._hinfnorm`` otherwise), one bounded-real Riccati solution and
+the certificate eigenvalues (the SDP only where the Riccati certificate
+fails; the table counts those). A second table forces the pure
+numpy/scipy level-set norm (``--no-pure`` skips it).
 
 1. One loop per call, n = 4, 10, 20, discrete (dt = 0.1) and continuous.
 2. A batch: ``B`` gains of one plant (n = 4, discrete) in one call
    ``robust_stability((plant, K_stack), unc)`` against ``B`` calls of
    ``linfnorm``.
-3. Robust H-infinity synthesis for a norm-bounded payload model of the
+3. ``guaranteed_cost`` on a stack of gains against one SDP per gain.
+4. Robust H-infinity synthesis for a norm-bounded payload model of the
    truck against the polytopic design (:func:`robust_vs_polytopic`).
 
 Loops: random plants, ``m = 2`` inputs, LQR gains (python-control ``dlqr`` /
 ``lqr``), ``p = 2`` columns of ``H``, ``l = 3`` rows of ``E``, ``H`` scaled
 so that the margin is 2; the batch perturbs the LQR gain by 5 % Gaussian
 noise. Times are CPU times of this process (``time.process_time``, BLAS
-threads pinned to 1 unless the environment says otherwise), the best of
-``--reps`` runs after a warm-up: the development machine is shared, and
-CPU time keeps the ratio from depending on what else runs. The machine
-load (1-minute load average) is recorded.
+threads pinned to 1 unless the environment says otherwise): the two
+functions of a ratio are timed alternately, ``--reps`` rounds of
+``number`` calls each after a warm-up, and each keeps its best round, so
+that a load change on the shared machine hits both alike. The ratio per
+loop is best over best; the table gives the median over the loops and the
+largest. The machine load (1-minute load average) is recorded.
 
-Usage: python benchmarks/bench_analysis.py [--sizes 4 10 20] [--seeds 5] [--reps 5] [--batch 92]
-                                           [--out benchmarks/results/analysis.md]
+Usage: python -m benchmarks.bench_analysis [--sizes 4 10 20] [--seeds 5] [--reps 15] [--batch 92]
+                                           [--no-pure] [--out benchmarks/results/analysis.md]
+(quick look: ``--seeds 2 --reps 3 --out /tmp/analysis.md``)
 """
 
 from __future__ import annotations
@@ -38,6 +45,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
+import contextlib  # noqa: E402
 import datetime  # noqa: E402
 import platform  # noqa: E402
 import time  # noqa: E402
@@ -48,6 +56,7 @@ import control  # noqa: E402
 import numpy as np  # noqa: E402
 
 import robustctl as rc  # noqa: E402
+from robustctl import _hinfnorm  # noqa: E402
 
 
 def case(n: int, seed: int, discrete: bool):
@@ -69,6 +78,26 @@ def linfnorm(plant, K, H, E) -> float:
 def cpu(fn, reps: int, number: int = 1) -> float:
     """Best CPU time of ``reps`` runs of ``number`` calls, per call."""
     return min(timeit.repeat(fn, number=number, repeat=reps, timer=time.process_time)) / number
+
+
+def paired(f, g, reps: int, number: int) -> tuple[float, float]:
+    """Best CPU time per call of ``f`` and of ``g``, timed alternately (``reps`` rounds of ``number`` calls)."""
+    tf, tg = np.inf, np.inf
+    for _ in range(reps):
+        tf = min(tf, timeit.timeit(f, number=number, timer=time.process_time) / number)
+        tg = min(tg, timeit.timeit(g, number=number, timer=time.process_time) / number)
+    return tf, tg
+
+
+@contextlib.contextmanager
+def pure_norm():
+    """Single-loop calls without slycot's AB13DD (the level-set norm of robustctl._hinfnorm)."""
+    saved = _hinfnorm.slicot_ab13dd
+    _hinfnorm.slicot_ab13dd = lambda: None  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        _hinfnorm.slicot_ab13dd = saved
 
 
 def best_time(fn, reps: int):
@@ -115,27 +144,33 @@ def single_rows(sizes, seeds: int, reps: int) -> list[str]:
     rows = []
     for discrete in (True, False):
         for n in sizes:
-            t_rs, t_ref, ratios, diffs, sdp = [], [], [], [], 0
+            t_rs, t_ref, ratios, diffs, sdp, how = [], [], [], [], 0, set()
             for seed in range(seeds):
                 plant, K, unc = case(n, seed, discrete)
                 E = unc.EF + unc.EG @ K
                 res = rc.robust_stability((plant, K), unc)
                 assert res.certified and min(res.certificate.values()) > 0, "margin 2 must be certified"
                 sdp += res.info["path"] == "sdp"
+                how.add(f"{res.info['norm']}, {res.info['riccati']}")
                 gain = linfnorm(plant, K, unc.H, E)
                 number = 20 if n <= 10 else 5
-                t = cpu(lambda: rc.robust_stability((plant, K), unc), reps, number)
-                t_l = cpu(lambda: linfnorm(plant, K, unc.H, E), reps, number)
+                t, t_l = paired(lambda: rc.robust_stability((plant, K), unc),
+                                lambda: linfnorm(plant, K, unc.H, E), reps, number)
                 t_rs.append(t)
                 t_ref.append(t_l)
                 ratios.append(t / t_l)
                 diffs.append(abs(res.margin * gain - 1.0))
             row = (f"| {'discrete' if discrete else 'continuous'} | {n} | {1e3 * np.median(t_rs):.3f} "
                    f"| {1e3 * np.median(t_ref):.3f} | **{np.median(ratios):.2f}**, {max(ratios):.2f} "
-                   f"| {max(diffs):.1e} | {sdp} |")
+                   f"| {max(diffs):.1e} | {sdp} | {'; '.join(sorted(how))} |")
             print(row, flush=True)
             rows.append(row)
     return rows
+
+
+SINGLE_HEADER = [("| time | n | robust_stability [ms] | linfnorm [ms] | **ratio** (median, max) "
+                  "| max rel. margin difference | SDP fallbacks | norm, Riccati |"),
+                 "|---|---|---|---|---|---|---|---|"]
 
 
 def batch_row(B: int, reps: int) -> tuple[str, float]:
@@ -146,20 +181,40 @@ def batch_row(B: int, reps: int) -> tuple[str, float]:
     E = unc.EF + unc.EG @ Ks
     gains = np.array([linfnorm(plant, Ks[b], unc.H, E[b]) for b in range(B)])
     diff = float(np.max(np.abs(res.margin * gains - 1.0)))
-    t = cpu(lambda: rc.robust_stability((plant, Ks), unc).margin, reps)
+    t, t_l = paired(lambda: rc.robust_stability((plant, Ks), unc).margin,
+                    lambda: [linfnorm(plant, Ks[b], unc.H, E[b]) for b in range(B)], reps, 1)
     t_c = cpu(lambda: rc.robust_stability((plant, Ks), unc).certified, reps)
-    t_l = cpu(lambda: [linfnorm(plant, Ks[b], unc.H, E[b]) for b in range(B)], reps)
     row = (f"| {B} | {1e3 * t:.2f} | {1e3 * t_c:.2f} | {1e3 * t_l:.2f} | **{t / t_l:.2f}** | {t_c / t_l:.2f} "
            f"| {diff:.1e} | {int(res.certified.sum())} | {res.info['sdp_solves']} |")
     print(row, flush=True)
     return row, t / t_l
 
 
+def cost_row(B: int, reps: int) -> str:
+    """``guaranteed_cost`` on a stack of ``B`` gains (Riccati search) against ``B`` single-gain SDP calls."""
+    plant, K, unc = case(4, 0, True)
+    rng = np.random.default_rng(2)
+    Ks = K + 0.05 * np.abs(K).max() * rng.standard_normal((B, *K.shape))
+    Q, R = np.eye(4), np.eye(2)
+    res, t = best_time(lambda: rc.guaranteed_cost((plant, Ks), unc, Q, R), reps)
+    start = time.process_time()
+    ones = [rc.guaranteed_cost((plant, Ks[b]), unc, Q, R) for b in range(B)]
+    t_s = time.process_time() - start
+    diff = max(abs(res.bound[b] / ones[b].bound - 1.0) for b in range(B))
+    row = (f"| {B} | {1e3 * t:.1f} | {1e3 * t_s:.0f} | **{t / t_s:.3f}** | {diff:.1e} "
+           f"| {int((res.reason == 'ok').sum())} |")
+    print(row, flush=True)
+    return row
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=[4, 10, 20])
     ap.add_argument("--seeds", type=int, default=5, help="random loops per size and time domain")
-    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--reps", type=int, default=15, help="alternating timing rounds per loop")
+    ap.add_argument("--cost-batch", type=int, default=20, help="gains in the guaranteed-cost row")
+    ap.add_argument("--no-pure", dest="pure", action="store_false",
+                    help="skip the table with the pure numpy/scipy level-set norm")
     ap.add_argument("--batch", type=int, default=92, help="gains of one plant in the batch row")
     ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "analysis.md")
     args = ap.parse_args(argv)
@@ -170,15 +225,20 @@ def main(argv=None) -> int:
     lines = [(f"# bench_analysis ({datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, "
               f"{platform.processor() or platform.machine()}, Python {platform.python_version()}, "
               f"{os.cpu_count()} cores, load average {load:.1f} at start: shared machine, CPU times)"), "",
-             ("`robust_stability` (level-set H-infinity norm, bounded-real Riccati certificate verified by "
-              "eigenvalues) against python-control's `linfnorm` of the same loop `E (zI - A)^-1 H`; p = 2, l = 3, "
-              f"m = 2, margin 2. Best of {args.reps} runs per loop, median over {args.seeds} loops; target ratio "
-              "<= 3."), "",
-             ("| time | n | robust_stability [ms] | linfnorm [ms] | **ratio** (median, max) "
-              "| max rel. margin difference | SDP fallbacks |"),
-             "|---|---|---|---|---|---|---|"]
+             ("`robust_stability` of one loop with its certificate (H-infinity norm, bounded-real Riccati "
+              "certificate verified by eigenvalues) against python-control's `linfnorm` of the same loop "
+              "`E (zI - A)^-1 H`; p = 2, l = 3, m = 2, margin 2. CPU times, the two timed alternately: best of "
+              f"{args.reps} rounds each per loop, ratio per loop, median and largest over {args.seeds} loops; "
+              "target ratio <= 3. Norm: AB13DD through slycot when installed (the default)."), "",
+             *SINGLE_HEADER]
     print("\n".join(lines), flush=True)
     lines += single_rows(args.sizes, args.seeds, args.reps)
+    if args.pure:
+        lines += ["", "The same with the pure numpy/scipy level-set norm (slycot's AB13DD switched off):", "",
+                  *SINGLE_HEADER]
+        print("\n".join(lines[-5:]), flush=True)
+        with pure_norm():
+            lines += single_rows(args.sizes, args.seeds, args.reps)
     lines += ["", (f"One call on a stack of {args.batch} gains of one plant (n = 4, discrete) against "
                    f"{args.batch} `linfnorm` calls; target ratio <= 0.5. The margins come with the call; the "
                    "certificates (`certified`, `P`, ...) are computed on first access, timed separately."), "",
@@ -187,6 +247,14 @@ def main(argv=None) -> int:
               "|---|---|---|---|---|---|---|---|---|"]
     row, _ = batch_row(args.batch, args.reps)
     lines.append(row)
+    lines += ["", ("`guaranteed_cost` (n = 4, discrete, Q = I, R = I, worst unit x0) on a stack of "
+                   f"{args.cost_batch} gains (bounded-real Riccati solutions, golden-section search over the "
+                   "multiplier, all designs at once) "
+                   f"against {args.cost_batch} single-gain calls (one SDP each, Clarabel, timed once), best of "
+                   f"{min(args.reps, 5)}:"), "",
+              "| B | stack, one call [ms] | single calls [ms] | **ratio** | max rel. bound difference | bounds |",
+              "|---|---|---|---|---|---|"]
+    lines.append(cost_row(args.cost_batch, min(args.reps, 5)))
     rb = robust_vs_polytopic(min(args.reps, 3))
     lines += ["", ("Robust H-infinity synthesis (`hinf(..., uncertainty=)`: a norm-bounded payload model of the truck, "
                    f"rank {rb['rank']}) against the polytopic design (4 payload vertices), no input bound, best of "

@@ -55,13 +55,19 @@ The margin is the small-gain value ``1 / ||E (zI - A)^-1 H||_inf``,
 computed by a level-set H-infinity norm (Bruinsma & Steinbuch 1990;
 imaginary-axis eigenvalues of a Hamiltonian, the discrete case through a
 bilinear transform; :mod:`robustctl._hinfnorm`) to ``2e-10`` relative, on
-the whole stack of gains at once. The certificate ``P`` at the radius
+the whole stack of gains at once. One gain per call uses SLICOT's AB13DD
+(the same algorithm with a structure-preserving Hamiltonian eigensolver,
+through slycot) when slycot is installed, the level-set iteration without
+it (``info["norm"]``: ``"ab13dd"`` or ``"level-set"``). The certificate ``P`` at the radius
 ``r`` (1 if the margin exceeds 1, else ``margin / (1 + 1e-3)``) is the
 stabilising solution of the bounded-real Riccati equation of
 ``(A, r H, [E; sqrt(eps) I])`` at the level ``gamma`` with
 ``gamma^2 = (1 + (r / margin)^2) / 2``: between the norm of the scaled loop
 and 1, so that the LMI is strictly feasible (its Schur complement is at
-least ``eps I``). It is verified like any other certificate (eigenvalues of
+least ``eps I``); for one gain of state size 14 or more it is computed by the
+structure-preserving doubling algorithm (``n x n`` matrices only; Chu, Fan &
+Lin 2005), with the Hamiltonian's eigenvectors as the fallback
+(``info["riccati"]``). It is verified like any other certificate (eigenvalues of
 the LMI blocks at ``P`` in the plant's coordinates); only a design whose
 Riccati certificate fails that check goes to the SDP below (``info["path"]``
 says which: ``"riccati"`` or ``"sdp"``). Polytopes always use the SDP.
@@ -114,6 +120,7 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -122,6 +129,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
+from scipy.linalg import lapack
 
 from . import _cvx, _hinfnorm
 from ._validation import as_batch, as_float_array, as_matrix, as_rng, check_int, check_performance, check_spd
@@ -131,7 +139,7 @@ from .plant import Plant, _frozen, check_vertices
 from .stability import STABILITY_MARGIN, is_stable, spectral_abscissa, spectral_radius
 from .uncertainty import NormBounded, check_norm_bounded
 
-__all__ = ["RobustStability", "RobustStabilityBatch", "CostBound", "HinfBound", "WorstCase",
+__all__ = ["RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase",
            "robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case"]
 
 # Regularisation (relative to the weight's norm) of the Lyapunov equation defining the coordinates.
@@ -148,6 +156,11 @@ _POLY_RMAX = 1e3
 _POLY_STEPS = 60
 # Riccati certificate: tries of the regularisation eps (each 100 times smaller) before the SDP.
 _EPS_TRIES = 3
+# Batched guaranteed cost: a Riccati solution counts when the LMI's smallest eigenvalue is at least
+# -_COST_LMI_TOL times its largest (rounding of a boundary point).
+_COST_LMI_TOL = 1e-9
+# One loop: state size from which the Riccati certificate is tried by the doubling algorithm first.
+_SDA_MIN_N = 14
 # Worst-case search: projected-gradient iterations per start.
 _ASCENT_ITER = 200
 
@@ -193,8 +206,12 @@ class RobustStability:
     info : Mapping
         ``"nominal_radius"`` (spectral radius or abscissa of ``F + G K``);
         norm-bounded: ``"path"`` (``"riccati"`` or ``"sdp"``: which
-        computation certified ``P``; None if neither passed the check) and
-        ``"norm_iterations"`` (level-set steps); polytope: solver
+        computation certified ``P``; None if neither passed the check),
+        ``"norm"`` (``"ab13dd"`` or ``"level-set"``: which computed the
+        H-infinity norm), ``"norm_iterations"`` (level-set steps; 0 for
+        AB13DD) and ``"riccati"`` (``"doubling"`` or ``"eigenvectors"``:
+        how the certifying Riccati solution was computed; None if the
+        Riccati path did not certify); polytope: solver
         diagnostics (``solve_time``, ``iterations``, ``solves``).
     """
 
@@ -251,6 +268,7 @@ class RobustStabilityBatch:
         ``"path"``: (B,) str ndarray, which computation certified ``P[b]``
         (``"riccati"``, ``"sdp"``; ``""`` where there is no verified ``P``);
         ``"nominal_radius"``: (B,) spectral radius (abscissa) of ``F + G K``;
+        ``"norm"``: ``"level-set"`` (the batched H-infinity norm);
         ``"norm_iterations"``: level-set steps of the H-infinity norm;
         ``"sdp_solves"``: designs that needed the SDP.
     """
@@ -338,6 +356,58 @@ class CostBound:
     def __repr__(self) -> str:
         x0 = "given" if self.x0 is not None else "worst unit"
         return f"CostBound(bound={self.bound:.6g}, multiplier={self.multiplier:.6g}, x0={x0!r})"
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class CostBoundBatch:
+    """Guaranteed LQ costs of a stack of gains ``K`` (B, m, n) on one plant (:func:`guaranteed_cost`).
+
+    Design ``b`` gets the bound of :class:`CostBound` (computed by Riccati
+    equations and a search over the multiplier instead of an SDP), as
+    entries of arrays.
+
+    Attributes
+    ----------
+    bound : (B,) ndarray
+        ``x0' P x0``, or ``lambda_max(P)`` when ``x0`` is not given; ``inf``
+        where no bound exists (``reason`` says why), ``nan`` where ``K[b]``
+        has a non-finite entry.
+    P : (B, n, n) ndarray
+        Quadratic cost bounds ``V(x) = x'Px`` (NaN where there is none).
+    multiplier : (B,) ndarray
+        S-procedure multiplier ``lam`` (0 where the uncertainty does not reach the loop).
+    reason : (B,) str ndarray
+        ``"ok"``, ``"unstable"`` (``F + G K`` is not stable), ``"not robustly
+        stable"`` (``||E (zI - A)^-1 H||_inf >= 1``: no bound exists) or
+        ``"not finite"``.
+    x0 : (n,) ndarray or None
+    certificate : Mapping[str, (B,) ndarray]
+        Smallest eigenvalue of each LMI block at ``(P, lam)`` in the plant's
+        coordinates: ``"cost"`` (the guaranteed-cost LMI) and ``"P"``
+        (``>= 0`` up to rounding: ``P`` solves the Riccati equation, on the
+        boundary of the LMI, as the SDP's optimum is).
+    info : Mapping
+        ``"path"``: ``"riccati"``; ``"search_steps"``: golden-section steps
+        of the multiplier search; ``"riccati_failures"``: designs whose
+        Riccati solution failed at the optimal multiplier (bound ``inf``).
+    """
+
+    bound: np.ndarray
+    P: np.ndarray
+    multiplier: np.ndarray
+    reason: np.ndarray
+    x0: np.ndarray | None
+    certificate: Mapping[str, np.ndarray]
+    info: Mapping[str, Any] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return self.bound.shape[0]
+
+    def __repr__(self) -> str:
+        ok = self.reason == "ok"
+        x0 = "given" if self.x0 is not None else "worst unit"
+        return (f"CostBoundBatch(B={len(self)}, ok={int(ok.sum())}, x0={x0!r}, "
+                f"largest bound={_fmt(float(self.bound[ok].max()) if ok.any() else None)})")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -737,16 +807,22 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
                 for key in cs:
                     cert[key][idx] = cs[key]
                 certified[idx] = ok & (r == 1.0)
-        info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm_iterations": iterations,
-                "sdp_solves": sdp}
+        info = {"path": _ro(path), "nominal_radius": _frozen(nominal), "norm": "level-set",
+                "norm_iterations": iterations, "sdp_solves": sdp}
         return (_ro(certified), _frozen(radius), _frozen(P), MappingProxyType({k: _frozen(v) for k, v in cert.items()}),
                 MappingProxyType(info))
 
     return RobustStabilityBatch(_frozen(margin), _ro(reason), "norm-bounded", certify)
 
 
-def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustStability:
-    """One gain: what :func:`_norm_bounded_batch` does for a stack, on 2-D arrays (less overhead)."""
+def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
+                            norm: str = "auto") -> RobustStability:
+    """One gain: what :func:`_norm_bounded_batch` does for a stack, on 2-D arrays (less overhead).
+
+    ``norm`` chooses the H-infinity norm (:func:`robustctl._hinfnorm.norm_one`):
+    SLICOT AB13DD when slycot is installed (``"auto"``) or the level-set
+    iteration of :mod:`robustctl._hinfnorm` (``"level-set"``).
+    """
     discrete = plant.is_discrete
     n = plant.n
     A = plant.F + plant.G @ K
@@ -756,34 +832,43 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
     if not nominal < ((1.0 - STABILITY_MARGIN) if discrete else -STABILITY_MARGIN):
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
                                MappingProxyType({"nominal_radius": nominal}))
-    g, peak, iterations, h2 = _hinfnorm.hinf_norm_one(A, H, E, lam, discrete=discrete)
-    margin = 1.0 / g if g > 0 else np.inf
+    g, peak, iterations, h2, method = _hinfnorm.norm_one(A, H, E, lam, discrete=discrete, method=norm)
+    margin = 1.0 / g if g > 0 else math.inf
     r = 1.0 if margin > 1.0 else margin / (1.0 + _BACKOFF)
-    Hr = r * H
     gr = r * g
-    gam = np.sqrt(0.5 * (1.0 + gr * gr))
-    hn2, en2 = float((Hr * Hr).sum()), float((E * E).sum())
+    gam = math.sqrt(0.5 * (1.0 + gr * gr))
+    hn2, en2 = r * r * float(np.vdot(H, H)), float(np.vdot(E, E))
     c = (en2 / hn2) ** 0.25 if hn2 > 0 and en2 > 0 else 1.0
-    Hb, Eb = Hr * c, E / c
-    if h2 == 0.0:   # the norm did not evaluate the resolvent (E = 0): do it at the peak
+    Hb, Eb = (r * c) * H, E / c
+    if h2 == 0.0:   # the norm did not evaluate the resolvent (AB13DD, or E = 0): do it at the peak
         z = np.exp(1j * peak) if discrete else 1j * peak
-        X = _hinfnorm.solve((z * _hinfnorm.eye(n) - A)[None], H.astype(complex)[None])[0]
-        h2 = float((X.real ** 2 + X.imag ** 2).sum())
+        _, _, X, info = lapack.zgesv(z * _hinfnorm.eye(n) - A, H)
+        h2 = float(np.vdot(X, X).real) if info == 0 else 0.0
     h2 *= (r * c) ** 2   # ||(zI - A)^-1 H_b||_F^2 at the peak
     eps = min((gam * gam - gr * gr) / (4.0 * h2 if h2 > 0 else 1.0), max(1.0, en2 / c**2))
     best: tuple = (-np.inf, None, {})
-    path = None
+    path = solver = None
+    Ea = np.empty((Eb.shape[0] + n, n))
+    Ea[:Eb.shape[0]] = Eb
+    solvers = ("doubling", "eigenvectors") if n >= _SDA_MIN_N else ("eigenvectors",)
     for _ in range(_EPS_TRIES):
-        Ea = np.concatenate([Eb, np.sqrt(eps) * _hinfnorm.eye(n)], axis=0)
-        Pt = _hinfnorm.riccati_one(A, Hb, Ea, gam, discrete=discrete)
-        if Pt is not None:
-            P = c * c * Pt
-            score, cert = _verify_one(_stability_blocks_fast(A, Hr, E, P, discrete))
+        Ea[Eb.shape[0]:] = math.sqrt(eps) * _hinfnorm.eye(n)
+        for solver in solvers:
+            if solver == "doubling":
+                Pt = _hinfnorm.riccati_doubling(A, Hb, Ea, gam, lam, discrete=discrete)
+            else:
+                Pt = _hinfnorm.riccati_one(A, Hb, Ea, gam, discrete=discrete)
+            if Pt is None:
+                continue
+            P = (c * c) * Pt
+            score, cert = _certify_one(A, r * H, E, P, discrete)
             if score > best[0]:
                 best = (score, P, cert)
             if score > _STRICT:
                 path = "riccati"
                 break
+        if path is not None:
+            break
         eps *= 1e-2
     if path is None:   # rare: the SDP
         try:
@@ -791,15 +876,42 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded) -> Ro
         except (InfeasibleError, ConvergenceError):
             res = None
         if res is not None and res.P is not None:
-            score, cert = _verify_one(_stability_blocks_fast(A, Hr, E, res.P, discrete))
+            score, cert = _verify_one(_stability_blocks_fast(A, r * H, E, res.P, discrete))
             if score > _STRICT or best[1] is None:
                 best = (score, res.P, cert)
                 path = "sdp" if score > _STRICT else None
     score, P, cert = best
-    info = {"path": path, "nominal_radius": nominal, "norm_iterations": iterations}
-    return RobustStability(bool(path is not None and r == 1.0), float(margin), float(r),
-                           None if P is None else _frozen(P), MappingProxyType(cert), "norm-bounded",
+    if P is not None:
+        P.flags.writeable = False
+    info = {"path": path, "nominal_radius": nominal, "norm_iterations": iterations, "norm": method,
+            "riccati": solver if path == "riccati" else None}
+    return RobustStability(path is not None and r == 1.0, margin, r, P, MappingProxyType(cert), "norm-bounded",
                            MappingProxyType(info))
+
+
+def _certify_one(A, Hr, E, P, discrete: bool) -> tuple[float, dict[str, float]]:
+    """:func:`_verify_one` of :func:`_stability_blocks_fast` (``P`` symmetric), with fewer small array operations."""
+    n, p = A.shape[0], Hr.shape[1]
+    M = np.empty((n + p, n + p))
+    if discrete:
+        PA, PH = P @ A, P @ Hr
+        M[:n, :n] = P - A.T @ PA - E.T @ E
+        M[n:, :n] = -(Hr.T @ PA)
+        M[n:, n:] = _hinfnorm.eye(p) - Hr.T @ PH
+    else:
+        PA = P @ A
+        M[:n, :n] = -(PA + PA.T) - E.T @ E
+        M[n:, :n] = -(Hr.T @ P)
+        M[n:, n:] = _hinfnorm.eye(p)
+    score, cert = np.inf, {}
+    for key, S in (("P", P), ("lyapunov", M)):   # dsyevd reads the lower triangle
+        w, _, info = lapack.dsyevd(S, compute_v=0, lower=1)
+        if info != 0:
+            w = np.linalg.eigvalsh(S)
+        lo, hi = float(w[0]), float(w[-1])
+        cert[key] = lo
+        score = min(score, lo / max(1.0, abs(lo), abs(hi)))
+    return score, cert
 
 
 def _stability_blocks_fast(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
@@ -907,9 +1019,10 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
     ``||Delta|| <= r``, ``A = F + G K``, ``E = EF + EG K``, by the
     S-procedure LMI of the module docstring. Its ``margin`` equals the
     small-gain value ``1 / ||E (zI - A)^-1 H||_inf`` (continuous time:
-    ``s``), computed by a level-set H-infinity norm; the certificate ``P``
-    comes from the bounded-real Riccati equation at a level between the
-    norm and 1 and is verified by eigenvalues (the SDP is the fallback).
+    ``s``), computed by a level-set H-infinity norm (for one gain SLICOT's
+    AB13DD when slycot is installed); the certificate ``P`` comes from the
+    bounded-real Riccati equation at a level between the norm and 1 and is
+    verified by eigenvalues (the SDP is the fallback).
     A stack of gains (B, m, n) is analysed at once (eigenvalue problems on
     (B, 2n, 2n) arrays, one level-set iteration for all); its certificates
     are computed when first asked for (:class:`RobustStabilityBatch`).
@@ -1045,8 +1158,154 @@ def _multiplier(lam, p: int, c: float) -> float:
     return float(_cvx.value(lam)) / c**2 if p else 0.0
 
 
+def _psd_factor(M: np.ndarray) -> np.ndarray:
+    """``L`` with ``L'L = M`` for a symmetric positive semidefinite ``M`` (rows ``sqrt(w_i) v_i'``)."""
+    w, V = np.linalg.eigh(M)
+    return np.sqrt(np.clip(w, 0.0, None))[:, None] * V.T
+
+
+def _cost_objective(P: np.ndarray, x0: np.ndarray | None) -> np.ndarray:
+    """``x0' P x0`` or ``lambda_max(P)`` of a stack."""
+    if x0 is not None:
+        return np.einsum("i,bij,j->b", x0, P, x0)
+    return np.linalg.eigvalsh(0.5 * (P + P.mT))[:, -1]
+
+
+def _cost_lmi_eigs(A, H, E, QK, P, lam, discrete: bool) -> np.ndarray:
+    """Eigenvalues (S, n + p), ascending, of the guaranteed-cost LMI at ``(P, lam)`` for stacks."""
+    S, n = A.shape[0], A.shape[-1]
+    p = H.shape[-1]
+    AH = np.concatenate([A, np.broadcast_to(H, (S, n, p))], axis=-1)
+    if discrete:
+        M = -(AH.mT @ P @ AH)
+        M[:, :n, :n] += P
+    else:
+        Sx = P @ AH
+        M = np.zeros((S, n + p, n + p))
+        M[:, :n, :] = -Sx
+        M[:, :, :n] -= Sx.mT
+    M[:, :n, :n] -= QK + lam[:, None, None] * (E.mT @ E)
+    M[:, n:, n:] += lam[:, None, None] * np.eye(p)
+    return np.linalg.eigvalsh(0.5 * (M + M.mT))
+
+
+def _guaranteed_cost_batch(plant: Plant, K: np.ndarray, unc: NormBounded, Q: np.ndarray, R: np.ndarray,
+                           x0: np.ndarray | None) -> CostBoundBatch:
+    """:func:`guaranteed_cost` of a stack of gains by Riccati equations and a search over the multiplier.
+
+    For a fixed ``lam`` the smallest ``P`` of the guaranteed-cost LMI is the
+    stabilising solution ``P_lam`` of the bounded-real Riccati equation of
+    ``(A, H, C_lam)`` at the level ``sqrt(lam)``, ``C_lam'C_lam = Q_K + lam
+    E'E`` (the LMI's Schur complement at equality); both objectives grow
+    with ``P``, so the bound is ``min over lam`` of ``f(lam) = x0'P_lam x0``
+    (or ``lambda_max(P_lam)``), a convex function (the partial minimum of the
+    convex SDP) on ``lam > lam*``. With ``q = ||C_Q (zI - A)^-1 H||_inf``
+    (``C_Q'C_Q = Q_K``) and ``g = ||E (zI - A)^-1 H||_inf < 1``,
+    ``q^2 <= lam* <= q^2 / (1 - g^2)``; from ``P_lam >= P_Q + lam P_E``
+    (Lyapunov solutions of ``Q_K`` and ``E'E``) the minimiser is at most
+    ``(f(lam_1) - f_Q) / f_E`` for any feasible ``lam_1``. A golden-section
+    search on ``log lam`` over that bracket, all designs at once (one
+    batched Riccati solve per step), finds it.
+    """
+    discrete = plant.is_discrete
+    B, n = K.shape[0], plant.n
+    finite = np.isfinite(K).all(axis=(1, 2))
+    Kf = np.where(finite[:, None, None], K, 0.0)
+    A = plant.F + plant.G @ Kf
+    E = unc.EF + unc.EG @ Kf
+    H = unc.H
+    lam_A = _hinfnorm.eigvals(A)
+    if discrete:
+        stable = np.abs(lam_A).max(axis=1) < 1.0 - STABILITY_MARGIN
+    else:
+        stable = lam_A.real.max(axis=1) < -STABILITY_MARGIN
+    stable &= finite
+    reason = np.where(finite, np.where(stable, "ok", "unstable"), "not finite").astype("<U20")
+    bound = np.where(finite, np.inf, np.nan)
+    P_out = np.full((B, n, n), np.nan)
+    mult = np.full(B, np.nan)
+    cert = {"cost": np.full(B, np.nan), "P": np.full(B, np.nan)}
+    steps = failures = 0
+    idx = np.flatnonzero(stable)
+    if idx.size:
+        A, E = A[idx], E[idx]
+        S = idx.size
+        CQ = np.concatenate([np.broadcast_to(_psd_factor(Q), (S, n, n)), _psd_factor(R) @ Kf[idx]], axis=1)
+        QK = CQ.mT @ CQ
+        Hs = np.broadcast_to(H, (S, *H.shape))
+        reach = bool(np.any(H)) & (np.abs(E).max(axis=(1, 2)) > 0)
+        g = _hinfnorm.hinf_norm(A, Hs, E, discrete=discrete, poles=lam_A[idx])[0]
+        robust = ~reach | (g < 1.0)
+        reason[idx[~robust]] = "not robustly stable"
+        zero = np.zeros_like(Hs)
+        one = np.ones(S)
+        # Lyapunov solutions (the Riccati equation without H): P_Q, and P_E for the bracket
+        P_Q, ok_Q = _hinfnorm.bounded_real_riccati(A, zero, CQ, one, discrete=discrete)
+        f_Q = np.where(ok_Q, _cost_objective(P_Q, x0), np.inf)
+        best_f, best_P, best_lam = np.where(reach, np.inf, f_Q), P_Q.copy(), np.zeros(S)
+        live = np.flatnonzero(reach & robust)
+        if live.size:
+            Al, El, CQl, Hl, QKl = A[live], E[live], CQ[live], Hs[live], QK[live]
+            P_E, ok_E = _hinfnorm.bounded_real_riccati(Al, zero[live], El, one[live], discrete=discrete)
+            f_E = np.where(ok_E, _cost_objective(P_E, x0), 0.0)
+            q = _hinfnorm.hinf_norm(Al, Hl, CQl, discrete=discrete, poles=lam_A[idx[live]])[0]
+            gl = g[live]
+
+            def f(lam):
+                C = np.concatenate([CQl, np.sqrt(lam)[:, None, None] * El], axis=1)
+                P, ok = _hinfnorm.bounded_real_riccati(Al, Hl, C, np.sqrt(lam), discrete=discrete)
+                ok &= np.isfinite(P).all(axis=(1, 2))
+                P = np.where(ok[:, None, None], P, 0.0)
+                # a level at or below the norm can pass the eigenvalue count with imaginary-axis
+                # eigenvalues split by rounding: keep only P that satisfy the LMI (up to rounding)
+                ev = _cost_lmi_eigs(Al, H, El, QKl, P, lam, discrete)
+                ok &= ev[:, 0] >= -_COST_LMI_TOL * np.maximum(1.0, np.abs(ev).max(axis=1))
+                val = _cost_objective(P, x0)
+                val = np.where(ok & np.isfinite(val), val, np.inf)
+                better = val < best_f[live]
+                sel = live[better]
+                best_f[sel], best_P[sel], best_lam[sel] = val[better], P[better], lam[better]
+                return val
+
+            scale = np.where(q > 0, q * q, np.maximum(f_Q[live], 1e-300) / np.maximum(f_E, 1e-300))
+            lam1 = np.maximum(2.0 * q * q / (1.0 - gl * gl), 1e-12 * scale)
+            f1 = f(lam1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                up = np.where(f_E > 0, (f1 - f_Q[live]) / f_E, 1e6 * lam1)
+            up = np.where(np.isfinite(up) & (up > lam1), up, lam1)
+            lo = np.where(q > 0, q * q, 1e-12 * up)
+            a, b = np.log(lo), np.log(up) + 1e-12
+            gr = (math.sqrt(5.0) - 1.0) / 2.0
+            c, d = b - gr * (b - a), a + gr * (b - a)
+            fc, fd = f(np.exp(c)), f(np.exp(d))
+            width = float((b - a).max())
+            steps = max(0, math.ceil(math.log(1e-9 / width) / math.log(gr))) if width > 1e-9 else 0
+            for _ in range(min(steps, 100)):
+                left = fc < fd
+                b = np.where(left, d, b)
+                a = np.where(left, a, c)
+                c_new = np.where(left, b - gr * (b - a), d)
+                d_new = np.where(left, c, a + gr * (b - a))
+                x = np.where(left, c_new, d_new)
+                fx = f(np.exp(x))
+                fc, fd = np.where(left, fx, fd), np.where(left, fc, fx)
+                c, d = c_new, d_new
+        found = np.isfinite(best_f) & robust
+        failures = int((robust & ~found).sum())
+        rows = idx[found]
+        Pf, lf = best_P[found], best_lam[found]
+        bound[rows], P_out[rows], mult[rows] = best_f[found], Pf, lf
+        if rows.size:   # the LMI blocks at (P, lam), in the plant's coordinates
+            cert["cost"][rows] = _cost_lmi_eigs(A[found], H, E[found], QK[found], Pf, lf, discrete)[:, 0]
+            cert["P"][rows] = np.linalg.eigvalsh(Pf)[:, 0]
+    info = {"path": "riccati", "search_steps": steps, "riccati_failures": failures}
+    return CostBoundBatch(_frozen(bound), _frozen(P_out), _frozen(mult), _ro(reason),
+                          None if x0 is None else _frozen(x0),
+                          MappingProxyType({k: _frozen(v) for k, v in cert.items()}), MappingProxyType(info))
+
+
 def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertainty: NormBounded, Q: ArrayLike,
-                    R: ArrayLike, x0: ArrayLike | None = None) -> CostBound:
+                    R: ArrayLike, x0: ArrayLike | None = None) -> CostBound | CostBoundBatch:
     r"""Upper bound on the LQ cost of ``u = K x`` valid for every ``||Delta|| <= 1``.
 
     The guaranteed-cost LMI of Petersen & McFarlane (1994), for a fixed gain:
@@ -1061,16 +1320,18 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     minimises ``x0'P x0``, or ``lambda_max(P)`` (one ``P`` for every unit
     initial state) if ``x0`` is not given.
 
-    One gain per call (no stacks, unlike :func:`robust_stability`): the bound
-    is an optimisation over the multiplier ``lam`` as well as ``P``, one SDP
-    per design. (For a fixed ``lam`` the smallest ``P`` is the stabilising
-    solution of a Riccati equation and the bound is convex in ``lam``, so a
-    batched version would be a scalar search over ``lam`` with batched
-    Riccati solves; it is not implemented.)
+    One gain: one SDP. A stack of gains (B, m, n) is answered at once
+    without an SDP (:class:`CostBoundBatch`): for a fixed ``lam`` the
+    smallest ``P`` is the stabilising solution of a bounded-real Riccati
+    equation and the bound is convex in ``lam``, so a golden-section search
+    over ``log lam`` with batched Riccati solves gives every design's bound
+    (:func:`_guaranteed_cost_batch`); designs that are unstable, not
+    robustly stable or not finite are flagged (``reason``) instead of
+    raising.
 
     Parameters
     ----------
-    controller : Controller or (Plant, (m, n) array_like)
+    controller : Controller or (Plant, (m, n) or (B, m, n) array_like)
     uncertainty : NormBounded
     Q : (n, n) array_like, symmetric positive semidefinite
     R : (m, m) array_like, symmetric positive semidefinite
@@ -1079,15 +1340,26 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
 
     Returns
     -------
-    CostBound
+    CostBound or CostBoundBatch
+        The latter for a stack of gains.
 
     Raises
     ------
     InfeasibleError
-        The loop is not quadratically stable for ``||Delta|| <= 1`` (no bound exists).
+        One gain: the loop is not quadratically stable for ``||Delta|| <= 1`` (no bound exists).
     """
     import cvxpy as cp
 
+    plant, K = _loop(controller, batch=True)
+    if K.ndim == 3:
+        unc = check_norm_bounded(uncertainty, plant)
+        n, m = plant.n, plant.m
+        Qc = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
+                                 cols_what="the number of states"), "Q", semidefinite=True)
+        Rc = check_spd(as_matrix(R, "R", rows=m, cols=m, rows_what="the number of inputs",
+                                 cols_what="the number of inputs"), "R", semidefinite=True)
+        x0b = None if x0 is None else as_batch(x0, "x0", (n,), ("the number of states",))
+        return _guaranteed_cost_batch(plant, K, unc, Qc, Rc, x0b)
     plant, K, A, H, E = _robust_loop(controller, uncertainty, "guaranteed cost")
     n, m, p = plant.n, plant.m, H.shape[1]
     Q = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
