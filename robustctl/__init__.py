@@ -19,6 +19,7 @@ from ._margins_report import MarginsReport, margins_report
 from ._rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule, rlqr_step, rlqr_step_block
 from .analysis import (
     CostBound,
+    CostBoundBatch,
     HinfBound,
     RobustStability,
     RobustStabilityBatch,
@@ -57,6 +58,6 @@ __all__ = [
     "NotStabilizingError",
 ]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
-            "RobustStability", "RobustStabilityBatch", "CostBound", "HinfBound", "WorstCase"]
+            "RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase"]
 __all__ += ["lq_output", "InputMemoryFeedback", "margins_report", "MarginsReport"]
 __version__ = "0.1.0"

@@ -163,7 +163,7 @@ CASES = {
                                   "P_N": np.eye(2), "implementation": "kkt"}),
     "rlqr_gains": (_gains, {"EF": np.ones((3, 1, 2)) * EF2, "EG": EG2, "mu": np.array([1e2, 1e4, np.inf]),
                             "Q": np.eye(2), "R": np.eye(1), "H": H2, "alpha": 0.1, "tol": 1e-10,
-                            "max_iter": 100, "P0": np.eye(2), "fallback": "newton"}),
+                            "max_iter": 100, "P_N": np.eye(2), "fallback": "newton"}),
     "rlqr_step": (_step, {"P_next": np.eye(2), "F": F2, "G": G2, "EF": EF2, "EG": EG2, "Q": np.eye(2),
                           "R": np.eye(1), "H": H2, "mu": 1e4, "alpha": 0.1}),
     "spectral_radius": (lambda A=F2: rc.spectral_radius(A), {"A": F2}),
@@ -225,7 +225,7 @@ OBJECTS = {"vertices", "poles", "uncertainty", "controller"}   # drawn like a pl
 VALID_NAMES = ("kkt", "block", "recursion", "newton", "zoh", "tustin", "euler", "lqr", "rlqr", "hinf", "h2",
                "left", "right", "clarabel", "scs", "scipy", "highs", "osqp", "cvxopt", "mosek")
 # None is a documented value of these (default, identity, continuous time, the design plant, no bound, ...)
-NONE_OK = {"P_N", "P0", "H", "Q", "R", "dt", "Dzw", "vertices", "gamma", "u_max", "w_energy", "poles",
+NONE_OK = {"P_N", "H", "Q", "R", "dt", "Dzw", "vertices", "gamma", "u_max", "w_energy", "poles",
            "uncertainty", "x0", "seed"}
 INF_OK = {"mu"}  # inf is a valid value of these
 CAUSES = ["bool", "string", "numeric string", "complex", "ragged", "None", "nan", "inf", "object"]
