@@ -34,6 +34,7 @@ from .lqr import lqr
 from .plant import Plant
 from .regions import ConicSector, Disk, HalfPlane
 from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule
+from .scenarios import PlantSamples, sample_plants
 from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
 
@@ -44,6 +45,7 @@ __all__ = [
     "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
 ]
+__all__ += ["sample_plants", "PlantSamples"]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
             "RobustStability", "CostBound", "HinfBound", "WorstCase"]
 __version__ = "0.1.0"
