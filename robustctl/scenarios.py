@@ -147,7 +147,7 @@ def sample_plants(model: Callable[..., Plant], ranges: Mapping[str, tuple[float,
     method = check_choice(method, "method", SAMPLING_METHODS)
     rng = as_rng(seed)
     params = bounds[:, 0] + _unit_samples(method, len(names), n, rng) * (bounds[:, 1] - bounds[:, 0])
-    plants = []
+    plants: list[Plant] = []
     for row in params:
         kwargs = dict(zip(names, map(float, row), strict=True))
         plant = model(**kwargs)
