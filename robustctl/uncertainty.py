@@ -111,27 +111,37 @@ class NormBounded:
         ``E = [EF EG]``, is built from the two subspaces every ``D_i`` lives in
         (singular value decompositions of the stacked deviations):
 
-        * the column space: ``[D_1 ... D_N] = U S V'``; ``U_p`` its first ``p``
-          left singular vectors;
-        * the row space: ``[D_1; ...; D_N] = X S' W'``; ``W_l`` its first ``l``
-          right singular vectors;
+        * the column space: ``[D_1 ... D_N] = U S V'``, singular values
+          ``s_1 >= s_2 >= ...``; ``U_p`` its first ``p`` left singular vectors;
+        * the row space: ``[D_1; ...; D_N] = X S' W'``, singular values
+          ``s'_1 >= ...``; ``W_l`` its first ``l`` right singular vectors;
 
         where ``p`` and ``l`` are the numerical ranks (singular values above
-        ``tol / 2`` times ``c = max_i ||D_i||_2``, at most ``rank``). Then
-        ``D_i = U_p Delta0_i W_l'`` with ``Delta0_i = U_p' D_i W_l`` (the
-        least-squares solution ``H^+ D_i E^+``) and ``||Delta0_i||_2 = ||D_i||_2``,
-        and the smallest common scaling puts every ``Delta_i`` in the unit ball:
+        ``tol / 2`` times ``d = max_i ||D_i||_2``, at most ``rank``). Each
+        direction is weighted by the square root of its share of the
+        deviations, ``S_h = diag(sqrt(s_k / s_1))``,
+        ``S_e = diag(sqrt(s'_j / s'_1))``, so that a direction in which the
+        plants hardly deviate gets a correspondingly small share of the
+        uncertainty (with orthonormal ``H`` and ``E`` every direction of
+        ``Delta`` could reach the size of the largest deviation, a far more
+        conservative model when the deviations are close to low rank). Then
+        ``D_i = U_p S_h Delta0_i S_e W_l'`` with the least-squares solution
+        ``Delta0_i = S_h^-1 U_p' D_i W_l S_e^-1`` (``H^+ D_i E^+``; its
+        entries satisfy ``|(Delta0_i)_kj| <= sqrt(s_1 s'_1)``, since
+        ``|u_k' D_i w_j| <= min(s_k, s'_j)``), and the smallest common
+        scaling ``c = max_i ||Delta0_i||_2`` puts every ``Delta_i`` in the
+        unit ball:
 
         .. math::
 
-            H = \sqrt{c}\, U_p, \qquad [E_F\; E_G] = \sqrt{c}\, W_l', \qquad
+            H = \sqrt{c}\, U_p S_h, \qquad [E_F\; E_G] = \sqrt{c}\, S_e W_l', \qquad
             \Delta_i = \Delta^0_i / c, \qquad \max_i \|\Delta_i\|_2 = 1,
 
         attained by the plant(s) that deviate most (so a one-parameter family
         ``(F + theta F1, G + theta G1)``, ``|theta| <= 1``, fitted on its two
         extreme plants, is reproduced exactly, with ``||Delta|| = 1`` at both
         ends). The model is checked to contain every plant: each deviation is
-        reproduced by its ``Delta_i`` to ``||D_i - H Delta_i E||_2 <= tol c``
+        reproduced by its ``Delta_i`` to ``||D_i - H Delta_i E||_2 <= tol d``
         (guaranteed by the truncation when ``rank`` is not given; with a
         ``rank`` too small to represent the deviations a ``ValueError`` says
         which plant does not fit and by how much).
@@ -139,8 +149,7 @@ class NormBounded:
         The set ``{H Delta E : ||Delta|| <= 1}`` contains the plants (and
         their convex hull, the unit ball being convex) but in general also
         plants beyond them: a certificate against it is conservative for the
-        plant set, never optimistic. ``H`` and ``E`` share the scale
-        (``||H|| = ||E|| = sqrt(c)``); ``(a H, E / a)`` is the same model.
+        plant set, never optimistic. ``(a H, E / a)`` is the same model.
 
         Parameters
         ----------
@@ -204,20 +213,22 @@ class NormBounded:
             raise ValueError(f"tol must be < 1 (a relative tolerance), got {tol}")
         nom = np.hstack([nominal.F, nominal.G])
         D = np.stack([np.hstack([p.F, p.G]) - nom for p in plants])               # (N, n, n + m)
-        c = float(np.linalg.norm(D, ord=2, axis=(1, 2)).max())
-        if not c > 0:
+        d = float(np.linalg.norm(D, ord=2, axis=(1, 2)).max())
+        if not d > 0:
             raise ValueError("plants do not deviate from nominal (every [F_i - F, G_i - G] is zero): "
                              "there is no uncertainty to model")
         U, su, _ = np.linalg.svd(np.concatenate(list(D), axis=1), full_matrices=False)
         _, sv, Wt = np.linalg.svd(np.concatenate(list(D), axis=0), full_matrices=False)
-        p = int(np.count_nonzero(su > 0.5 * tol * c))
-        l = int(np.count_nonzero(sv > 0.5 * tol * c))
+        p = int(np.count_nonzero(su > 0.5 * tol * d))
+        l = int(np.count_nonzero(sv > 0.5 * tol * d))
         if cap is not None:
             p, l = min(p, cap), min(l, cap)
-        Up, Wl = U[:, :p], Wt[:l].T
-        Delta = np.einsum("np,snk,kl->spl", Up, D, Wl) / c                         # H^+ D_i E^+
-        H, E = np.sqrt(c) * Up, np.sqrt(c) * Wl.T
-        resid = np.linalg.norm(D - np.einsum("np,spl,lk->snk", H, Delta, E), ord=2, axis=(1, 2)) / c
+        Sh, Se = np.sqrt(su[:p] / su[0]), np.sqrt(sv[:l] / sv[0])
+        H0, E0 = U[:, :p] * Sh, Se[:, None] * Wt[:l]
+        Delta = np.einsum("np,snk,kl->spl", U[:, :p] / Sh, D, Wt[:l].T / Se)        # H0^+ D_i E0^+
+        c = float(np.linalg.norm(Delta, ord=2, axis=(1, 2)).max())
+        H, E, Delta = np.sqrt(c) * H0, np.sqrt(c) * E0, Delta / c
+        resid = np.linalg.norm(D - np.einsum("np,spl,lk->snk", H, Delta, E), ord=2, axis=(1, 2)) / d
         worst = int(np.argmax(resid))
         if resid[worst] > tol:
             raise ValueError(f"a model with Delta of size {p} x {l} (rank={rank}) reproduces the deviation of "
