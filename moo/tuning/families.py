@@ -1,0 +1,402 @@
+r"""Design families: a decision vector ``z`` -> a state-feedback gain, for a whole population at once.
+
+A *design family* turns the MOEA's decision vectors into gains ``u = K x``
+for the scenario plants of a :class:`~moo.tuning.TuningProblem`. Any object
+with the small protocol :class:`DesignFamily` works; two are provided:
+
+* :class:`RLQRFamily` - the paper's family, generalised: ``z = (E_F (l x n),
+  E_G (l x m), (log10 mu)^2)`` is a candidate uncertainty model
+  ``[dF dG] = H Delta [E_F E_G]`` and penalty ``mu`` of the steady-state
+  robust LQR (:func:`robustctl.rlqr_gains`, batched);
+* :class:`LQRFamily` - ``z = (log10 diag Q (n), log10 diag R (m))``, the
+  discrete LQR of diagonal weights, all designs solved as one stack of
+  Riccati equations (structure-preserving doubling, :func:`dlqr_gains`).
+
+Both accept an ``input_map`` ``M`` (``p x m``): the design is done on
+``(F, G M)`` (``m`` design inputs) and the gain applied to the plant is
+``M K_d`` (``p x n``). The paper's truck is designed with a doubled steering
+column ``[G G]`` and steers with ``alpha = u1 + u2``: ``input_map = [[1, 1]]``.
+
+References
+----------
+D. C. Morais et al., "Robust path-following control design of heavy vehicles
+based on multiobjective evolutionary optimization", Expert Systems with
+Applications 192 (2022) 116304, Section 3.1 (the RLQR family).
+E. K.-W. Chu, H.-Y. Fan, W.-W. Lin, C.-S. Wang, "Structure-preserving
+algorithms for periodic discrete-time algebraic Riccati equations", Int. J.
+Control 77(8) (2004) 767-788 (the doubling iteration of :func:`dlqr_gains`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Protocol, runtime_checkable
+
+import numpy as np
+
+import robustctl as rc
+from robustctl.validation import check_plant, check_positive_scalar
+
+from .._validation import as_float_array, as_matrix, check_int
+
+__all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains"]
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class FamilyGains:
+    """Gains of a population of designs.
+
+    Attributes
+    ----------
+    K : (B, m, n) ndarray
+        Gains ``u = K x`` for the scenario plants (NaN rows where ``ok`` is False).
+    ok : (B,) bool ndarray
+        The design was computed.
+    reason : (B,) object ndarray of str
+        ``""`` where ``ok``, otherwise why not (e.g. ``"not converged"``, ``"rank"``).
+    """
+
+    K: np.ndarray
+    ok: np.ndarray
+    reason: np.ndarray
+
+    def __repr__(self) -> str:
+        B, m, n = self.K.shape
+        return f"FamilyGains(B={B}, m={m}, n={n}, failed={int((~self.ok).sum())})"
+
+
+@runtime_checkable
+class DesignFamily(Protocol):
+    """What :class:`~moo.tuning.TuningProblem` needs of a design family (any object with these works).
+
+    Attributes
+    ----------
+    n_var : int
+        Length of the decision vector ``z``.
+    xl, xu : (n_var,) ndarray
+        Default bounds of ``z`` (``xl < xu``).
+    n_states, n_inputs : int
+        The gains are ``(n_inputs, n_states)``: the scenario plants' ``m`` and ``n``.
+
+    Methods
+    -------
+    gains(Z)
+        ``Z`` (B, n_var) -> :class:`FamilyGains`; a design that cannot be
+        computed is flagged (``ok`` False, NaN row), never raised.
+
+    Examples
+    --------
+    A family that searches a gain directly, ``K = z.reshape(m, n)``::
+
+        class DirectGain:
+            def __init__(self, n, m, bound=5.0):
+                self.n_states, self.n_inputs, self.n_var = n, m, n * m
+                self.xl, self.xu = np.full(n * m, -bound), np.full(n * m, bound)
+
+            def gains(self, Z):
+                B = Z.shape[0]
+                return FamilyGains(Z.reshape(B, self.n_inputs, self.n_states),
+                                   np.ones(B, bool), np.full(B, "", object))
+    """
+
+    n_var: int
+    xl: np.ndarray
+    xu: np.ndarray
+    n_states: int
+    n_inputs: int
+
+    def gains(self, Z: np.ndarray) -> FamilyGains:
+        """Gains of a population ``Z`` (B, n_var), failed designs flagged."""
+        ...
+
+
+def _input_map(input_map, plant: rc.Plant) -> np.ndarray | None:
+    if input_map is None:
+        return None
+    return as_matrix(input_map, "input_map", rows=plant.m, rows_what="the plant's number of inputs")
+
+
+def _bounds(value, name: str, default: np.ndarray) -> np.ndarray:
+    if value is None:
+        return default.copy()
+    arr = as_float_array(value, name)
+    if arr.ndim == 0:
+        arr = np.full(default.size, float(arr))
+    if arr.shape != default.shape:
+        raise ValueError(f"{name} must be a scalar or have shape {default.shape} (one per variable), "
+                         f"got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must have finite entries (found NaN or inf)")
+    return arr
+
+
+def check_bounds(xl: np.ndarray, xu: np.ndarray) -> None:
+    """``ValueError`` naming ``xl``/``xu`` unless ``xl < xu`` everywhere."""
+    bad = np.flatnonzero(~(xl < xu))
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(f"bounds inverted or empty: xl[{i}] = {xl[i]:g} must be < xu[{i}] = {xu[i]:g}")
+
+
+def population(Z, n_var: int, name: str = "Z") -> np.ndarray:
+    """``Z`` as a finite (B, n_var) float array (a single (n_var,) vector becomes B = 1)."""
+    arr = as_float_array(Z, name)
+    if arr.ndim == 1:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != n_var:
+        raise ValueError(f"{name} must have shape (B, {n_var}) (one decision vector per row), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must have finite entries (found NaN or inf)")
+    return arr
+
+
+def _reasons(ok: np.ndarray, reason) -> np.ndarray:
+    out = np.asarray(reason).astype(object)
+    out[ok] = ""
+    return out
+
+
+class RLQRFamily:
+    r"""The paper's RLQR design family, for any plant size and uncertainty rank.
+
+    .. math::
+
+        z = \big(\operatorname{vec}_r E_F\ (l n),\ \operatorname{vec}_r E_G\ (l m),\
+        (\log_{10}\mu)^2\big), \qquad
+        K(z) = \text{steady-state RLQR of } (F, G M; H, E_F, E_G, \mu; Q, R),
+
+    ``vec_r`` row by row, ``mu = 10**sqrt(z[-1])``, ``l`` the number of
+    columns of ``H`` (``Delta`` is ``l x l``). The gains of a whole population
+    come from one call of :func:`robustctl.rlqr_gains`; designs it flags
+    (rank condition, not converged, diverged) are flagged here too. With an
+    ``input_map`` ``M`` the returned gain is ``M K_d``.
+
+    Parameters
+    ----------
+    plant : robustctl.Plant
+        Nominal discrete-time design model ``(F, G)`` (``n`` states, ``p`` inputs).
+    H : (n, l) array_like, optional
+        Uncertainty input; default ``ones((n, 1))`` (the paper's).
+    Q : (n, n) array_like, optional
+        State weight, default identity.
+    R : (m, m) array_like, optional
+        Input weight of the design inputs, default identity.
+    alpha : float
+        RLQR's ``lambda = (1 + alpha) ||mu H^T H||`` margin.
+    max_iter : int
+        Steps of the plain recursion :func:`robustctl.rlqr_gains` may take for
+        designs the doubling leaves unsettled; a design not converged by then
+        is flagged (the MOEA then penalises it: slow designs cost much and are
+        rarely useful).
+    fallback : {"newton", "recursion"}
+        :func:`robustctl.rlqr_gains`'s treatment of those designs.
+    input_map : (p, m) array_like, optional
+        Design on ``(F, G M)``, apply ``M K_d`` (see the module docstring).
+    e_bound : float
+        Default upper bound of every ``E_F``, ``E_G`` entry (lower bound 0): 100.
+    log_mu_bound : float
+        Default upper bound of ``(log10 mu)^2`` (lower bound 0): 100, i.e.
+        ``mu`` in ``[1, 1e10]``.
+
+    Attributes
+    ----------
+    n_var : int
+        ``l (n + m) + 1``.
+    xl, xu : (n_var,) ndarray
+        Default bounds (``[0, e_bound]`` and ``[0, log_mu_bound]``).
+    design_plant : robustctl.Plant
+        ``(F, G M)`` (the plant itself without an input map).
+    """
+
+    def __init__(self, plant: rc.Plant, *, H=None, Q=None, R=None, alpha: float = 0.1, max_iter: int = 500,
+                 fallback: Literal["newton", "recursion"] = "newton", input_map=None, e_bound: float = 100.0,
+                 log_mu_bound: float = 100.0):
+        plant = check_plant(plant, "plant", discrete_for="RLQRFamily")
+        self.plant = plant
+        self.input_map = _input_map(input_map, plant)
+        self.design_plant = plant if self.input_map is None else rc.Plant(plant.F, plant.G @ self.input_map,
+                                                                          dt=plant.dt)
+        n, m = self.design_plant.n, self.design_plant.m
+        self.H = np.ones((n, 1)) if H is None else as_matrix(H, "H", rows=n, rows_what="the number of states")
+        self.l = self.H.shape[1]
+        self.Q = np.eye(n) if Q is None else as_matrix(Q, "Q")
+        self.R = np.eye(m) if R is None else as_matrix(R, "R")
+        self.alpha = check_positive_scalar(alpha, "alpha")
+        self.max_iter = check_int(max_iter, "max_iter", 1)
+        self.fallback = fallback
+        l = self.l
+        rc.rlqr_gains(self.design_plant, np.zeros((1, l, n)), np.zeros((1, l, m)), np.ones(1), Q=self.Q, R=self.R,
+                      H=self.H, alpha=self.alpha, max_iter=1, fallback=fallback)   # checks Q, R, H, alpha, fallback
+        self.n_states, self.n_inputs = plant.n, plant.m
+        self.n_var = l * (n + m) + 1
+        e_bound = check_positive_scalar(e_bound, "e_bound")
+        log_mu_bound = check_positive_scalar(log_mu_bound, "log_mu_bound")
+        self.xl = np.zeros(self.n_var)
+        self.xu = np.full(self.n_var, e_bound)
+        self.xu[-1] = log_mu_bound
+
+    def decode(self, Z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(EF (B, l, n), EG (B, l, m), mu (B,))`` of a population ``Z`` (B, n_var) or one ``z``.
+
+        ``mu = 10 ** sqrt(z[:, -1])``; ``(log10 mu)^2`` must be ``>= 0``.
+        """
+        z = population(Z, self.n_var, "Z")
+        if np.any(z[:, -1] < 0):
+            raise ValueError(f"the last variable of Z, (log10 mu)^2, must be >= 0, got {z[:, -1].min():g}")
+        B, l = z.shape[0], self.l
+        n, m = self.design_plant.n, self.design_plant.m
+        EF = z[:, :l * n].reshape(B, l, n).copy()
+        EG = z[:, l * n:l * (n + m)].reshape(B, l, m).copy()
+        return EF, EG, 10.0 ** np.sqrt(z[:, -1])
+
+    def design(self, Z) -> rc.RLQRBatch:
+        """The batched RLQR designs (gains of the design inputs, no input map) of a population ``Z``."""
+        EF, EG, mu = self.decode(Z)
+        return rc.rlqr_gains(self.design_plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha,
+                             max_iter=self.max_iter, fallback=self.fallback)
+
+    def gains(self, Z) -> FamilyGains:
+        """:class:`FamilyGains` of a population ``Z`` (B, n_var): ``M K_d`` (or ``K_d``), flags."""
+        batch = self.design(Z)
+        ok = np.asarray(batch.ok, dtype=bool) & np.all(np.isfinite(batch.K), axis=(1, 2))
+        K = np.where(ok[:, None, None], batch.K, np.nan)
+        if self.input_map is not None:
+            K = self.input_map @ K
+        return FamilyGains(K=K, ok=ok, reason=_reasons(ok, batch.reason))
+
+    def nominal(self) -> np.ndarray:
+        """The gain with no uncertainty: the LQR of ``Q``, ``R`` on the design plant (through the input map)."""
+        K = rc.lqr(self.design_plant, Q=self.Q, R=self.R).K
+        return K if self.input_map is None else self.input_map @ K
+
+    def __repr__(self) -> str:
+        return (f"RLQRFamily(n={self.design_plant.n}, m={self.design_plant.m}, l={self.l}, n_var={self.n_var}, "
+                f"input_map={'none' if self.input_map is None else self.input_map.shape})")
+
+
+def dlqr_gains(F, G, Q, R, *, tol: float = 1e-12, max_iter: int = 100) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Discrete LQR gains of a stack of weights, by structure-preserving doubling (vectorised).
+
+    For each ``b`` solves the DARE
+    ``X = F^T X F - F^T X G (R_b + G^T X G)^{-1} G^T X F + Q_b`` with the
+    doubling iteration (Chu et al. 2004): ``A_0 = F``, ``S_0 = G R_b^{-1} G^T``,
+    ``X_0 = Q_b``,
+
+    .. math::
+
+        W_k = I + S_k X_k,\quad A_{k+1} = A_k W_k^{-1} A_k,\quad
+        S_{k+1} = S_k + A_k W_k^{-1} S_k A_k^T,\quad
+        X_{k+1} = X_k + A_k^T X_k W_k^{-1} A_k,
+
+    which converges quadratically to the stabilising solution when ``(F, G)``
+    is stabilisable and ``(Q_b^{1/2}, F)`` detectable; then
+    ``K_b = -(R_b + G^T X G)^{-1} G^T X F`` (``u = K x``).
+
+    Parameters
+    ----------
+    F, G : (n, n), (n, m) ndarray
+    Q, R : (B, n, n), (B, m, m) ndarray
+        Symmetric positive definite weights.
+    tol : float
+        Stop when ``||X_{k+1} - X_k||_F <= tol ||X_{k+1}||_F`` for every design.
+    max_iter : int
+        Doubling steps at most (each doubles the horizon).
+
+    Returns
+    -------
+    K : (B, m, n) ndarray
+    X : (B, n, n) ndarray
+    ok : (B,) bool ndarray
+        Converged, finite, and ``F + G K`` Schur-stable.
+    """
+    B, n = Q.shape[0], F.shape[0]
+    A = np.broadcast_to(F, (B, n, n)).copy()
+    S = G @ np.linalg.solve(R, np.broadcast_to(G.T, (B, *G.T.shape)))
+    X = Q.copy()
+    eye = np.eye(n)
+    done = np.zeros(B, dtype=bool)
+    with np.errstate(all="ignore"):
+        for _ in range(max_iter):
+            act = ~done
+            a, s, x = A[act], S[act], X[act]
+            W = eye + s @ x
+            WA = np.linalg.solve(W, a)                        # W^{-1} A
+            WS = np.linalg.solve(W, s)                        # W^{-1} S
+            x_new = x + np.swapaxes(a, 1, 2) @ x @ WA
+            step = np.linalg.norm(x_new - x, axis=(1, 2))
+            A[act], S[act], X[act] = a @ WA, s + a @ WS @ np.swapaxes(a, 1, 2), x_new
+            conv = ~(step > tol * np.linalg.norm(x_new, axis=(1, 2)))   # NaN counts as settled (flagged below)
+            done[np.flatnonzero(act)[conv]] = True
+            if done.all():
+                break
+        X = 0.5 * (X + np.swapaxes(X, 1, 2))
+        GX = G.T @ X                                          # (B, m, n)
+        K = -np.linalg.solve(R + GX @ G, GX @ F)
+    ok = done & np.all(np.isfinite(K), axis=(1, 2))
+    ok[ok] = np.asarray(rc.is_schur_stable(F + G @ K[ok]), dtype=bool)
+    return K, X, ok
+
+
+class LQRFamily:
+    r"""LQR designs of diagonal weights: ``z = (log10 diag Q (n), log10 diag R (m))``.
+
+    .. math::
+
+        K(z) = \text{DLQR}\big(F, G M;\ \operatorname{diag}(10^{z_{1..n}}),\
+        \operatorname{diag}(10^{z_{n+1..n+m}})\big),
+
+    all designs of a population solved together (:func:`dlqr_gains`). The
+    sign convention is ``u = K x`` (python-control's ``dlqr`` returns ``-K``).
+
+    Parameters
+    ----------
+    plant : robustctl.Plant
+        Discrete-time design model (must be stabilisable).
+    input_map : (p, m) array_like, optional
+        Design on ``(F, G M)``, apply ``M K_d``.
+    log_bound : float
+        Default bounds ``[-log_bound, log_bound]`` of every variable (default 4:
+        weights from ``1e-4`` to ``1e4``).
+
+    Attributes
+    ----------
+    n_var : int
+        ``n + m``.
+    xl, xu : (n_var,) ndarray
+    """
+
+    def __init__(self, plant: rc.Plant, *, input_map=None, log_bound: float = 4.0, tol: float = 1e-12,
+                 max_iter: int = 100):
+        plant = check_plant(plant, "plant", discrete_for="LQRFamily")
+        self.plant = plant
+        self.input_map = _input_map(input_map, plant)
+        self.design_plant = plant if self.input_map is None else rc.Plant(plant.F, plant.G @ self.input_map,
+                                                                          dt=plant.dt)
+        if not self.design_plant.is_stabilizable:
+            raise ValueError("plant must be stabilisable (with the input map) for LQRFamily")
+        n, m = self.design_plant.n, self.design_plant.m
+        self.n_states, self.n_inputs = plant.n, plant.m
+        self.n_var = n + m
+        b = check_positive_scalar(log_bound, "log_bound")
+        self.xl, self.xu = np.full(self.n_var, -b), np.full(self.n_var, b)
+        self.tol = check_positive_scalar(tol, "tol")
+        self.max_iter = check_int(max_iter, "max_iter", 1)
+
+    def weights(self, Z) -> tuple[np.ndarray, np.ndarray]:
+        """``(Q (B, n, n), R (B, m, m))``, the diagonal weights of a population ``Z``."""
+        z = population(Z, self.n_var, "Z")
+        n = self.design_plant.n
+        eye_n, eye_m = np.eye(n), np.eye(self.design_plant.m)
+        return 10.0 ** z[:, :n, None] * eye_n, 10.0 ** z[:, n:, None] * eye_m
+
+    def gains(self, Z) -> FamilyGains:
+        """:class:`FamilyGains` of a population ``Z`` (B, n_var)."""
+        Q, R = self.weights(Z)
+        K, _, ok = dlqr_gains(self.design_plant.F, self.design_plant.G, Q, R, tol=self.tol, max_iter=self.max_iter)
+        K = np.where(ok[:, None, None], K, np.nan)
+        if self.input_map is not None:
+            K = self.input_map @ K
+        return FamilyGains(K=K, ok=ok, reason=np.where(ok, "", "not converged").astype(object))
+
+    def __repr__(self) -> str:
+        return f"LQRFamily(n={self.design_plant.n}, m={self.design_plant.m}, n_var={self.n_var})"

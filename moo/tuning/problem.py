@@ -1,0 +1,346 @@
+r"""A tuning problem: a design family, a set of plants and goals, as one pymoo ``Problem``.
+
+:class:`TuningProblem` evaluates a whole population at once:
+
+1. check the population ``Z`` (B, n_var) and design all gains with the
+   family (:meth:`DesignFamily.gains <moo.tuning.families.DesignFamily>`);
+2. screen the closed loops ``F_s + G_s K`` of the ``S`` scenario plants for
+   Schur stability (:func:`robustctl.is_schur_stable`), and compute the
+   largest spectral radius of the designs unstable somewhere
+   (:func:`robustctl.spectral_radius`);
+3. call every goal (objective or constraint) once, on the gains of the
+   designs that were computed and stabilise every scenario only;
+4. apply the penalty rule (:func:`penalise`).
+
+The penalty rule (Morais et al. 2022, Section 3.1) makes every objective
+finite and ranks the designs: with ``p`` the ``penalty``,
+
+* a design the family could not compute gets ``2 p`` on every objective;
+* a design unstable in some scenario gets ``p min(rho, 2)`` on every
+  objective (``rho`` its largest closed-loop spectral radius over the
+  scenarios, so the MOEA still prefers the less unstable ones);
+* a design for which a goal returned NaN or inf is *flagged* and gets ``p``
+  on every objective;
+* the others get their goal values, clipped at ``p``.
+
+Constraints (``g <= 0`` holds) of the penalised designs get the same positive
+value as their objectives, so they are infeasible too.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from pymoo.core.problem import Problem
+
+import robustctl as rc
+from robustctl.validation import check_positive_scalar
+
+from .._validation import as_float_array, as_matrix
+from .families import DesignFamily, FamilyGains, _bounds, check_bounds, population
+
+__all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
+
+#: A goal: ``f(K (B, m, n), plants) -> (B,)``, smaller is better (a constraint holds where ``<= 0``).
+Goal = Callable[[np.ndarray, list[rc.Plant]], Any]
+
+
+def penalise(J: np.ndarray, ok: np.ndarray, stable: np.ndarray, rho: np.ndarray, penalty: float) -> np.ndarray:
+    """Apply the penalty rule (module docstring) to raw objectives ``J`` (B, M).
+
+    ``ok`` (B,): the design was computed; ``stable`` (B,): its closed loops are
+    Schur-stable in every scenario; ``rho`` (B,): the largest closed-loop
+    spectral radius over the scenarios (read only where ``ok & ~stable``).
+    Non-finite entries of ``J`` become ``penalty``. Every returned value is
+    finite and the penalised ones are ``>= penalty``.
+    """
+    out = np.where(np.isfinite(J), np.minimum(J, penalty), penalty)
+    unstable = ok & ~stable
+    out[unstable] = (penalty * np.minimum(np.nan_to_num(rho[unstable], nan=2.0), 2.0))[:, None]
+    out[~ok] = 2.0 * penalty
+    return out
+
+
+def goal_name(goal, index: int, kind: str) -> str:
+    """A readable name of a goal: its ``name`` attribute, a function's name, or ``kind[index]``."""
+    name = getattr(goal, "name", None)
+    if isinstance(name, str) and name:
+        return name
+    fn = getattr(goal, "__name__", None)
+    if isinstance(fn, str) and fn != "<lambda>":
+        return fn
+    return f"{kind}[{index}]"
+
+
+def _scenarios(scenarios) -> list[rc.Plant]:
+    if isinstance(scenarios, rc.Plant) or not isinstance(scenarios, Sequence) or isinstance(scenarios, (str, bytes)):
+        raise TypeError(f"scenarios must be a non-empty list of robustctl.Plant, got {type(scenarios).__name__}")
+    if len(scenarios) == 0:
+        raise ValueError("scenarios must not be empty (give at least the nominal plant)")
+    first = scenarios[0]
+    for i, p in enumerate(scenarios):
+        if not isinstance(p, rc.Plant):
+            raise TypeError(f"scenarios[{i}] must be a robustctl.Plant, got {type(p).__name__}")
+        if not p.is_discrete:
+            raise ValueError(f"scenarios[{i}] must be discrete-time (dt > 0); discretise it first")
+        if (p.n, p.m) != (first.n, first.m):
+            raise ValueError(f"scenarios must all have the same size: scenarios[0] has n={first.n}, m={first.m}, "
+                             f"scenarios[{i}] has n={p.n}, m={p.m}")
+        if p.dt != first.dt:
+            raise ValueError(f"scenarios must all have the same sampling time: scenarios[0] has dt={first.dt}, "
+                             f"scenarios[{i}] has dt={p.dt}")
+    return list(scenarios)
+
+
+def _goals(goals, kind: str) -> tuple[list, list[str]]:
+    if callable(goals):
+        goals = [goals]
+    if isinstance(goals, (str, bytes)) or not isinstance(goals, Sequence):
+        raise TypeError(f"{kind} must be a list of callables f(K, plants), got {type(goals).__name__}")
+    goals = list(goals)
+    for i, g in enumerate(goals):
+        if not callable(g):
+            raise TypeError(f"{kind}[{i}] must be callable as f(K, plants), got {type(g).__name__}")
+    names = [goal_name(g, i, kind) for i, g in enumerate(goals)]
+    return goals, names
+
+
+def _ref_point(value, name: str, default: np.ndarray) -> np.ndarray:
+    if value is None:
+        return default.copy()
+    arr = as_matrix(value, name, rows=1, cols=default.size, cols_what="the number of objectives").ravel()
+    return arr
+
+
+class TuningProblem(Problem):
+    r"""Tune a state feedback of a design family against a set of plants (a pymoo ``Problem``).
+
+    ``n_var = family.n_var``, ``n_obj = len(objectives)``, ``n_ieq_constr =
+    len(constraints)``; the population is evaluated at once (module docstring:
+    the screen and the penalty rule).
+
+    Parameters
+    ----------
+    family : DesignFamily
+        ``z`` -> gains (:class:`~moo.tuning.RLQRFamily`, :class:`~moo.tuning.LQRFamily` or your own).
+    scenarios : list of robustctl.Plant
+        The plant set (same ``n``, ``m``, ``dt``; the family's ``n_states``, ``n_inputs``).
+        A design must stabilise every one of them.
+    objectives : list of callables
+        Goals ``f(K, plants) -> (B,)``, ``K`` (B, m, n) the gains of the
+        designs that stabilise every scenario, ``plants`` the scenario list;
+        smaller is better. A goal with a ``check(plants)`` method has it called
+        once here (it raises for arguments that do not fit the plants).
+    constraints : list of callables
+        Goals of the same form; a design is feasible where every value is ``<= 0``.
+    xl, xu : float or (n_var,) array_like, optional
+        Bounds of ``z`` (default: the family's).
+    penalty : float
+        ``p`` of the penalty rule; it must exceed every goal value of an
+        acceptable design (values above it are clipped to it). Default ``1e6``.
+    hv_ref_point : (n_obj,) array_like, optional
+        Hypervolume reference point of the runs' records. Default: ``penalty``
+        on every objective, which every design that is computed, stabilises
+        every scenario and scores below ``p`` dominates. It is always
+        valid but on a scale far above good designs, so the hypervolume
+        differences of good fronts are tiny: give a point just beyond the
+        values you accept (e.g. a front's nadir enlarged by 10-30 %) to
+        compare runs.
+    molsp_ref_point : (n_obj,) array_like, optional
+        MO-LSP's leader reference point; default ``hv_ref_point`` (MO-LSP
+        chooses its leaders among the designs that dominate it).
+
+    Attributes
+    ----------
+    scenarios : list of robustctl.Plant
+    objectives, constraints : list of callables
+    objective_names, constraint_names : list of str
+    last_flags : (B,) object ndarray
+        Why each design of the last evaluated population was penalised
+        (``""`` for none): the family's reason, ``"unstable"``, or
+        ``"<goal> returned nan"``.
+
+    Raises
+    ------
+    ValueError
+        Scenarios of different sizes (naming ``scenarios``), a family whose
+        gain size does not fit them, inverted bounds (naming ``xl``/``xu``),
+        a goal's ``check`` failing, a reference point of the wrong length.
+        During evaluation: a goal that returns anything but ``(B,)`` numbers
+        (naming the goal).
+    """
+
+    def __init__(self, family: DesignFamily, scenarios: Sequence[rc.Plant], objectives: Sequence[Goal],
+                 constraints: Sequence[Goal] = (), *, xl=None, xu=None, penalty: float = 1e6,
+                 hv_ref_point=None, molsp_ref_point=None):
+        for attr in ("n_var", "xl", "xu", "n_states", "n_inputs", "gains"):
+            if not hasattr(family, attr):
+                raise TypeError(f"family must follow the DesignFamily protocol (missing {attr!r}), "
+                                f"got {type(family).__name__}")
+        self.family = family
+        self.scenarios = _scenarios(scenarios)
+        n, m = self.scenarios[0].n, self.scenarios[0].m
+        if (family.n_states, family.n_inputs) != (n, m):
+            raise ValueError(f"family gives gains of shape ({family.n_inputs}, {family.n_states}), but the scenarios "
+                             f"have m={m} inputs and n={n} states")
+        self.objectives, self.objective_names = _goals(objectives, "objectives")
+        if not self.objectives:
+            raise ValueError("objectives must not be empty")
+        self.constraints, self.constraint_names = _goals(constraints, "constraints")
+        for goal in (*self.objectives, *self.constraints):
+            check = getattr(goal, "check", None)
+            if callable(check):
+                check(self.scenarios)
+        n_var = int(family.n_var)
+        lo = _bounds(family.xl if xl is None else xl, "xl", np.zeros(n_var))
+        hi = _bounds(family.xu if xu is None else xu, "xu", np.zeros(n_var))
+        check_bounds(lo, hi)
+        self.penalty = check_positive_scalar(penalty, "penalty")
+        n_obj = len(self.objectives)
+        self.hv_ref_point = _ref_point(hv_ref_point, "hv_ref_point", np.full(n_obj, self.penalty))
+        self.molsp_ref_point = _ref_point(molsp_ref_point, "molsp_ref_point", self.hv_ref_point)
+        self._F_s = np.stack([p.F for p in self.scenarios])
+        self._G_s = np.stack([p.G for p in self.scenarios])
+        self.last_flags = np.zeros(0, dtype=object)
+        super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=len(self.constraints), xl=lo, xu=hi, vtype=float)
+
+    # -- gains and closed loops ----------------------------------------------------
+    @property
+    def n_states(self) -> int:
+        """Number of states of the scenario plants."""
+        return int(self._F_s.shape[-1])
+
+    @property
+    def n_inputs(self) -> int:
+        """Number of inputs of the scenario plants."""
+        return int(self._G_s.shape[-1])
+
+    def population(self, Z, name: str = "Z") -> np.ndarray:
+        """``Z`` as a finite (B, n_var) float array (a single (n_var,) vector becomes B = 1)."""
+        return population(Z, self.n_var, name)
+
+    def gains(self, Z) -> FamilyGains:
+        """The family's :class:`~moo.tuning.families.FamilyGains` of a population ``Z`` (B, n_var)."""
+        z = self.population(Z)
+        fg = self.family.gains(z)
+        K = np.asarray(fg.K, dtype=float)
+        if K.shape != (z.shape[0], self.n_inputs, self.n_states):
+            raise ValueError(f"family.gains returned K of shape {K.shape}, expected "
+                             f"({z.shape[0]}, {self.n_inputs}, {self.n_states})")
+        ok = np.asarray(fg.ok, dtype=bool) & np.all(np.isfinite(K), axis=(1, 2))
+        return FamilyGains(K=np.where(ok[:, None, None], K, np.nan), ok=ok, reason=np.asarray(fg.reason, dtype=object))
+
+    def check_gains(self, K) -> np.ndarray:
+        """``K`` as a (B, m, n) float array (NaN rows allowed: failed designs); one (m, n) gain becomes B = 1."""
+        K = as_float_array(K, "K")
+        if K.ndim == 2:
+            K = K[None]
+        if K.ndim != 3 or K.shape[1:] != (self.n_inputs, self.n_states):
+            raise ValueError(f"K must have shape (B, {self.n_inputs}, {self.n_states}), got shape {K.shape}")
+        return K
+
+    def closed_loops(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
+        """The closed loops ``F_s + G_s K`` (B, S, n, n) of gains ``K`` (B, m, n) (default: the problem's scenarios)."""
+        K = self.check_gains(K)
+        if scenarios is None:
+            F_s, G_s = self._F_s, self._G_s
+        else:
+            plants = _scenarios(scenarios)
+            F_s, G_s = np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
+        return F_s[None] + G_s[None] @ K[:, None]
+
+    def stability(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the worst spectral radius.
+
+        ``rho`` is the largest spectral radius over the scenarios of the designs
+        unstable somewhere (NaN for the others, which need no eigenvalues; inf
+        for non-finite K).
+        """
+        A = self.closed_loops(K, scenarios)
+        stable = np.asarray(rc.is_schur_stable(A))                         # a stack: an array
+        rho = np.full(A.shape[0], np.nan)
+        bad = ~stable.all(axis=1)
+        if bad.any():
+            rho[bad] = np.asarray(rc.spectral_radius(A[bad])).max(axis=1)
+        return stable, rho
+
+    # -- goals ---------------------------------------------------------------------
+    def _call(self, goal, name: str, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+        value = goal(K, plants)
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"goal {name!r} must return a ({K.shape[0]},) array of numbers (one per design), "
+                             f"got {type(value).__name__}") from None
+        if arr.shape != (K.shape[0],):
+            raise ValueError(f"goal {name!r} must return shape ({K.shape[0]},) (one value per design), "
+                             f"got shape {arr.shape}")
+        return arr
+
+    def evaluate_gains(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Goal values of given gains on the scenarios (default the problem's): ``(F (B, n_obj), G (B, n_constr))``.
+
+        Every goal is called once, on the designs that stabilise every
+        scenario; the others, and rows of ``K`` with NaN, get ``+inf``. No
+        penalty, no clipping; a goal's NaN stays NaN.
+        """
+        K = self.check_gains(K)
+        plants = self.scenarios if scenarios is None else _scenarios(scenarios)
+        finite = np.all(np.isfinite(K), axis=(1, 2))
+        Kf = np.where(finite[:, None, None], K, 0.0)
+        stable, _ = self.stability(Kf, plants)
+        run = finite & stable.all(axis=1)
+        F = np.full((K.shape[0], self.n_obj), np.inf)
+        G = np.full((K.shape[0], self.n_ieq_constr), np.inf)
+        if run.any():
+            Kr = np.ascontiguousarray(K[run])
+            for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
+                F[run, j] = self._call(g, name, Kr, plants)
+            for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
+                G[run, j] = self._call(g, name, Kr, plants)
+        return F, G
+
+    # -- pymoo hooks -----------------------------------------------------------------
+    def evaluate(self, X, *args, **kwargs):
+        """Check ``X`` (errors that name it, not pymoo's assertion), then pymoo's ``Problem.evaluate``."""
+        arr = self.population(X, "X")
+        return super().evaluate(arr[0] if np.ndim(X) == 1 else arr, *args, **kwargs)
+
+    def _evaluate(self, x, out, *args, **kwargs):
+        z = self.population(x, "X")
+        fg = self.gains(z)
+        ok, K = fg.ok, fg.K
+        stable, rho = self.stability(K)
+        run = ok & stable.all(axis=1)
+        B = z.shape[0]
+        J = np.full((B, self.n_obj), np.inf)
+        C = np.full((B, self.n_ieq_constr), np.inf)
+        flags = np.where(ok, np.where(run, "", "unstable"), fg.reason).astype(object)
+        if run.any():
+            Kr = K[run]
+            for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
+                J[run, j] = self._call(g, name, Kr, self.scenarios)
+            for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
+                C[run, j] = self._call(g, name, Kr, self.scenarios)
+            vals = np.concatenate([J[run], C[run]], axis=1)
+            bad = ~np.all(np.isfinite(vals), axis=1)
+            if bad.any():
+                idx = np.flatnonzero(run)[bad]
+                names = [*self.objective_names, *self.constraint_names]
+                for i, row in zip(idx, vals[bad], strict=True):
+                    flags[i] = f"{names[int(np.flatnonzero(~np.isfinite(row))[0])]} returned nan"
+                J[idx] = np.inf                       # flagged: the penalty p on every objective
+                C[idx] = np.inf
+        self.last_flags = flags
+        F = penalise(J, ok, run, rho, self.penalty)
+        out["F"] = F
+        if self.n_ieq_constr:
+            level = F.max(axis=1, keepdims=True)      # the design's penalty level where it is penalised
+            pen = ~run | ~np.all(np.isfinite(C), axis=1)
+            out["G"] = np.where(pen[:, None], level, np.nan_to_num(C, posinf=self.penalty))
+
+    def __repr__(self) -> str:
+        return (f"TuningProblem(family={self.family!r}, S={len(self.scenarios)}, n_var={self.n_var}, "
+                f"objectives={self.objective_names}, constraints={self.constraint_names})")

@@ -1,0 +1,296 @@
+r"""Monte Carlo design selection over a tuning problem's scenarios (Morais et al. 2022, Secs. 4.4.1, 4.5.1).
+
+A MOEA returns a front of designs; a controller needs one. The paper picks
+it by simulation: every candidate is run on the same ``S`` random
+realisations of the uncertainty, in each simulation the design with the
+least cumulative error wins, and the design that wins most often is chosen.
+
+For any :class:`~moo.tuning.TuningProblem` (:func:`select`):
+
+* **draws** - simulation ``s`` draws one plant ``P_s``: a scenario of the
+  problem chosen uniformly at random, or ``sampler(rng)`` if a sampler is
+  given (e.g. a random ``Delta`` of a norm-bounded model, or a random
+  parameter inside the range the scenarios sample);
+* **error** - every design ``d`` runs on ``P_s`` alone: the problem's
+  objectives evaluated on the one-plant list ``[P_s]`` give ``f_j(K_d, P_s)``
+  and the cumulative error is their weighted sum
+
+  .. math::
+
+      E[d, s] = \sum_j w_j\, f_j(K_d, [P_s]), \qquad
+      w_j = 1 / \big(\max_d F_{dj} - \min_d F_{dj}\big) \text{ (default)},
+
+  the default weights dividing each objective by its spread over the front
+  (``F`` the front's objectives), so that each objective counts the same over
+  the range the front covers (adding a constant to an objective does not change
+  a winner). A design unstable on ``P_s``, or whose goal is NaN there, gets
+  ``+inf`` (cannot win);
+* **count** - :func:`monte_carlo_selection` (ties go to the lowest index).
+
+When the draws come from the scenario set, each goal is called once per
+distinct scenario drawn (not once per simulation); with a sampler, once per
+simulation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+import robustctl as rc
+
+from .._validation import as_float_array, check_int
+
+__all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "scenario_errors", "default_weights"]
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class SelectionResult:
+    """Outcome of :func:`monte_carlo_selection` on ``D`` designs and ``S`` simulations.
+
+    Attributes
+    ----------
+    winners : (S,) int ndarray
+        Index of the design with the least error in each simulation (ties: the
+        lowest index); ``-1`` where no design has a finite error.
+    counts : (D,) int ndarray
+        Number of simulations each design won; ``counts.sum() == S - n_no_winner``.
+    best : int
+        The most frequent winner (ties: the lowest index), the selected design.
+    """
+
+    winners: np.ndarray
+    counts: np.ndarray
+    best: int
+
+    @property
+    def n_designs(self) -> int:
+        """Number of candidate designs D."""
+        return int(self.counts.size)
+
+    @property
+    def n_simulations(self) -> int:
+        """Number of simulations (realisations) S."""
+        return int(self.winners.size)
+
+    @property
+    def n_no_winner(self) -> int:
+        """Simulations in which every design's error was infinite."""
+        return int(np.count_nonzero(self.winners < 0))
+
+    def ranking(self) -> np.ndarray:
+        """Design indices by decreasing win count (equal counts: increasing index)."""
+        return np.argsort(-self.counts, kind="stable")
+
+    def __repr__(self) -> str:
+        return (f"SelectionResult(D={self.n_designs}, S={self.n_simulations}, best={self.best}, "
+                f"wins={int(self.counts[self.best])}, no_winner={self.n_no_winner})")
+
+
+def _as_errors(errors) -> np.ndarray:
+    if isinstance(errors, (str, bytes)) or errors is None:
+        raise TypeError(f"errors must be a (designs, simulations) array of numbers, got {type(errors).__name__}")
+    try:
+        arr = np.asarray(errors, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError("errors must be a (designs, simulations) array of real numbers") from None
+    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
+        raise ValueError(f"errors must be a non-empty 2-D array (designs, simulations), got shape {arr.shape}")
+    if np.any(np.isnan(arr)) or np.any(arr == -np.inf):
+        raise ValueError("errors must not contain NaN or -inf (+inf marks a design that cannot win)")
+    return arr
+
+
+def monte_carlo_selection(errors) -> SelectionResult:
+    r"""Count how often each design has the least cumulative error; select the most frequent winner.
+
+    With ``E[d, s]`` the cumulative error of design ``d`` in simulation ``s``,
+
+    .. math::
+
+        w_s = \min \arg\min_d E[d, s], \qquad
+        c_d = \#\{s : w_s = d\}, \qquad
+        d^* = \min \arg\max_d c_d,
+
+    i.e. ties within a simulation go to the lowest design index, and so do ties
+    between win counts. ``+inf`` marks a design that cannot win a simulation
+    (e.g. unstable there); a simulation in which every design is ``+inf`` has
+    no winner (``winners[s] = -1``) and counts for nobody.
+
+    Parameters
+    ----------
+    errors : (D, S) array_like
+        Cumulative errors, lower is better; finite or ``+inf``.
+
+    Returns
+    -------
+    SelectionResult
+
+    Raises
+    ------
+    ValueError
+        ``errors`` not 2-D or empty, containing NaN or ``-inf``, or no
+        simulation has a winner.
+
+    References
+    ----------
+    Morais et al. (2022), Section 4.4.1: "The control design with less
+    cumulative error is assigned as the winner for each simulation [...] the
+    selection criterium is to choose [...] the most frequent individual".
+    """
+    E = _as_errors(errors)
+    D = E.shape[0]
+    winners = np.argmin(E, axis=0)                       # first minimum: lowest index on ties
+    winners[~np.isfinite(E.min(axis=0))] = -1
+    counts = np.bincount(winners[winners >= 0], minlength=D)
+    if counts.sum() == 0:
+        raise ValueError("errors: no design has a finite error in any simulation; nothing to select")
+    return SelectionResult(winners=winners, counts=counts, best=int(np.argmax(counts)))
+
+
+def default_weights(F) -> np.ndarray:
+    """``1 / (max_d F[d, j] - min_d F[d, j])`` per objective (1 where the spread is zero or not finite)."""
+    F = as_float_array(F, "F")
+    if F.ndim != 2 or F.shape[0] < 1:
+        raise ValueError(f"F must be a non-empty (designs, objectives) array, got shape {F.shape}")
+    spread = np.max(F, axis=0) - np.min(F, axis=0)
+    return np.where(np.isfinite(spread) & (spread > 0), 1.0 / np.where(spread > 0, spread, 1.0), 1.0)
+
+
+def _weights(weights, n_obj: int) -> np.ndarray:
+    w = as_float_array(weights, "weights").ravel()
+    if w.shape != (n_obj,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ValueError(f"weights must be {n_obj} finite non-negative numbers (one per objective), got {w}")
+    return w
+
+
+def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights) -> np.ndarray:
+    """Cumulative errors (D, P): ``sum_j w_j f_j(K_d, [plant_p])`` of every design on every plant alone.
+
+    ``+inf`` where a design has NaN gains, is unstable on that plant or a goal is not finite there.
+    """
+    K = problem.check_gains(K)
+    w = _weights(weights, problem.n_obj)
+    E = np.empty((K.shape[0], len(plants)))
+    for p, plant in enumerate(plants):
+        F, _ = problem.evaluate_gains(K, [plant])
+        with np.errstate(invalid="ignore"):
+            e = (np.where(w > 0, F, 0.0) * w).sum(axis=1)
+        E[:, p] = np.where(np.isfinite(e), e, np.inf)
+    return E
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Selection:
+    """The design chosen by :func:`select`, with the evidence.
+
+    Attributes
+    ----------
+    index : int
+        Row of the chosen design in the candidate gains.
+    K : (m, n) ndarray
+        Its gain ``u = K x``.
+    controller : robustctl.Controller
+        Its controller.
+    counts : (D,) int ndarray
+        Simulations won by each candidate.
+    winners : (S,) int ndarray
+        Winner of each simulation (-1: none).
+    errors : (D, S) ndarray
+        Cumulative errors.
+    draws : (S,) int ndarray
+        Scenario drawn by each simulation (-1 where a sampler drew the plant).
+    weights : (n_obj,) ndarray
+        Weights of the objectives in the cumulative error.
+    """
+
+    index: int
+    K: np.ndarray
+    controller: rc.Controller
+    counts: np.ndarray
+    winners: np.ndarray
+    errors: np.ndarray
+    draws: np.ndarray
+    weights: np.ndarray
+
+    @property
+    def result(self) -> SelectionResult:
+        """The counting result (:class:`SelectionResult`)."""
+        return SelectionResult(winners=self.winners, counts=self.counts, best=self.index)
+
+    def __repr__(self) -> str:
+        return (f"Selection(index={self.index}, wins={int(self.counts[self.index])}/{self.winners.size}, "
+                f"D={self.counts.size})")
+
+
+def _rng(seed) -> np.random.Generator:
+    try:
+        return np.random.default_rng(seed)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"seed must be None, a non-negative integer, a SeedSequence or a Generator ({exc})") from None
+
+
+def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
+           sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None,
+           plant: rc.Plant | None = None, method: str = "tuned") -> Selection:
+    """The paper's Monte Carlo selection, for any tuning problem (module docstring).
+
+    Parameters
+    ----------
+    problem : TuningProblem
+    K : (D, m, n) array_like
+        Candidate gains (e.g. a front's, :attr:`TuningResult.gains <moo.tuning.TuningResult.gains>`).
+    F : (D, n_obj) array_like, optional
+        Their objectives, for the default weights (:func:`default_weights`);
+        default: evaluated on the problem's scenarios.
+    n_sims : int
+        Number of simulations ``S``.
+    seed : int or numpy Generator-compatible seed
+        Seed of the draws.
+    sampler : callable, optional
+        ``sampler(rng) -> robustctl.Plant``: draw the plant of a simulation
+        (same size as the scenarios). Default: a random scenario.
+    weights : (n_obj,) array_like, optional
+        Weights of the objectives in the cumulative error (default: 1 / the front's spread).
+    plant : robustctl.Plant, optional
+        The plant of the returned :class:`~robustctl.Controller` (default: the first scenario).
+    method : str
+        The controller's ``method``.
+    """
+    Kc = problem.check_gains(K)
+    n_sims = check_int(n_sims, "n_sims", 1)
+    rng = _rng(seed)
+    if weights is None:
+        if F is None:
+            F, _ = problem.evaluate_gains(Kc)
+        Ff = as_float_array(F, "F")
+        fin = np.all(np.isfinite(Ff), axis=1) if Ff.ndim == 2 else None
+        weights = default_weights(Ff[fin] if fin is not None and fin.any() else Ff)
+    w = _weights(weights, problem.n_obj)
+    if sampler is None:
+        S = len(problem.scenarios)
+        draws = rng.integers(0, S, size=n_sims)
+        used = np.unique(draws)
+        per = scenario_errors(problem, Kc, [problem.scenarios[i] for i in used], w)
+        col = np.searchsorted(used, draws)
+        E = per[:, col]
+    else:
+        if not callable(sampler):
+            raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, "
+                            f"got {type(sampler).__name__}")
+        draws = np.full(n_sims, -1)
+        plants = []
+        for _ in range(n_sims):
+            p = sampler(rng)
+            if not isinstance(p, rc.Plant):
+                raise TypeError(f"sampler must return a robustctl.Plant, got {type(p).__name__}")
+            plants.append(p)
+        E = scenario_errors(problem, Kc, plants, w)
+    res = monte_carlo_selection(E)
+    Kbest = Kc[res.best]
+    ctrl = rc.Controller(Kbest, method, problem.scenarios[0] if plant is None else plant,
+                         {"selection_wins": int(res.counts[res.best]), "n_sims": n_sims})
+    return Selection(index=res.best, K=Kbest.copy(), controller=ctrl, counts=res.counts, winners=res.winners,
+                     errors=E, draws=draws, weights=w)

@@ -1,0 +1,175 @@
+"""Tune: run a MOEA (with MO-LSP by default) on a :class:`~moo.tuning.TuningProblem` and keep its front.
+
+:func:`tune` goes through the project's runner (:mod:`moo.runner`: the
+algorithm registry :func:`moo.algorithms.make_algorithm`, MO-LSP
+:func:`moo.molsp.molsp` with the problem's ``molsp_ref_point``, the
+hypervolume history at ``hv_ref_point``), so a tuning run is the same run
+``python -m moo run`` makes, and :class:`TuningResult` holds its record.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+import robustctl as rc
+
+from .._validation import check_int
+from ..algorithms.operators import POP_SIZE
+from ..molsp import molsp as add_molsp
+from ..runner import PreparedRun, RunResult, check_budget
+from .problem import TuningProblem
+from .selection import Selection, select
+
+__all__ = ["tune", "TuningResult"]
+
+
+def _method(family) -> str:
+    name = type(family).__name__
+    return {"RLQRFamily": "rlqr", "LQRFamily": "lqr"}.get(name, "tuned")
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class TuningResult:
+    """The front of a tuning run.
+
+    Attributes
+    ----------
+    problem : TuningProblem
+    X : (N, n_var) ndarray
+        Decision vectors of the final non-dominated set.
+    F : (N, n_obj) ndarray
+        Their objectives.
+    run : moo.runner.RunResult
+        The run's record (hypervolume history, evaluations, wall time; ``run.to_dict()`` is JSON).
+    """
+
+    problem: TuningProblem
+    X: np.ndarray
+    F: np.ndarray
+    run: RunResult
+
+    @property
+    def gains(self) -> np.ndarray:
+        """Gains (N, m, n) of the front (``u = K x`` for the scenario plants; NaN rows: failed designs)."""
+        return self.problem.gains(self.X).K
+
+    def _plant(self) -> rc.Plant:
+        plant = getattr(self.problem.family, "plant", None)
+        return plant if isinstance(plant, rc.Plant) else self.problem.scenarios[0]
+
+    def controllers(self) -> list[rc.Controller]:
+        """One :class:`robustctl.Controller` per front design (its ``info`` holds ``z`` and the objectives)."""
+        method, plant = _method(self.problem.family), self._plant()
+        return [rc.Controller(K, method, plant, {"z": x.copy(), "objectives": f.copy()})
+                for K, x, f in zip(self.gains, self.X, self.F, strict=True) if np.all(np.isfinite(K))]
+
+    def select(self, *, n_sims: int = 1000, seed=None, sampler: Callable[[np.random.Generator], rc.Plant] | None = None,
+               weights=None) -> Selection:
+        """Pick one front design by the Monte Carlo selection (:func:`moo.tuning.selection.select`).
+
+        ``index`` of the returned :class:`~moo.tuning.selection.Selection` is a row of ``X``/``F``.
+        """
+        if len(self.X) == 0:
+            raise ValueError("the front is empty (no design stabilised every scenario): nothing to select")
+        return select(self.problem, self.gains, F=self.F, n_sims=n_sims, seed=seed, sampler=sampler,
+                      weights=weights, plant=self._plant(), method=_method(self.problem.family))
+
+    def plot(self, selection: Selection | None = None, *, x0=None, steps: int = 50):
+        """Figure: the front (pairwise objectives) and a design's closed-loop response on every scenario.
+
+        Parameters
+        ----------
+        selection : Selection, optional
+            The design to show (default: ``self.select(n_sims=200, seed=0)``).
+        x0 : (n,) array_like, optional
+            Initial state of the response (default: all ones).
+        steps : int
+            Samples of the response.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib.pyplot as plt
+
+        if selection is None:
+            selection = self.select(n_sims=200, seed=0)
+        steps = check_int(steps, "steps", 1)
+        n = self.problem.n_states
+        x = np.ones(n) if x0 is None else np.asarray(x0, dtype=float).reshape(n)
+        fig, (ax_f, ax_r) = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
+        F = self.F
+        j = 1 if F.shape[1] > 1 else 0
+        ax_f.scatter(F[:, 0], F[:, j], s=12, label="front")
+        ax_f.scatter(F[selection.index, 0], F[selection.index, j], s=60, marker="*", color="C3", label="selected")
+        ax_f.set_xlabel(self.problem.objective_names[0])
+        ax_f.set_ylabel(self.problem.objective_names[j])
+        ax_f.set_title("front")
+        ax_f.legend()
+        A = self.problem.closed_loops(selection.K[None])[0]         # (S, n, n)
+        traj = np.empty((A.shape[0], steps + 1, n))
+        traj[:, 0] = x
+        for k in range(steps):
+            traj[:, k + 1] = np.einsum("sij,sj->si", A, traj[:, k])
+        for s in range(A.shape[0]):
+            for i in range(n):
+                ax_r.plot(traj[s, :, i], color=f"C{i}", alpha=0.6, label=f"x{i + 1}" if s == 0 else None)
+        ax_r.set_xlabel("step k")
+        ax_r.set_title(f"selected design {selection.index}: response on {A.shape[0]} scenarios")
+        ax_r.legend()
+        return fig
+
+    def __repr__(self) -> str:
+        return (f"TuningResult(front={len(self.X)}, n_obj={self.F.shape[1]}, evaluations={self.run.n_evals}, "
+                f"hv={self.run.hv:.6g})")
+
+
+def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True, evals: int = 10000, seed: int = 0,
+         pop_size: int | None = None, max_leaders: int | None = None,
+         progress: Callable[[int, int], None] | None = None) -> TuningResult:
+    """Tune: one MOEA run on ``problem``, optionally with MO-LSP; the final non-dominated set.
+
+    Parameters
+    ----------
+    problem : TuningProblem
+        (Any pymoo problem with ``hv_ref_point``/``molsp_ref_point`` runs, but the result's gains need a TuningProblem.)
+    algorithm : str
+        A name of :data:`moo.algorithms.ALGORITHMS` (default ``"nsga2"``).
+    molsp : bool
+        Add the MO-LSP local search (reference point ``problem.molsp_ref_point``).
+    evals : int
+        Evaluation budget (at least the population size).
+    seed : int
+        Seed of the run (same seed, same result).
+    pop_size : int, optional
+        Population size (default the paper's 92).
+    max_leaders : int, optional
+        MO-LSP's cap on leaders per generation.
+    progress : callable, optional
+        ``progress(n_evals, evals)`` after every generation.
+
+    Returns
+    -------
+    TuningResult
+    """
+    if not isinstance(problem, TuningProblem):
+        raise TypeError(f"problem must be a moo.tuning.TuningProblem, got {type(problem).__name__}")
+    seed = check_int(seed, "seed", 0)
+    evals = check_int(evals, "evals", 1)
+    pop_size = POP_SIZE if pop_size is None else check_int(pop_size, "pop_size", 4)
+    if not isinstance(molsp, (bool, np.bool_)):
+        raise TypeError(f"molsp must be a bool, got {type(molsp).__name__}")
+    if max_leaders is not None:
+        max_leaders = check_int(max_leaders, "max_leaders", 1)
+        if not molsp:
+            raise ValueError("max_leaders needs molsp=True")
+    alg = check_budget(problem, algorithm, evals=evals, pop_size=pop_size)
+    if molsp:
+        alg = add_molsp(alg, ref_point=np.asarray(problem.molsp_ref_point, dtype=float), max_leaders=max_leaders)
+    prepared = PreparedRun(problem_name="tuning", algorithm_name=algorithm.lower(), seed=seed, evals=evals,
+                           molsp=bool(molsp), max_leaders=max_leaders, problem=problem, algorithm=alg)
+    record = prepared.run(progress)
+    return TuningResult(problem=problem, X=record.X, F=record.F, run=record)
