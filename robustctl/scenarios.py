@@ -29,7 +29,7 @@ from .plant import Plant
 
 __all__ = ["PlantSamples", "sample_plants", "SAMPLING_METHODS"]
 
-#: Names :func:`sample_plants` accepts as ``method``.
+#: Names :func:`robustctl.sample_plants` accepts as ``method``.
 SAMPLING_METHODS = ("grid", "lhs")
 
 

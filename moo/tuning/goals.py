@@ -89,7 +89,7 @@ __all__ = ["Goal", "Response", "ErrorGoal", "PeakInput", "SettlingTime", "Spectr
 
 #: Reductions over the scenarios a goal accepts as ``over``.
 OVER = ("mean", "max")
-#: Error measures of :meth:`Response.error`.
+#: Error measures of ``Response.error``.
 MEASURES = ("mse", "ise", "iae")
 # Squared Smith iteration: relative size of the last increment, and the most doublings
 # (A^(2^64) of a stable A is zero unless its spectral radius is within ~1e-17 of 1).
