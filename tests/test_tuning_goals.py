@@ -287,3 +287,25 @@ def test_bad_input(plants, gains):
         SpectralRadius()(np.zeros((2, 1, 3)), plants)
     with pytest.raises(ValueError, match="K must have 3 columns"):
         SpectralRadius()(np.zeros((2, 2, 4)), plants)
+
+
+# ---------------------------------------------------------------- inside a TuningProblem
+def test_goals_in_a_tuning_problem(plants, gains):
+    from moo.tuning import LQRFamily, TuningProblem
+
+    resp = Response(x0=[1.0, 0.0, 0.5], steps=40, u_limit=2.0)
+    objectives = [resp.error([0, 2]), resp.peak_input(), SpectralRadius()]
+    constraints = [at_most(H2Norm([0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), 5.0)]
+    prob = TuningProblem(LQRFamily(plants[1]), plants, objectives, constraints)
+    J, C = prob.evaluate_gains(gains)
+    np.testing.assert_allclose(J, np.column_stack([g(gains, plants) for g in objectives]))
+    np.testing.assert_allclose(C[:, 0], constraints[0](gains, plants))
+    # a goal that does not fit the plants is refused when the problem is built
+    with pytest.raises(ValueError, match=r"states must be state indices in \[0, 3\)"):
+        TuningProblem(LQRFamily(plants[1]), plants, [resp.error([3])])
+    with pytest.raises(ValueError, match="Bw must have 3 rows"):
+        TuningProblem(LQRFamily(plants[1]), plants, [SpectralRadius()], [at_most(H2Norm([1.0, 0.0], [1.0]), 1.0)])
+
+
+def test_hinf_norm_of_a_zero_channel(plants, gains):
+    np.testing.assert_array_equal(HinfNorm([0.0, 1.0, 0.0], [0.0, 0.0, 0.0])(gains[:1], plants[:1]), [0.0])
