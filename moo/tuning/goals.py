@@ -81,7 +81,7 @@ import numpy as np
 import robustctl as rc
 from robustctl.batchsim import BACKENDS, DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
 from robustctl.regions import Region, as_regions
-from robustctl.validation import as_float_array, check_choice, check_int, check_positive_scalar, check_real
+from robustctl.validation import as_float_array, as_matrix, check_choice, check_int, check_positive_scalar, check_real
 
 __all__ = ["Goal", "Response", "ErrorGoal", "PeakInput", "SettlingTime", "SpectralRadius", "PoleRegion",
            "H2Norm", "HinfNorm", "RobustMargin", "Bound", "at_most", "at_least", "check_scenarios",
@@ -160,16 +160,8 @@ def _check_range(idx: tuple[int, ...] | None, size: int, name: str, what: str) -
 
 
 def _matrix(value, name: str, vector: str) -> np.ndarray:
-    """A finite 2-D float array (a 1-D array is a ``vector`` ("column" or "row"), a scalar 1 x 1)."""
-    arr = as_float_array(value, name)
-    if arr.ndim == 0:
-        arr = arr.reshape(1, 1)
-    elif arr.ndim == 1:
-        arr = arr.reshape(-1, 1) if vector == "column" else arr.reshape(1, -1)
-    if arr.ndim != 2 or arr.size == 0:
-        raise ValueError(f"{name} must be a non-empty 2-D matrix, got shape {np.shape(value)}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must have finite entries (found NaN or inf)")
+    """A finite non-empty 2-D float array, read-only (a 1-D array is a ``vector``: "column" or "row")."""
+    arr = as_matrix(value, name, vector=vector)
     arr.flags.writeable = False
     return arr
 
