@@ -235,7 +235,9 @@ class Response:
     Parameters
     ----------
     x0 : (n,) or (S, n) array_like
-        Initial state (one per scenario, or shared).
+        Initial state, shared or one per scenario (a per-scenario ``x0`` or
+        ``reference`` ties the goals to lists of S plants: the Monte Carlo
+        selection, which evaluates goals on one plant at a time, needs shared ones).
     steps : int
         Number of samples ``T`` (``k = 0 .. T-1``; the horizon is ``T dt``).
     reference : (T, n) or (S, T, n) array_like, optional
