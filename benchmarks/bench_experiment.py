@@ -71,10 +71,10 @@ from pymoo.problems import get_problem  # noqa: E402
 
 from moo.algorithms import ALGORITHMS  # noqa: E402
 from moo.experiment import run_seeds  # noqa: E402
-from moo.problems._rlqr_problem import RLQRTuningProblem  # noqa: E402
-from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
-from moo.problems.generic import GenericRLQRProblem  # noqa: E402
+from moo.problems.applied import AppliedRLQRProblem, PathFollowingErrors  # noqa: E402
+from moo.problems.generic import RegulationErrors  # noqa: E402
 from moo.runner import run  # noqa: E402
+from moo.tuning import RLQRFamily  # noqa: E402
 
 QUICK_ALGORITHMS = ("nsga2", "maoea-ddfc")
 POP = 92
@@ -173,9 +173,9 @@ class _Timers:
         self._patched = []
 
     def __enter__(self):
-        for cls, name, slot in ((RLQRTuningProblem, "gains", "rlqr"),
-                                (GenericRLQRProblem, "scenario_objectives", "sim"),
-                                (AppliedRLQRProblem, "scenario_objectives", "sim")):
+        for cls, name, slot in ((RLQRFamily, "design", "rlqr"),
+                                (RegulationErrors, "per_scenario", "sim"),
+                                (PathFollowingErrors, "per_scenario", "sim")):
             original = cls.__dict__[name]
 
             def timed(*args, _f=original, _slot=slot, **kwargs):

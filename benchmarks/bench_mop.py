@@ -26,7 +26,16 @@ Measured in one run, on the same machine (timings on a shared machine are noisy)
    included). At equal budget the two runs evaluate different designs, whose
    cost differs (slowly converging RLQR designs, simulator runs that diverge),
    so part of the difference is not MO-LSP's own work.
-3. **Objective scales** behind the reference points: for a seeded sample of
+3. **TuningProblem vs the frozen pre-tuning evaluation.** The applied MOP is
+   now a :class:`moo.tuning.TuningProblem` (``RLQRFamily`` + goals sharing one
+   simulation). Its time per population (``--pop`` seeded random designs;
+   the two alternate, ``--tuning-repeats`` calls each, the fastest counts)
+   against :class:`FrozenApplied` below, a frozen copy of the evaluation the
+   problem had before (the private ``RLQRTuningProblem`` base class, deleted
+   from the package): the same batched RLQR, stability screen, penalty rule
+   and simulation, written inline. The objectives must be bit-identical.
+   Target: ratio <= 1.1.
+4. **Objective scales** behind the reference points: for a seeded sample of
    random designs, the share that is stable and the share of those that
    dominate ``hv_ref_point`` / ``molsp_ref_point``.
 """
@@ -44,7 +53,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # run from a checkout without install
 
-from pymoo.core.problem import ElementwiseProblem
+from pymoo.core.problem import ElementwiseProblem, Problem
 from pymoo.optimize import minimize
 
 import robustctl as rc
@@ -88,6 +97,75 @@ class ElementwiseApplied(ElementwiseProblem):
                      input_map=truck.DOUBLED_INPUT_MAP).mse()[0]
         f = e.mean(axis=0) if b.aggregate == "mean" else e.max(axis=0)
         out["F"] = np.minimum(f, pen)
+
+
+class FrozenApplied(Problem):
+    """The applied MOP's evaluation as it was before ``moo.tuning`` (frozen here as the speed peer).
+
+    A copy of the deleted ``moo.problems._rlqr_problem.RLQRTuningProblem._evaluate`` specialised to
+    the applied MOP: decode, one batched :func:`robustctl.rlqr_gains`, the Schur screen of
+    ``F_s + G_s M K`` per payload, one path-following simulation of the stable designs, the
+    penalty rule. Parameters (plant, weights, simulator) are read from ``new``.
+    """
+
+    def __init__(self, new: AppliedRLQRProblem):
+        self.b = new
+        F_s, G_s, _ = truck.discretise(new.overloads)
+        self._F_s = F_s
+        self._G_s_steer = G_s @ np.asarray(truck.DOUBLED_INPUT_MAP, dtype=float)
+        super().__init__(n_var=new.n_var, n_obj=new.n_obj, xl=new.xl, xu=new.xu, vtype=float)
+
+    def _evaluate(self, x, out, *args, **kwargs):
+        b = self.b
+        z = np.asarray(x, dtype=float)
+        if z.ndim != 2 or z.shape[1] != self.n_var or not np.all(np.isfinite(z)) or np.any(z[:, -1] < 0):
+            raise ValueError("X")
+        n, m = b.plant.n, b.plant.m
+        EF, EG, mu = z[:, None, :n].copy(), z[:, None, n:n + m].copy(), 10.0 ** np.sqrt(z[:, n + m])
+        batch = rc.rlqr_gains(b.plant, EF, EG, mu, Q=b.Q, R=b.R, H=b.H, alpha=b.alpha, max_iter=b.max_iter,
+                              fallback=b.fallback)
+        ok = np.asarray(batch.ok, dtype=bool) & np.all(np.isfinite(batch.K), axis=(1, 2))
+        K = np.where(ok[:, None, None], batch.K, np.nan)
+        A = self._F_s[None] + self._G_s_steer[None] @ K[:, None]
+        stable = np.asarray(rc.is_schur_stable(A))
+        rho = np.full(A.shape[0], np.nan)
+        bad = ~stable.all(axis=1)
+        if bad.any():
+            rho[bad] = np.asarray(rc.spectral_radius(A[bad])).max(axis=1)
+        run = ok & stable.all(axis=1)
+        J = np.full((z.shape[0], self.n_obj), np.inf)
+        if run.any():
+            e = b._sim.run(K[run], keep_trajectories=False, backend=b.backend).mse()
+            J[run] = e.mean(axis=1) if b.aggregate == "mean" else e.max(axis=1)
+        pen = b.penalty
+        F = np.where(np.isfinite(J), np.minimum(J, pen), pen)
+        unstable = ok & ~run
+        F[unstable] = (pen * np.minimum(np.nan_to_num(rho[unstable], nan=2.0), 2.0))[:, None]
+        F[~ok] = 2.0 * pen
+        out["F"] = F
+
+
+def tuning_vs_frozen(pop: int, seed: int, repeats: int) -> dict:
+    """Time per population of the TuningProblem-based applied MOP and of :class:`FrozenApplied` (alternating)."""
+    new = AppliedRLQRProblem()
+    old = FrozenApplied(new)
+    Z = np.random.default_rng(seed).uniform(new.xl, new.xu, (pop, new.n_var))
+    F_new, F_old = new.evaluate(Z), old.evaluate(Z)
+    np.testing.assert_array_equal(F_new, F_old)                # bit-identical objectives
+    wall: dict[str, list[float]] = {"new": [], "old": []}
+    cpu: dict[str, list[float]] = {"new": [], "old": []}
+    for r in range(repeats):                                   # ABBA: neither always goes first
+        order = (("new", new), ("old", old)) if r % 2 == 0 else (("old", old), ("new", new))
+        for key, prob in order:
+            w0, c0 = time.perf_counter(), time.process_time()
+            prob.evaluate(Z)
+            wall[key].append(time.perf_counter() - w0)
+            cpu[key].append(time.process_time() - c0)
+    med = {k: float(np.median(v)) for k, v in cpu.items()}
+    return dict(pop=pop, repeats=repeats, new_ms=1e3 * min(wall["new"]), old_ms=1e3 * min(wall["old"]),
+                new_cpu_ms=1e3 * med["new"], old_cpu_ms=1e3 * med["old"],
+                ratio=min(wall["new"]) / min(wall["old"]), cpu_ratio=med["new"] / med["old"],
+                n_penalised=int(np.sum(F_new[:, 0] >= new.penalty)))
 
 
 def batched_vs_elementwise(pop: int, n_elem: int, seed: int) -> dict:
@@ -166,11 +244,28 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--repeats", type=int, default=2, help="runs per NSGA-II configuration (fastest kept)")
     ap.add_argument("--skip-runs", action="store_true", help="skip the NSGA-II runs")
+    ap.add_argument("--tuning-repeats", type=int, default=30, help="calls per problem in the TuningProblem row")
+    ap.add_argument("--only-tuning", action="store_true", help="measure the TuningProblem row only")
     ap.add_argument("--out", type=Path, default=None, help="also write the report (Markdown) here")
     args = ap.parse_args(argv)
 
     lines = [(f"# bench_mop ({datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, "
               f"{platform.processor() or platform.machine()}, Python {platform.python_version()})"), ""]
+    t = tuning_vs_frozen(args.pop, args.seed, args.tuning_repeats)
+    lines += ["## TuningProblem equal to the applied MOP vs today's AppliedRLQRProblem (frozen copy)", "",
+              (f"Population {t['pop']} ({t['n_penalised']} penalised), objectives bit-identical; "
+               f"{t['repeats']} calls each, alternating ABBA; wall time (fastest call) and CPU time "
+               "(median call, less sensitive to other load on a shared machine)."), "",
+              "| evaluation | fastest wall ms | median CPU ms |", "|---|---|---|",
+              f"| TuningProblem (AppliedRLQRProblem on moo.tuning) | {t['new_ms']:.2f} | {t['new_cpu_ms']:.2f} |",
+              f"| frozen pre-tuning evaluation (FrozenApplied) | {t['old_ms']:.2f} | {t['old_cpu_ms']:.2f} |",
+              f"| **ratio new / old** (target <= 1.1) | **{t['ratio']:.3f}** | **{t['cpu_ratio']:.3f}** |", ""]
+    print("\n".join(lines), flush=True)
+    if args.only_tuning:
+        if args.out is not None:
+            args.out.parent.mkdir(parents=True, exist_ok=True)
+            args.out.write_text("\n".join(lines) + "\n")
+        return 0
     b = batched_vs_elementwise(args.pop, args.elementwise, args.seed)
     lines += ["## Applied MOP: batched vs elementwise", "",
               "| evaluation | evals/s |", "|---|---|",

@@ -538,3 +538,31 @@ def test_make_problem_passes_the_setup_to_applied_only():
         make_problem("zdt1", setup="authors")
     with pytest.raises(ValueError, match="unknown setup"):
         make_problem("applied", setup="theirs")
+
+
+# ------------------------------------------------------------ on the public moo.tuning API --
+def test_paper_mops_are_tuning_problems_with_one_simulation_per_population(applied_short, generic, monkeypatch):
+    from moo.tuning import RLQRFamily, TuningProblem
+
+    for p in (generic, applied_short):
+        assert isinstance(p, TuningProblem) and isinstance(p.family, RLQRFamily)
+        assert len(p.objectives) == p.n_obj and p.n_ieq_constr == 0
+    calls = []
+    real = applied_short.errors.per_scenario
+    monkeypatch.setattr(applied_short.errors, "per_scenario", lambda K: calls.append(len(K)) or real(K))
+    F = applied_short.evaluate(APPLIED_Z)
+    assert len(calls) == 1                                     # four objectives, one simulation
+    stable = F[:, 0] < applied_short.penalty
+    np.testing.assert_allclose(F[stable], applied_short.mse(applied_short.gains(APPLIED_Z).K[stable]).mean(axis=1),
+                               rtol=1e-12)
+    with pytest.raises(ValueError, match="its own payload scenarios"):
+        applied_short.evaluate_gains(applied_short.gains(APPLIED_Z[:1]).K, applied_short.scenarios[:1])
+
+
+def test_generic_goals_on_other_plants(generic):
+    """evaluate_gains on one scenario alone: the regulation errors of that scenario (its own simulator)."""
+    K = generic.gains(generic.paper_optimum).K
+    e, _ = generic.regulation_errors(K)
+    for s in (0, 3):
+        F, _ = generic.evaluate_gains(K, [generic.scenarios[s]])
+        np.testing.assert_allclose(F[0], e[0, s], rtol=1e-12)

@@ -410,3 +410,41 @@ def test_script_rejects_bad_options(tmp_path):
         design_selection.main(["--problem", "generic", "--sims", "0", "--out", str(tmp_path)])
     with pytest.raises(SystemExit):
         design_selection.main(["--problem", "other", "--out", str(tmp_path)])
+
+
+# ------------------------------------------------------------ any TuningProblem --
+def test_select_design_on_a_user_tuning_problem():
+    from moo import tuning
+
+    plant = rc.Plant([[1.1, 0.1], [0.0, 0.9]], [[0.0], [0.1]], dt=0.1)
+    scenarios = [rc.Plant(plant.F * s, plant.G, dt=0.1) for s in (0.95, 1.0, 1.05)]
+
+    def effort(K, plants):
+        return np.abs(K).sum(axis=(1, 2))
+
+    def decay(K, plants):          # the largest closed-loop spectral radius, by eigenvalues per design
+        return np.array([max(np.abs(np.linalg.eigvals(p.F + p.G @ k)).max() for p in plants) for k in K])
+
+    prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios, [effort, decay])
+    X = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, -1.0], [2.0, 0.0, -2.0]])
+    sel = select_design(prob, X, n_sims=40, seed=2)
+    assert sel.designs.labels == ("1", "2", "3", "random") and sel.deltas.shape == (40,)
+    assert set(np.unique(sel.deltas)) <= {0, 1, 2}
+    K = sel.designs.K
+    Ffront = np.stack([effort(K[:3], scenarios), decay(K[:3], scenarios)], axis=1)
+    w = 1.0 / (Ffront.max(axis=0) - Ffront.min(axis=0))
+    # per plant alone: a design unstable on that plant cannot win there
+    unstable = np.array([[max(np.abs(np.linalg.eigvals(p.F + p.G @ k))) >= 1 for p in scenarios] for k in K])
+    per = np.where(unstable, np.inf, np.stack([np.stack([effort(K, [p]), decay(K, [p])], 1) @ w
+                                                   for p in scenarios], 1))
+    np.testing.assert_allclose(sel.errors, per[:, sel.deltas], rtol=1e-12)
+    assert sel.best == int(np.argmax(np.bincount(sel.errors.argmin(axis=0), minlength=4)))
+    # an RLQR family adds its nominal design, the LQR of its weights
+    fam = tuning.RLQRFamily(plant)
+    prob2 = tuning.TuningProblem(fam, scenarios, [effort, decay])
+    d = build_designs(prob2, [[0.1, 0.1, 0.1, 36.0]], seed=0)
+    assert d.labels == ("1", "nominal", "random")
+    K_pc, _, _ = control.dlqr(plant.F, plant.G, np.eye(2), np.eye(1))
+    np.testing.assert_allclose(d.K[d.index("nominal")], -K_pc, rtol=1e-9)
+    with pytest.raises(ValueError, match="path and scales"):
+        select_design(prob, X, n_sims=3, scales=[1, 1, 1, 1])

@@ -89,8 +89,12 @@ def test_user_family_protocol():
         def gains(self, Z):
             return FamilyGains(Z.reshape(-1, 1, 2).copy(), np.ones(len(Z), bool), np.full(len(Z), "", object))
 
+    def only_stable(K, plants):          # the screen: user goals never see a design unstable somewhere
+        assert np.all(radius(K, plants) < 1.0) and np.all(np.isfinite(K))
+        return effort(K, plants)
+
     assert isinstance(DirectGain(), tuning.DesignFamily)
-    prob = tuning.TuningProblem(DirectGain(), SCENARIOS, [effort])
+    prob = tuning.TuningProblem(DirectGain(), SCENARIOS, [only_stable])
     F = prob.evaluate(np.array([[-10.0, -5.0], [0.0, 0.0]]))
     np.testing.assert_allclose(F[0], 15.0)
     assert F[1, 0] == pytest.approx(1e6 * 1.05 * 1.1)            # unstable open loop: p * rho
@@ -226,3 +230,39 @@ def test_select_with_sampler():
     rng = np.random.default_rng(3)
     plants = [sampler(rng) for _ in range(20)]
     np.testing.assert_allclose(sel.errors, np.stack([radius(K, [p]) for p in plants], 1), rtol=1e-12)
+
+
+def test_tune_options_and_record():
+    import json
+
+    prob = tuning.TuningProblem(tuning.LQRFamily(PLANT), SCENARIOS, [effort, radius])
+    res = tuning.tune(prob, "spea2-sde", molsp=False, evals=60, seed=0, pop_size=20)
+    assert not res.run.molsp and res.run.algorithm == "spea2-sde" and res.run.n_evals >= 60
+    json.dumps(res.run.to_dict())
+    assert "TuningResult(front=" in repr(res)
+    with pytest.raises(ValueError, match="evals must be at least the population size"):
+        tuning.tune(prob, evals=10, pop_size=20)
+    with pytest.raises(ValueError, match="max_leaders needs molsp=True"):
+        tuning.tune(prob, molsp=False, max_leaders=3, evals=40, pop_size=20)
+    with pytest.raises(ValueError, match="unknown algorithm"):
+        tuning.tune(prob, "nope", evals=40, pop_size=20)
+
+
+def test_sample_reference_points_by_hand():
+    prob = tuning.TuningProblem(tuning.LQRFamily(PLANT), SCENARIOS, [effort, radius])
+    hv, ms = prob.sample_reference_points(200, seed=4, margin=0.5)
+    Z = np.random.default_rng(4).uniform(prob.xl, prob.xu, (200, prob.n_var))
+    F = prob.evaluate(Z)
+    ok = np.all(prob.penalty > F, axis=1)
+    Fa = F[ok]
+    nd = np.array([not np.any(np.all(Fa <= f, axis=1) & np.any(Fa < f, axis=1)) for f in Fa])
+    lo, hi = Fa[nd].min(axis=0), Fa[nd].max(axis=0)
+    np.testing.assert_allclose(hv, hi + 0.5 * (hi - lo))
+    np.testing.assert_allclose(ms, np.maximum(Fa.max(axis=0), hi) + 0.5 * (hi - lo))
+    assert np.all(Fa[nd] < hv) and np.all(Fa < ms)
+    def huge(K, plants):                 # above the penalty: clipped, never acceptable
+        return np.full(len(K), 2e6)
+
+    tight = tuning.TuningProblem(tuning.LQRFamily(PLANT), SCENARIOS, [huge])
+    with pytest.raises(ValueError, match="none of the 20 sampled designs is acceptable"):
+        tight.sample_reference_points(20)

@@ -32,21 +32,75 @@ from typing import ClassVar, Literal
 
 import numpy as np
 
-from robustctl.batchsim import DEFAULT_BOUND
+import robustctl as rc
+from robustctl.batchsim import BACKENDS, DEFAULT_BOUND
 from robustctl.models import truck
 from robustctl.path import ReferencePath, default_route
 from robustctl.pathfollow import PathFollowing, PathFollowingSetup, get_setup
+from robustctl.validation import check_positive_scalar
 
-from ._rlqr_problem import RLQRTuningProblem
+from ..tuning import RLQRFamily, TuningProblem
+from .generic import positive_ref_point
 
-__all__ = ["AppliedRLQRProblem"]
+__all__ = ["AppliedRLQRProblem", "PathFollowingErrors", "PathFollowingError"]
 
 #: Lower bound of every variable: the paper's open interval (0, 500] closed at 1e-6.
 Z_LOWER = 1e-6
 Z_UPPER = 500.0
 
 
-class AppliedRLQRProblem(RLQRTuningProblem):
+class PathFollowingErrors:
+    """The path-following MSEs of gains on the payload scenarios, simulated once per population.
+
+    ``sim`` is the problem's :class:`robustctl.pathfollow.PathFollowing`;
+    calling with gains ``K`` (B, 2, 4) returns the MSEs (B, 4) combined over the
+    scenarios (``mean`` or ``max``). The last ``K`` array (by identity) and
+    its result are kept, so the four goals :class:`PathFollowingError` of one
+    population cost one simulation. The simulator is built for the problem's
+    payloads: other plant lists are refused.
+    """
+
+    def __init__(self, sim: PathFollowing, plants: list[rc.Plant], aggregate: str,
+                 backend: Literal["numba", "numpy"]):
+        self.sim, self.plants, self.aggregate, self.backend = sim, plants, aggregate, backend
+        self._last: tuple = (None, None)
+
+    def per_scenario(self, K: np.ndarray) -> np.ndarray:
+        """MSEs (B, S, 4) of gains ``K`` (B, 2, 4), in the order f1..f4 (no penalties)."""
+        return self.sim.run(K, keep_trajectories=False, backend=self.backend).mse()
+
+    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+        """Combined MSEs (B, 4) (memoised on ``K``)."""
+        if plants is not self.plants:
+            raise ValueError("the applied MOP's goals simulate its own payload scenarios only; "
+                             "use moo.problems.selection for other payloads")
+        last_K, last_value = self._last
+        if K is last_K:
+            return last_value
+        e = self.per_scenario(K)
+        value = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
+        self._last = (K, value)
+        return value
+
+
+class PathFollowingError:
+    """Goal: the path-following MSE ``f_{j+1}`` (:class:`PathFollowingErrors`, column ``j``)."""
+
+    NAMES = ("rho MSE", "psidot MSE", "ydot MSE", "theta MSE")
+
+    def __init__(self, errors: PathFollowingErrors, j: int):
+        self.errors, self.j = errors, j
+        self.name = self.NAMES[j]
+
+    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+        """``errors(K, plants)[:, j]``."""
+        return self.errors(K, plants)[:, self.j]
+
+    def __repr__(self) -> str:
+        return f"PathFollowingError(j={self.j})"
+
+
+class AppliedRLQRProblem(TuningProblem):
     r"""Truck path-following RLQR tuning problem: 7 variables in ``(0, 500]``, 4 objectives.
 
     For each decision vector ``z`` (one row of the population):
@@ -207,24 +261,48 @@ class AppliedRLQRProblem(RLQRTuningProblem):
         if isinstance(overloads, (str, bytes)) or np.ndim(overloads) != 1 or len(overloads) == 0:
             raise ValueError(f"overloads must be a non-empty 1-D sequence of percentages, got {overloads!r}")
         self.overloads = np.asarray(truck.check_overload(list(overloads), "overloads"), dtype=float)
+        if aggregate not in ("mean", "max"):
+            raise ValueError(f"aggregate must be 'mean' or 'max', got {aggregate!r}")
+        if backend not in BACKENDS:
+            raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}")
+        self.aggregate, self.backend = aggregate, backend
+        family = RLQRFamily(plant, H=np.ones((plant.n, 1)), Q=Q_default if Q is None else Q,
+                            R=R_default if R is None else R, alpha=alpha, max_iter=max_iter, fallback=fallback)
+        self.rlqr_family = family
+        self.plant, self.H, self.Q, self.R = family.plant, family.H, family.Q, family.R
+        self.alpha, self.max_iter, self.fallback = family.alpha, family.max_iter, family.fallback
         # checks path; discretises the scenarios and builds the reference once
         self._sim = PathFollowing(path, tuple(self.overloads), setup=self.setup, input_map=truck.DOUBLED_INPUT_MAP)
         self.path = path
-        F_s, G_s, _ = truck.discretise(self.overloads)       # true plants of the scenarios (S, 4, 4), (S, 4, 1)
-        super().__init__(plant, np.ones((plant.n, 1)), F_s, G_s, truck.DOUBLED_INPUT_MAP,
-                         Q=Q_default if Q is None else Q, R=R_default if R is None else R, alpha=alpha,
-                         max_iter=max_iter, fallback=fallback, aggregate=aggregate, penalty=penalty,
-                         hv_ref_point=hv_ref_point, molsp_ref_point=molsp_ref_point, default_hv=self._HV_REF[refs],
-                         default_molsp=self._MOLSP_REF[refs], n_obj=4, xl=Z_LOWER, xu=Z_UPPER, backend=backend)
-        if self.penalty <= DEFAULT_BOUND**2:
+        # the scenario plants: the true truck at each payload with the doubled column [G_s G_s], so that the
+        # designs' gains (2 x 4) apply as they are (closed loop F_s + G_s (u1 + u2))
+        F_s, G_s, _ = truck.discretise(self.overloads)       # (S, 4, 4), (S, 4, 1)
+        G_s2 = G_s @ np.asarray(truck.DOUBLED_INPUT_MAP)
+        scenarios = [rc.Plant(F, G, dt=plant.dt) for F, G in zip(F_s, G_s2, strict=True)]
+        self.errors = PathFollowingErrors(self._sim, scenarios, aggregate, backend)
+        penalty = check_positive_scalar(penalty, "penalty")
+        if penalty <= DEFAULT_BOUND**2:
             raise ValueError(f"penalty must exceed the largest simulated MSE ({DEFAULT_BOUND**2:g}), "
-                             f"got {self.penalty:g}")
+                             f"got {penalty:g}")
+        hv = positive_ref_point(hv_ref_point, "hv_ref_point", 4)
+        molsp = positive_ref_point(molsp_ref_point, "molsp_ref_point", 4)
+        super().__init__(family, scenarios, [PathFollowingError(self.errors, j) for j in range(4)], xl=Z_LOWER,
+                         xu=Z_UPPER, penalty=penalty, hv_ref_point=self._HV_REF[refs] if hv is None else hv,
+                         molsp_ref_point=self._MOLSP_REF[refs] if molsp is None else molsp)
+        self.errors.plants = self.scenarios          # the list the goals are called with (identity)
 
     # -- public helpers -----------------------------------------------------
+    def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(EF (B, 1, 4), EG (B, 1, 2), mu (B,))`` of a population ``z`` (B, 7) or one ``z``.
+
+        ``mu = 10**sqrt(z7)``.
+        """
+        return self.rlqr_family.decode(z)
+
     def mse(self, K) -> np.ndarray:
         """Per-scenario MSE (B, S, 4) of gains ``K`` (B, 2, 4), in the order f1..f4 (no penalties)."""
         K = self.check_gains(K)
-        return self._sim.run(K, keep_trajectories=False, backend=self.backend).mse()
+        return self.errors.per_scenario(K)
 
     def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
         """:meth:`mse` (the objectives before aggregation and penalties)."""

@@ -15,10 +15,12 @@ in ``[0, 200]^5`` parametrises a steady-state robust LQR (RLQR) gain
 ``mu = 10**sqrt(z5)``; the three objectives are the regulation errors of
 ``x1, x2, x3`` that gain achieves on the *true* uncertain system.
 
-The steps both control-design MOPs share (decoding of ``z``, the batched
-RLQR, the stability screen and the penalty rule) are in
-:mod:`moo.problems._rlqr_problem`; the regulation errors are simulated by
-:class:`robustctl.batchsim.LinearSimulator` (compiled kernel by default).
+The problem is a :class:`moo.tuning.TuningProblem`: the family is
+:class:`moo.tuning.RLQRFamily` on the nominal plant, the scenarios are the
+true plants at the realisations ``delta_s``, and the three objectives are
+goals (:class:`RegulationError`) that share one batched simulation
+(:class:`robustctl.batchsim.LinearSimulator`, compiled kernel by default) per
+population.
 
 References
 ----------
@@ -36,12 +38,12 @@ from typing import Literal
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import LinearSimulator
+from robustctl.batchsim import BACKENDS, LinearSimulator
 
 from .._validation import as_matrix, check_int
-from ._rlqr_problem import RLQRTuningProblem
+from ..tuning import RLQRFamily, TuningProblem
 
-__all__ = ["GenericRLQRProblem"]
+__all__ = ["GenericRLQRProblem", "RegulationErrors", "RegulationError", "positive_ref_point"]
 
 #: Nominal model of the paper's Section 4.4.
 F_GENERIC = np.array([[0.9, 0.8, 0.7], [0.01, 0.1, 0.3], [0.0, 0.25, 0.1]])
@@ -55,7 +57,84 @@ EG_TRUE = np.array([[0.1]])
 _REGULATION_BOUND = 1e100
 
 
-class GenericRLQRProblem(RLQRTuningProblem):
+def positive_ref_point(value, name: str, n_obj: int) -> np.ndarray | None:
+    """A reference point of the paper's MOPs (positive entries, ``n_obj`` of them), or None for the default."""
+    if value is None:
+        return None
+    arr = as_matrix(value, name, rows=1, cols=n_obj, cols_what="the number of objectives").ravel()
+    if np.any(arr <= 0):
+        raise ValueError(f"{name} must have positive entries, got {arr}")
+    return arr
+
+
+class RegulationErrors:
+    r"""The regulation errors of gains on a set of plants, simulated once per population (shared by three goals).
+
+    For gains ``K`` (B, m, n) and plants ``(F_s, G_s)`` the run from each
+    initial state ``x_{0,i}`` gives ``e_{j,s} = sum_i sum_{k=0}^{N} x_j^{(s,i)}[k]^2``
+    (:class:`GenericRLQRProblem`), combined over the plants with ``mean`` or ``max``.
+    The last ``K`` array (by identity) and its result are kept, so the goals
+    :class:`RegulationError` ``(j)`` of one population cost one simulation.
+
+    Parameters
+    ----------
+    plants : list of robustctl.Plant
+        The scenarios the simulator is built for (other plant lists get a simulator of their own).
+    initial_states : (n0, n) ndarray
+    horizon : int
+    aggregate : {"mean", "max"}
+    backend : {"numba", "numpy"}
+    """
+
+    def __init__(self, plants: list[rc.Plant], initial_states: np.ndarray, horizon: int, aggregate: str,
+                 backend: Literal["numba", "numpy"]):
+        self.plants, self.initial_states, self.horizon = plants, initial_states, horizon
+        self.aggregate, self.backend = aggregate, backend
+        self._sim = self._simulator(plants)
+        self._last: tuple = (None, None, None)
+
+    def _simulator(self, plants: list[rc.Plant]) -> LinearSimulator:
+        n0, n = self.initial_states.shape
+        F_s, G_s = np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
+        # one regulation run per (scenario, initial state): scenario index s * n0 + i
+        return LinearSimulator(np.repeat(F_s, n0, axis=0), np.repeat(G_s, n0, axis=0), np.zeros((self.horizon + 1, n)),
+                               x0=np.tile(self.initial_states, (len(plants), 1)), bound=_REGULATION_BOUND)
+
+    def per_scenario(self, K: np.ndarray, plants: list[rc.Plant] | None = None) -> np.ndarray:
+        """Errors (B, S, n) of gains ``K`` (B, m, n) whose closed loops are all stable."""
+        sim = self._sim if plants is None or plants is self.plants else self._simulator(plants)
+        S = len(self.plants if plants is None else plants)
+        n0, n = self.initial_states.shape
+        sums = sim.run(K, keep_trajectories=False, backend=self.backend).sq_state_sum
+        return sums.reshape(K.shape[0], S, n0, n).sum(axis=2)
+
+    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+        """Combined errors (B, n): ``mean_s`` or ``max_s`` of :meth:`per_scenario` (memoised on ``K``)."""
+        last_K, last_plants, last_value = self._last
+        if K is last_K and plants is last_plants:
+            return last_value
+        e = self.per_scenario(K, plants)
+        value = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
+        self._last = (K, plants, value)
+        return value
+
+
+class RegulationError:
+    """Goal: the regulation error of state ``j`` (:class:`RegulationErrors`, column ``j``)."""
+
+    def __init__(self, errors: RegulationErrors, j: int):
+        self.errors, self.j = errors, j
+        self.name = f"x{j + 1} regulation error"
+
+    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+        """``errors(K, plants)[:, j]``."""
+        return self.errors(K, plants)[:, self.j]
+
+    def __repr__(self) -> str:
+        return f"RegulationError(j={self.j})"
+
+
+class GenericRLQRProblem(TuningProblem):
     r"""Generic RLQR tuning problem: 5 variables in ``[0, 200]``, 3 objectives.
 
     Decision vector ``z = (E_F1, E_F2, E_F3, E_G, (log10 mu)^2)``. For each ``z`` the
@@ -201,20 +280,36 @@ class GenericRLQRProblem(RLQRTuningProblem):
         self.initial_states = np.eye(n) if initial_states is None else as_matrix(
             initial_states, "initial_states", cols=n, cols_what="the number of states")
         self.horizon = check_int(horizon, "horizon", 1)
+        if aggregate not in ("mean", "max"):
+            raise ValueError(f"aggregate must be 'mean' or 'max', got {aggregate!r}")
+        if backend not in BACKENDS:
+            raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}")
+        self.aggregate, self.backend = aggregate, backend
         # true plants per scenario: F_s (S, n, n), G_s (S, n, m)
         F_s = F_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EF_true)
         G_s = G_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EG_true)
-        super().__init__(rc.Plant(F_GENERIC, G_GENERIC, dt=1.0), H_GENERIC.copy(), F_s, G_s, None, Q=Q, R=R,
-                         alpha=alpha, max_iter=max_iter, fallback="recursion", aggregate=aggregate, penalty=penalty,
-                         hv_ref_point=hv_ref_point, molsp_ref_point=molsp_ref_point, default_hv=self._HV_REF,
-                         default_molsp=self._MOLSP_REF, n_obj=n, xl=0.0, xu=200.0, backend=backend)
-        # one regulation run per (scenario, initial state): scenario index s * n0 + i
-        n0 = self.initial_states.shape[0]
-        self._regulation = LinearSimulator(
-            np.repeat(F_s, n0, axis=0), np.repeat(G_s, n0, axis=0), np.zeros((self.horizon + 1, n)),
-            x0=np.tile(self.initial_states, (self.deltas.size, 1)), bound=_REGULATION_BOUND)
+        scenarios = [rc.Plant(F, G, dt=1.0) for F, G in zip(F_s, G_s, strict=True)]
+        family = RLQRFamily(rc.Plant(F_GENERIC, G_GENERIC, dt=1.0), H=H_GENERIC.copy(), Q=Q, R=R, alpha=alpha,
+                            max_iter=max_iter, fallback="recursion")
+        self.rlqr_family = family
+        self.plant, self.H, self.Q, self.R = family.plant, family.H, family.Q, family.R
+        self.alpha, self.max_iter, self.fallback = family.alpha, family.max_iter, family.fallback
+        self.errors = RegulationErrors(scenarios, self.initial_states, self.horizon, aggregate, backend)
+        hv = positive_ref_point(hv_ref_point, "hv_ref_point", n)
+        molsp = positive_ref_point(molsp_ref_point, "molsp_ref_point", n)
+        super().__init__(family, scenarios, [RegulationError(self.errors, j) for j in range(n)], xl=0.0, xu=200.0,
+                         penalty=penalty, hv_ref_point=self._HV_REF if hv is None else hv,
+                         molsp_ref_point=self._MOLSP_REF if molsp is None else molsp)
+        self.errors.plants = self.scenarios          # the list the goals are called with (identity)
 
     # -- public helpers -----------------------------------------------------
+    def decode(self, z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(EF (B, 1, 3), EG (B, 1, 1), mu (B,))`` of a population ``z`` (B, 5) or one ``z``.
+
+        ``mu = 10**sqrt(z5)``.
+        """
+        return self.rlqr_family.decode(z)
+
     def regulation_errors(self, K) -> tuple[np.ndarray, np.ndarray]:
         """Raw errors of gains ``K`` (B, 1, 3): ``(e (B, S, 3), rho (B, S))``.
 
@@ -223,23 +318,19 @@ class GenericRLQRProblem(RLQRTuningProblem):
         Rows of ``K`` with non-finite entries (``rho = inf``) and unstable closed
         loops get ``e = inf``; designs with no stable scenario are not simulated.
         """
+        K = self.check_gains(K)
         rho = self.closed_loop_radius(K)
         stable = np.asarray(rc.is_schur_stable(self.closed_loops(K)))  # a stack: an array
         e = np.full((*rho.shape, self.plant.n), np.inf)
         some = stable.any(axis=1)
         if some.any():
-            e[some] = self._simulate(np.asarray(K, dtype=float)[some])
+            e[some] = self.scenario_objectives(K[some])
         e[~stable] = np.inf
         return e, rho
 
     def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
         """Regulation errors (B, S, 3) of stable gains (:meth:`regulation_errors` without the screen)."""
-        return self._simulate(K)
-
-    def _simulate(self, K: np.ndarray) -> np.ndarray:
-        S, n0, n = self.deltas.size, self.initial_states.shape[0], self.plant.n
-        sums = self._regulation.run(K, keep_trajectories=False, backend=self.backend).sq_state_sum
-        return sums.reshape(K.shape[0], S, n0, n).sum(axis=2)
+        return self.errors.per_scenario(K)
 
     def __repr__(self) -> str:
         return (f"GenericRLQRProblem(n_var={self.n_var}, n_obj={self.n_obj}, S={self.deltas.size}, "

@@ -19,6 +19,14 @@ This module has three layers:
 * :func:`build_designs` (front + the paper's extra designs) and
   :func:`select_design` (everything in one call).
 
+Any other :class:`moo.tuning.TuningProblem` goes through the general rule
+of :mod:`moo.tuning.selection` (each simulation draws a scenario of the
+problem, or a plant from a ``sampler``; the cumulative error is the weighted
+sum of the problem's objectives on that plant alone): :func:`build_designs`
+gives the front, the family's *nominal* design if it has one (``nominal()``,
+e.g. :class:`moo.tuning.RLQRFamily`) and a *random* one, and
+:func:`select_design` returns the same :class:`DesignSelection`.
+
 Design sets (the paper's order). Generic: the ``N`` front designs, then the
 *nominal* design, then a *random* one (``N + 2`` designs, 94 in the paper).
 Applied: the front, *nominal*, *RLQR^A*, *random* (``N + 3``, 95 in the paper).
@@ -43,9 +51,10 @@ vehicles", Control Engineering Practice 85 (2019) (RLQR^A, the doubled column).
 
 Notes
 -----
-Layering: it lives in :mod:`moo.problems` because, like the problems, it is
-specific to the control-design MOPs and imports ``robustctl`` (the LQR, the
-truck model and the batched simulator).
+Layering: the paper's samplers live in :mod:`moo.problems` because, like the
+problems, they are specific to the paper's MOPs and import ``robustctl`` (the
+LQR, the truck model and the batched simulator); the counting rule and the
+general selection are in :mod:`moo.tuning.selection` (re-exported here).
 """
 
 from __future__ import annotations
@@ -61,6 +70,8 @@ from robustctl.path import ReferencePath, default_route
 from robustctl.pathfollow import PathFollowing, PathFollowingSetup, get_setup
 
 from .._validation import as_matrix, check_int
+from ..tuning import TuningProblem
+from ..tuning.selection import SelectionResult, default_weights, monte_carlo_selection, scenario_errors
 from .applied import AppliedRLQRProblem
 from .generic import GenericRLQRProblem
 
@@ -79,114 +90,6 @@ MAX_OVERLOAD = 300.0
 BRYSON_SCALES = tuple(float(truck.MAX_ERRORS[i]) for i in truck.OBJECTIVE_STATES)
 #: Scenarios simulated together by :func:`applied_errors` (bounds the memory of the disturbance arrays).
 _SCENARIO_CHUNK = 250
-
-
-# ---------------------------------------------------------------------------
-# the counting rule
-# ---------------------------------------------------------------------------
-
-@dataclass(frozen=True, eq=False, repr=False)
-class SelectionResult:
-    """Outcome of :func:`monte_carlo_selection` on ``D`` designs and ``S`` simulations.
-
-    Attributes
-    ----------
-    winners : (S,) int ndarray
-        Index of the design with the least error in each simulation (ties: the
-        lowest index); ``-1`` where no design has a finite error.
-    counts : (D,) int ndarray
-        Number of simulations each design won; ``counts.sum() == S - n_no_winner``.
-    best : int
-        The most frequent winner (ties: the lowest index), the selected design.
-    """
-
-    winners: np.ndarray
-    counts: np.ndarray
-    best: int
-
-    @property
-    def n_designs(self) -> int:
-        """Number of candidate designs D."""
-        return int(self.counts.size)
-
-    @property
-    def n_simulations(self) -> int:
-        """Number of simulations (realisations) S."""
-        return int(self.winners.size)
-
-    @property
-    def n_no_winner(self) -> int:
-        """Simulations in which every design's error was infinite."""
-        return int(np.count_nonzero(self.winners < 0))
-
-    def ranking(self) -> np.ndarray:
-        """Design indices by decreasing win count (equal counts: increasing index)."""
-        return np.argsort(-self.counts, kind="stable")
-
-    def __repr__(self) -> str:
-        return (f"SelectionResult(D={self.n_designs}, S={self.n_simulations}, best={self.best}, "
-                f"wins={int(self.counts[self.best])}, no_winner={self.n_no_winner})")
-
-
-def _as_errors(errors) -> np.ndarray:
-    if isinstance(errors, (str, bytes)) or errors is None:
-        raise TypeError(f"errors must be a (designs, simulations) array of numbers, got {type(errors).__name__}")
-    try:
-        arr = np.asarray(errors, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError("errors must be a (designs, simulations) array of real numbers") from None
-    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
-        raise ValueError(f"errors must be a non-empty 2-D array (designs, simulations), got shape {arr.shape}")
-    if np.any(np.isnan(arr)) or np.any(arr == -np.inf):
-        raise ValueError("errors must not contain NaN or -inf (+inf marks a design that cannot win)")
-    return arr
-
-
-def monte_carlo_selection(errors) -> SelectionResult:
-    r"""Count how often each design has the least cumulative error; select the most frequent winner.
-
-    With ``E[d, s]`` the cumulative error of design ``d`` in simulation ``s``,
-
-    .. math::
-
-        w_s = \min \arg\min_d E[d, s], \qquad
-        c_d = \#\{s : w_s = d\}, \qquad
-        d^* = \min \arg\max_d c_d,
-
-    i.e. ties within a simulation go to the lowest design index, and so do ties
-    between win counts. ``+inf`` marks a design that cannot win a simulation
-    (e.g. unstable there); a simulation in which every design is ``+inf`` has
-    no winner (``winners[s] = -1``) and counts for nobody.
-
-    Parameters
-    ----------
-    errors : (D, S) array_like
-        Cumulative errors, lower is better; finite or ``+inf``.
-
-    Returns
-    -------
-    SelectionResult
-
-    Raises
-    ------
-    ValueError
-        ``errors`` not 2-D or empty, containing NaN or ``-inf``, or no
-        simulation has a winner.
-
-    References
-    ----------
-    Morais et al. (2022), Section 4.4.1: "The control design with less
-    cumulative error is assigned as the winner for each simulation [...] the
-    selection criterium is to choose [...] the most frequent individual".
-    """
-    E = _as_errors(errors)
-    D = E.shape[0]
-    winners = np.argmin(E, axis=0)                       # first minimum: lowest index on ties
-    winners[~np.isfinite(E.min(axis=0))] = -1
-    counts = np.bincount(winners[winners >= 0], minlength=D)
-    if counts.sum() == 0:
-        raise ValueError("errors: no design has a finite error in any simulation; nothing to select")
-    return SelectionResult(winners=winners, counts=counts, best=int(np.argmax(counts)))
 
 
 # ---------------------------------------------------------------------------
@@ -428,16 +331,44 @@ class DesignSet:
 
 
 def _check_problem(problem) -> None:
-    if not isinstance(problem, (GenericRLQRProblem, AppliedRLQRProblem)):
-        raise TypeError(f"problem must be a GenericRLQRProblem or an AppliedRLQRProblem, "
-                        f"got {type(problem).__name__}")
+    if not isinstance(problem, TuningProblem):
+        raise TypeError(f"problem must be a moo.tuning.TuningProblem (e.g. a GenericRLQRProblem or an "
+                        f"AppliedRLQRProblem), got {type(problem).__name__}")
 
 
-def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, seed=None) -> DesignSet:
+def _paper(problem) -> bool:
+    return isinstance(problem, (GenericRLQRProblem, AppliedRLQRProblem))
+
+
+def _general_designs(problem: TuningProblem, X: np.ndarray, seed) -> DesignSet:
+    """Front, the family's nominal design (if it has ``nominal()``), random: for any TuningProblem."""
+    z_random = np.asarray(_rng(seed).uniform(problem.xl, problem.xu))
+    K_all = problem.gains(np.vstack([X, z_random])).K
+    N = X.shape[0]
+    Ks, zs = [K_all[:N]], [X]
+    labels, kinds = [str(i + 1) for i in range(N)], ["front"] * N
+    nominal = getattr(problem.family, "nominal", None)
+    if callable(nominal):
+        Ks.append(problem.check_gains(nominal()))
+        zs.append(np.full((1, problem.n_var), np.nan))
+        labels.append("nominal")
+        kinds.append("nominal")
+    Ks.append(K_all[N:])
+    zs.append(z_random[None])
+    labels.append("random")
+    kinds.append("random")
+    K = np.concatenate(Ks)
+    return DesignSet(K=K, z=np.concatenate(zs), labels=tuple(labels), kinds=tuple(kinds),
+                     ok=np.all(np.isfinite(K), axis=(1, 2)))
+
+
+def build_designs(problem: TuningProblem, X_front, *, seed=None) -> DesignSet:
     """The candidate designs: the front's decision vectors plus the paper's extra designs.
 
     Generic: ``[front (N), nominal, random]``; applied: ``[front (N), nominal,
-    RLQR^A, random]`` (the paper's order, see the module docstring). The front
+    RLQR^A, random]`` (the paper's order, see the module docstring); any
+    other :class:`~moo.tuning.TuningProblem`: ``[front (N), nominal (if its
+    family has ``nominal()``), random]``. The front
     and random designs are computed in one batched RLQR call
     (:meth:`~moo.problems.generic.GenericRLQRProblem.gains`), with the problem's ``Q``, ``R``, ``alpha`` and
     ``max_iter``; a design that fails keeps NaN gains (``ok`` False) and can
@@ -445,7 +376,7 @@ def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
 
     Parameters
     ----------
-    problem : GenericRLQRProblem or AppliedRLQRProblem
+    problem : TuningProblem
     X_front : (N, n_var) array_like
         Decision vectors of the front (N >= 1), e.g. ``moo.runner.run(...).X``.
     seed : int or numpy Generator-compatible seed
@@ -453,6 +384,8 @@ def build_designs(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     """
     _check_problem(problem)
     X = as_matrix(X_front, "X_front", cols=problem.n_var, cols_what="the problem's number of variables")
+    if not _paper(problem):
+        return _general_designs(problem, X, seed)
     if np.any(X[:, -1] < 0):
         raise ValueError(f"X_front's last variable, (log10 mu)^2, must be >= 0, got {X[:, -1].min():g}")
     z_random = np.asarray(_rng(seed).uniform(problem.xl, problem.xu))      # (n_var,): pymoo's bounds are arrays
@@ -493,9 +426,12 @@ class DesignSelection:
     ----------
     designs : DesignSet
     deltas : (S,) ndarray
-        The realisations ``Delta_s``.
+        The realisations ``Delta_s`` (the paper's problems), or the index of
+        the scenario each simulation drew (any other problem; -1 where a
+        ``sampler`` drew the plant).
     errors : (D, S) ndarray
-        Cumulative errors (see :func:`generic_errors`, :func:`applied_errors`).
+        Cumulative errors (see :func:`generic_errors`, :func:`applied_errors`,
+        :func:`moo.tuning.selection.scenario_errors`).
     result : SelectionResult
     """
 
@@ -524,19 +460,22 @@ class DesignSelection:
                 f"wins={int(self.result.counts[self.best])})")
 
 
-def select_design(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, n_sims: int = 1000,
-                  seed=None, path: ReferencePath | None = None, scales=None) -> DesignSelection:
+def select_design(problem: TuningProblem, X_front, *, n_sims: int = 1000, seed=None,
+                  path: ReferencePath | None = None, scales=None, sampler=None, weights=None) -> DesignSelection:
     """The paper's Monte Carlo selection of ``z*`` from a front, in one call.
 
     Builds the design set (:func:`build_designs`), draws ``n_sims`` realisations
     ``Delta ~ U(-1, 1)`` (:func:`draw_deltas`), computes the cumulative errors
     (:func:`generic_errors` or :func:`applied_errors`) and counts the winners
-    (:func:`monte_carlo_selection`).
+    (:func:`monte_carlo_selection`). Any other :class:`~moo.tuning.TuningProblem`:
+    each simulation draws one of its scenarios (or ``sampler(rng)``) and the
+    errors are :func:`moo.tuning.selection.scenario_errors` with ``weights``
+    (default: 1 / the spread of the front's objectives, see :mod:`moo.tuning.selection`).
 
     Parameters
     ----------
-    problem : GenericRLQRProblem or AppliedRLQRProblem
-        The problem the front was computed on (its ``Q``, ``R``, ``alpha`` design
+    problem : TuningProblem
+        The problem the front was computed on (the paper's: its ``Q``, ``R``, ``alpha`` design
         the gains; the generic one also gives initial states and horizon).
     X_front : (N, n_var) array_like
     n_sims : int
@@ -549,9 +488,19 @@ def select_design(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
     scales : (4,) array_like, optional
         Applied problem only: see :func:`applied_errors` (the loop and the
         default scales are those of ``problem.setup``).
+    sampler : callable, optional
+        Problems other than the paper's: ``sampler(rng) -> robustctl.Plant``, the plant of a simulation.
+    weights : (n_obj,) array_like, optional
+        Problems other than the paper's: weights of the objectives in the cumulative error.
     """
     _check_problem(problem)
     n_sims = check_int(n_sims, "n_sims", 1)
+    if not _paper(problem):
+        if path is not None or scales is not None:
+            raise ValueError("path and scales apply to the applied problem only; give None")
+        return _general_selection(problem, X_front, n_sims, seed, sampler, weights)
+    if sampler is not None or weights is not None:
+        raise ValueError("sampler and weights apply to problems other than the paper's two; give None")
     generic = isinstance(problem, GenericRLQRProblem)
     if generic and (path is not None or scales is not None):
         raise ValueError("path and scales apply to the applied problem only; give None for the generic one")
@@ -564,3 +513,25 @@ def select_design(problem: GenericRLQRProblem | AppliedRLQRProblem, X_front, *, 
         errors = applied_errors(designs.K, deltas, path=problem.path if path is None else path, scales=scales,
                                 setup=problem.setup)
     return DesignSelection(designs=designs, deltas=deltas, errors=errors, result=monte_carlo_selection(errors))
+
+
+def _general_selection(problem: TuningProblem, X_front, n_sims: int, seed, sampler, weights) -> DesignSelection:
+    """:func:`select_design` for a TuningProblem other than the paper's (see :mod:`moo.tuning.selection`)."""
+    design_rng, draw_rng = _rng(seed).spawn(2)
+    designs = build_designs(problem, X_front, seed=design_rng)
+    if weights is None:
+        F, _ = problem.evaluate_gains(designs.K[:designs.n_front])
+        fin = np.all(np.isfinite(F), axis=1)
+        weights = default_weights(F[fin] if fin.any() else np.ones((1, problem.n_obj)))
+    if sampler is None:
+        draws = draw_rng.integers(0, len(problem.scenarios), size=n_sims)
+        used = np.unique(draws)
+        per = scenario_errors(problem, designs.K, [problem.scenarios[i] for i in used], weights)
+        errors = per[:, np.searchsorted(used, draws)]
+    else:
+        if not callable(sampler):
+            raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, "
+                            f"got {type(sampler).__name__}")
+        draws = np.full(n_sims, -1)
+        errors = scenario_errors(problem, designs.K, [sampler(draw_rng) for _ in range(n_sims)], weights)
+    return DesignSelection(designs=designs, deltas=draws, errors=errors, result=monte_carlo_selection(errors))

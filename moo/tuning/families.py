@@ -152,6 +152,7 @@ def population(Z, n_var: int, name: str = "Z") -> np.ndarray:
 
 def _reasons(ok: np.ndarray, reason) -> np.ndarray:
     out = np.asarray(reason).astype(object)
+    out[~ok & (out == "ok")] = "non-finite gain"
     out[ok] = ""
     return out
 
@@ -262,7 +263,8 @@ class RLQRFamily:
         K = np.where(ok[:, None, None], batch.K, np.nan)
         if self.input_map is not None:
             K = self.input_map @ K
-        return FamilyGains(K=K, ok=ok, reason=_reasons(ok, batch.reason))
+        reason = getattr(batch, "reason", None)
+        return FamilyGains(K=K, ok=ok, reason=_reasons(ok, np.full(ok.shape, "failed") if reason is None else reason))
 
     def nominal(self) -> np.ndarray:
         """The gain with no uncertainty: the LQR of ``Q``, ``R`` on the design plant (through the input map)."""

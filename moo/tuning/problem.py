@@ -32,13 +32,14 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import moocore
 import numpy as np
 from pymoo.core.problem import Problem
 
 import robustctl as rc
 from robustctl.validation import check_positive_scalar
 
-from .._validation import as_float_array, as_matrix
+from .._validation import as_float_array, as_matrix, check_int
 from .families import DesignFamily, FamilyGains, _bounds, check_bounds, population
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
@@ -146,8 +147,8 @@ class TuningProblem(Problem):
         every scenario and scores below ``p`` dominates. It is always
         valid but on a scale far above good designs, so the hypervolume
         differences of good fronts are tiny: give a point just beyond the
-        values you accept (e.g. a front's nadir enlarged by 10-30 %) to
-        compare runs.
+        values you accept (e.g. a front's nadir enlarged by 10-30 %,
+        :meth:`sample_reference_points`) to compare runs.
     molsp_ref_point : (n_obj,) array_like, optional
         MO-LSP's leader reference point; default ``hv_ref_point`` (MO-LSP
         chooses its leaders among the designs that dominate it).
@@ -251,6 +252,10 @@ class TuningProblem(Problem):
             F_s, G_s = np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
         return F_s[None] + G_s[None] @ K[:, None]
 
+    def closed_loop_radius(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
+        """Spectral radius (B, S) of the closed loop per scenario (inf for non-finite K)."""
+        return np.asarray(rc.spectral_radius(self.closed_loops(K, scenarios)))      # a stack: an array
+
     def stability(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the worst spectral radius.
 
@@ -301,6 +306,60 @@ class TuningProblem(Problem):
             for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
                 G[run, j] = self._call(g, name, Kr, plants)
         return F, G
+
+    def sample_reference_points(self, n: int = 500, *, seed=0, margin: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
+        r"""Reference points from the scale of the objectives, by the rule the paper's two MOPs use.
+
+        ``n`` designs are drawn uniformly from the bounds and evaluated; among
+        the *acceptable* ones (not penalised, feasible) the non-dominated set
+        has the ideal point ``f^-`` and the nadir point ``f^+``, and the
+        acceptable designs reach at most ``f^max``. With ``d = f^+ - f^-``
+        (replaced by ``|f^+|``, or 1, where it is zero),
+
+        .. math::
+
+            r_{hv} = f^+ + 	ext{margin}\; d, \qquad
+            r_{molsp} = \max(f^{max}, f^+) + 	ext{margin}\; d,
+
+        so every non-dominated sampled design dominates ``r_hv`` and every
+        acceptable one ``r_molsp`` (MO-LSP then finds leaders from the first
+        random generation on). Pass them to the constructor (or set the
+        attributes) to get hypervolumes on the scale of good designs.
+
+        Parameters
+        ----------
+        n : int
+            Sample size.
+        seed : int or numpy Generator-compatible seed
+        margin : float
+            Relative enlargement beyond the sample's nadir.
+
+        Returns
+        -------
+        hv_ref_point, molsp_ref_point : (n_obj,) ndarray
+
+        Raises
+        ------
+        ValueError
+            No acceptable design in the sample (enlarge ``n`` or revise the bounds).
+        """
+        n = check_int(n, "n", 2)
+        margin = check_positive_scalar(margin, "margin")
+        Z = np.random.default_rng(seed).uniform(self.xl, self.xu, (n, self.n_var))
+        out = self.evaluate(Z, return_as_dictionary=True)
+        F = np.asarray(out["F"], dtype=float)
+        ok = np.all(self.penalty > F, axis=1) & (self.last_flags == "")
+        if self.n_ieq_constr:
+            ok &= np.all(np.asarray(out["G"]) <= 0.0, axis=1)
+        if not ok.any():
+            raise ValueError(f"n: none of the {n} sampled designs is acceptable (all penalised or infeasible); "
+                             "sample more or narrow the bounds")
+        Fa = F[ok]
+        nd = Fa[moocore.is_nondominated(Fa, keep_weakly=True)]
+        lo, hi = nd.min(axis=0), nd.max(axis=0)
+        d = hi - lo
+        d = np.where(d > 0, d, np.where(np.abs(hi) > 0, np.abs(hi), 1.0))
+        return hi + margin * d, np.maximum(Fa.max(axis=0), hi) + margin * d
 
     # -- pymoo hooks -----------------------------------------------------------------
     def evaluate(self, X, *args, **kwargs):

@@ -61,7 +61,11 @@ class TuningResult:
         return plant if isinstance(plant, rc.Plant) else self.problem.scenarios[0]
 
     def controllers(self) -> list[rc.Controller]:
-        """One :class:`robustctl.Controller` per front design (its ``info`` holds ``z`` and the objectives)."""
+        """One :class:`robustctl.Controller` per front design (its ``info`` holds ``z`` and the objectives).
+
+        A front design whose gain could not be computed (only possible when no
+        design of the run was acceptable, so the front holds penalised ones) is left out.
+        """
         method, plant = _method(self.problem.family), self._plant()
         return [rc.Controller(K, method, plant, {"z": x.copy(), "objectives": f.copy()})
                 for K, x, f in zip(self.gains, self.X, self.F, strict=True) if np.all(np.isfinite(K))]
