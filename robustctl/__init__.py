@@ -46,6 +46,7 @@ from .lqr import lqr
 from .performance import lq_output
 from .plant import Plant
 from .regions import ConicSector, Disk, HalfPlane
+from .scenarios import PlantSamples, sample_plants
 from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
 
@@ -57,6 +58,7 @@ __all__ = [
     "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
     "NotStabilizingError",
 ]
+__all__ += ["sample_plants", "PlantSamples"]
 __all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
             "RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase"]
 __all__ += ["lq_output", "InputMemoryFeedback", "margins_report", "MarginsReport"]

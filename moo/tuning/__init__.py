@@ -29,11 +29,26 @@ Applications 192 (2022) 116304.
 """
 
 from .families import DesignFamily, FamilyGains, LQRFamily, RLQRFamily, dlqr_gains
+from .goals import (
+    Bound,
+    ErrorGoal,
+    Goal,
+    H2Norm,
+    HinfNorm,
+    PeakInput,
+    PoleRegion,
+    Response,
+    RobustMargin,
+    SettlingTime,
+    SpectralRadius,
+    at_least,
+    at_most,
+)
 from .problem import TuningProblem, penalise
 from .selection import Selection, SelectionResult, monte_carlo_selection, select
-from .tune import TuningResult, tune
-
-# goals (moo/tuning/goals.py, another helper): the lead adds `from .goals import ...` and the names to __all__.
+from .tune import TuningResult, select_front, tune
 
 __all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains", "TuningProblem", "penalise",
-           "tune", "TuningResult", "select", "Selection", "SelectionResult", "monte_carlo_selection"]
+           "tune", "TuningResult", "select_front", "select", "Selection", "SelectionResult", "monte_carlo_selection",
+           "Goal", "Response", "ErrorGoal", "PeakInput", "SettlingTime", "SpectralRadius", "PoleRegion", "H2Norm",
+           "HinfNorm", "RobustMargin", "Bound", "at_most", "at_least"]

@@ -41,6 +41,7 @@ from robustctl.validation import check_positive_scalar
 
 from .._validation import as_float_array, as_matrix, check_int
 from .families import DesignFamily, FamilyGains, _bounds, check_bounds, population
+from .goals import check_scenarios
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
 
@@ -73,26 +74,6 @@ def goal_name(goal, index: int, kind: str) -> str:
     if isinstance(fn, str) and fn != "<lambda>":
         return fn
     return f"{kind}[{index}]"
-
-
-def _scenarios(scenarios) -> list[rc.Plant]:
-    if isinstance(scenarios, rc.Plant) or not isinstance(scenarios, Sequence) or isinstance(scenarios, (str, bytes)):
-        raise TypeError(f"scenarios must be a non-empty list of robustctl.Plant, got {type(scenarios).__name__}")
-    if len(scenarios) == 0:
-        raise ValueError("scenarios must not be empty (give at least the nominal plant)")
-    first = scenarios[0]
-    for i, p in enumerate(scenarios):
-        if not isinstance(p, rc.Plant):
-            raise TypeError(f"scenarios[{i}] must be a robustctl.Plant, got {type(p).__name__}")
-        if not p.is_discrete:
-            raise ValueError(f"scenarios[{i}] must be discrete-time (dt > 0); discretise it first")
-        if (p.n, p.m) != (first.n, first.m):
-            raise ValueError(f"scenarios must all have the same size: scenarios[0] has n={first.n}, m={first.m}, "
-                             f"scenarios[{i}] has n={p.n}, m={p.m}")
-        if p.dt != first.dt:
-            raise ValueError(f"scenarios must all have the same sampling time: scenarios[0] has dt={first.dt}, "
-                             f"scenarios[{i}] has dt={p.dt}")
-    return list(scenarios)
 
 
 def _goals(goals, kind: str) -> tuple[list, list[str]]:
@@ -181,7 +162,7 @@ class TuningProblem(Problem):
                 raise TypeError(f"family must follow the DesignFamily protocol (missing {attr!r}), "
                                 f"got {type(family).__name__}")
         self.family = family
-        self.scenarios = _scenarios(scenarios)
+        self.scenarios = check_scenarios(scenarios, "scenarios")
         n, m = self.scenarios[0].n, self.scenarios[0].m
         if (family.n_states, family.n_inputs) != (n, m):
             raise ValueError(f"family gives gains of shape ({family.n_inputs}, {family.n_states}), but the scenarios "
@@ -248,7 +229,7 @@ class TuningProblem(Problem):
         if scenarios is None:
             F_s, G_s = self._F_s, self._G_s
         else:
-            plants = _scenarios(scenarios)
+            plants = check_scenarios(scenarios, "scenarios")
             F_s, G_s = np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
         return F_s[None] + G_s[None] @ K[:, None]
 
@@ -292,7 +273,7 @@ class TuningProblem(Problem):
         penalty, no clipping; a goal's NaN stays NaN.
         """
         K = self.check_gains(K)
-        plants = self.scenarios if scenarios is None else _scenarios(scenarios)
+        plants = self.scenarios if scenarios is None else check_scenarios(scenarios, "scenarios")
         finite = np.all(np.isfinite(K), axis=(1, 2))
         Kf = np.where(finite[:, None, None], K, 0.0)
         stable, _ = self.stability(Kf, plants)

@@ -1,0 +1,842 @@
+r"""Tuning goals: objectives and constraints on state-feedback gains over a set of plants.
+
+A goal is any callable ``goal(K, plants) -> (B,)`` float array: ``K`` of
+shape (B, m, n) holds B gains (convention ``u = K x``) that stabilise every
+scenario, ``plants`` is the scenario list (:class:`robustctl.Plant`, one
+``n``, ``m`` and ``dt``, discrete time). Smaller is better; a constraint holds
+where its value is ``<= 0``. The goals of this module are small frozen
+classes, each batched over the B designs and the S scenarios (stacked
+matrices, one compiled simulation), each reducing the scenarios with
+``over="mean"`` or ``"max"``, and each with
+
+* ``name`` - a label for tables and plots (``name=`` overrides it);
+* ``check(plants)`` - the goal's arguments against the plants (state index
+  out of range, reference of the wrong shape, ``Bw`` with other than ``n``
+  rows ...), a ``ValueError`` naming the argument; the tuning problem calls it
+  once, and every call repeats it (cheap) so a goal is safe on its own;
+* ``measure(K, plants)`` - the goal's quantity in its own sense, to which the
+  bounds of :func:`at_most` and :func:`at_least` refer. It equals the goal's
+  value except for :class:`RobustMargin`, a quantity to *maximise* that is
+  minimised as ``1 / margin``.
+
+Time domain (one simulation per population, shared; :class:`Response`):
+from ``x[0] = x0`` the loop ``u[k] = sat(K (x[k] - r[k]))``,
+``x[k+1] = F x[k] + G u[k]`` runs ``T = steps`` samples on every scenario
+(:class:`robustctl.batchsim.LinearSimulator`, the compiled kernel), with the
+error ``e = x - r`` (``r = 0`` without a reference):
+
+========================  ================================================  ==========
+goal                      per design and scenario                           ``over``
+========================  ================================================  ==========
+``error(measure="mse")``  ``sum_i w_i (1/T) sum_k e_i[k]^2``                 ``"mean"``
+``error(measure="ise")``  ``sum_i w_i dt sum_k e_i[k]^2``                    ``"mean"``
+``error(measure="iae")``  ``sum_i w_i dt sum_k |e_i[k]|``                    ``"mean"``
+``peak_input()``          ``max_k max_j |u_j[k]|``                          ``"max"``
+``settling_time()``       ``dt k*``, ``k*`` the first sample from which     ``"mean"``
+                          every ``|e_i|`` stays within ``tol max_k |e_i|``
+========================  ================================================  ==========
+
+(sums over the chosen states ``i``). Closed loop ``A = F + G K`` (per
+scenario, ``over="max"``):
+
+* :class:`SpectralRadius` - ``max |eig(A)|``;
+* :class:`PoleRegion` - ``max_z lambda_max(L + M z + M' conj(z))`` over the
+  poles ``z`` and the regions' characteristic matrices (Chilali & Gahinet
+  1996): ``<= 0`` with every pole inside; for a :class:`robustctl.Disk` it is
+  ``max |z - c| - r``, the distance of the farthest pole beyond the circle;
+* :class:`H2Norm` - ``||T_zw||_2 = sqrt(trace(C_K P C_K'))`` of
+  ``x+ = A x + Bw w``, ``z = C_K x``, ``C_K = Cz + Dzu K``, with the
+  controllability Gramian ``P = A P A' + Bw Bw'`` (squared Smith iteration,
+  Smith 1968: ``P <- P + A_j P A_j'``, ``A_j <- A_j^2``);
+* :class:`HinfNorm` - ``||C_K (zI - A)^-1 Bw||_inf``, as ``1 / margin`` of
+  :func:`robustctl.robust_stability` with ``NormBounded(Bw, Cz, Dzu)`` (the
+  small-gain value: one norm implementation in the project).
+
+Robustness: :class:`RobustMargin` - the certified margin of
+:func:`robustctl.robust_stability` against a :class:`robustctl.NormBounded`
+uncertainty about a nominal plant, ``1 / ||E (zI - A)^-1 H||_inf`` with
+``A = F + G K``, ``E = EF + EG K``; ``at_least(RobustMargin(unc), 1.0)`` is
+"certified for every ``||Delta|| <= 1``".
+
+References
+----------
+P. Apkarian, D. Noll, "Nonsmooth H-infinity synthesis", IEEE TAC 51(1), 2006,
+and MATLAB's ``systune`` / ``TuningGoal`` objects (goals as objects; soft goals
+and hard constraints over an array of plants).
+M. Chilali, P. Gahinet, "H-infinity design with pole placement constraints: an
+LMI approach", IEEE TAC 41(3), 1996.
+K. Zhou, J. C. Doyle, K. Glover, *Robust and Optimal Control*, Prentice Hall
+1996, Ch. 4 (H2 and H-infinity norms, Gramians).
+R. A. Smith, "Matrix equation XA + BX = C", SIAM J. Appl. Math. 16(1), 1968.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal, cast
+
+import numpy as np
+
+import robustctl as rc
+from robustctl.batchsim import BACKENDS, DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
+from robustctl.regions import Region, as_regions
+from robustctl.validation import as_float_array, as_matrix, check_choice, check_int, check_positive_scalar, check_real
+
+__all__ = ["Goal", "Response", "ErrorGoal", "PeakInput", "SettlingTime", "SpectralRadius", "PoleRegion",
+           "H2Norm", "HinfNorm", "RobustMargin", "Bound", "at_most", "at_least", "check_scenarios",
+           "OVER", "MEASURES"]
+
+#: Reductions over the scenarios a goal accepts as ``over``.
+OVER = ("mean", "max")
+#: Error measures of ``Response.error``.
+MEASURES = ("mse", "ise", "iae")
+# Squared Smith iteration: relative size of the last increment, and the most doublings
+# (A^(2^64) of a stable A is zero unless its spectral radius is within ~1e-17 of 1).
+_SMITH_RTOL = 1e-16
+_SMITH_MAX = 64
+
+
+# ---------------------------------------------------------------- shared checks
+def check_scenarios(plants, name: str = "plants") -> list[rc.Plant]:
+    """``plants`` as a list of discrete-time plants of one ``n``, ``m`` and ``dt``.
+
+    ``TypeError`` for anything but a non-empty sequence of :class:`robustctl.Plant`
+    (``ValueError`` for an empty one), ``ValueError`` naming ``name[i]`` for a
+    continuous plant, or a size or sampling time unlike ``name[0]``'s.
+    """
+    if isinstance(plants, rc.Plant) or not isinstance(plants, Sequence) or isinstance(plants, (str, bytes)):
+        raise TypeError(f"{name} must be a non-empty list of robustctl.Plant, got {type(plants).__name__}")
+    if len(plants) == 0:
+        raise ValueError(f"{name} must not be empty (give at least the nominal plant)")
+    first = plants[0]
+    for i, p in enumerate(plants):
+        if not isinstance(p, rc.Plant):
+            raise TypeError(f"{name}[{i}] must be a robustctl.Plant, got {type(p).__name__}")
+        if not p.is_discrete:
+            raise ValueError(f"{name}[{i}] must be discrete-time (dt > 0); discretise it first")
+        if (p.n, p.m) != (first.n, first.m):
+            raise ValueError(f"{name} must all have the same size: {name}[0] has n={first.n}, m={first.m}, "
+                             f"{name}[{i}] has n={p.n}, m={p.m}")
+        if p.dt != first.dt:
+            raise ValueError(f"{name} must all have the same sampling time: {name}[0] has dt={first.dt}, "
+                             f"{name}[{i}] has dt={p.dt}")
+    return list(plants)
+
+
+def _gains(K, plants: list[rc.Plant]) -> np.ndarray:
+    """``K`` as (B, m, n) finite float gains for the plants."""
+    Kb, _ = check_gains(K, plants[0].n)
+    if Kb.shape[1] != plants[0].m:
+        raise ValueError(f"K must have {plants[0].m} rows (the number of inputs of the plants), "
+                         f"got shape {np.shape(K)}")
+    return Kb
+
+
+def _stacks(plants: list[rc.Plant]) -> tuple[np.ndarray, np.ndarray]:
+    """``F`` (S, n, n) and ``G`` (S, n, m) of the scenarios."""
+    return np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
+
+
+def _closed_loops(K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+    """``A = F_s + G_s K_b`` of every design and scenario, shape (B, S, n, n)."""
+    F, G = _stacks(plants)
+    return F[None] + np.einsum("snm,bmk->bsnk", G, K)
+
+
+def _reduce(values: np.ndarray, over: str) -> np.ndarray:
+    """(B, S) -> (B,) by the mean or the max over the scenarios."""
+    return values.mean(axis=1) if over == "mean" else values.max(axis=1)
+
+
+def _indices(value, name: str, what: str) -> tuple[int, ...] | None:
+    """``None`` or a non-empty tuple of non-negative ints (``value`` may be one int)."""
+    if value is None:
+        return None
+    items = [value] if isinstance(value, (int, np.integer)) and not isinstance(value, bool) else value
+    if not isinstance(items, Sequence | np.ndarray) or isinstance(items, (str, bytes)) or len(items) == 0:
+        raise TypeError(f"{name} must be a {what} index or a non-empty list of them, got {value!r}")
+    return tuple(check_int(i, f"{name}[{j}]", minimum=0) for j, i in enumerate(items))
+
+
+def _check_range(idx: tuple[int, ...] | None, size: int, name: str, what: str) -> None:
+    if idx is not None and max(idx) >= size:
+        raise ValueError(f"{name} must be {what} indices in [0, {size}) for these plants, got {list(idx)}")
+
+
+def _matrix(value, name: str, vector: str) -> np.ndarray:
+    """A finite non-empty 2-D float array, read-only (a 1-D array is a ``vector``: "column" or "row")."""
+    arr = as_matrix(value, name, vector=vector)
+    arr.flags.writeable = False
+    return arr
+
+
+def _robust_margins(plant: rc.Plant, K: np.ndarray, unc: rc.NormBounded) -> np.ndarray:
+    """``robust_stability((plant, K), unc).margin`` of each gain of the stack ``K`` (B, m, n), shape (B,).
+
+    One batched call of :func:`robustctl.robust_stability` (margins only: the
+    certificates of a stack are computed on request). Unstable loops get 0,
+    a design the analysis cannot answer NaN (the tuning problem penalises it).
+    """
+    return np.array(rc.robust_stability((plant, K), unc).margin, dtype=float)
+
+
+# ---------------------------------------------------------------- base
+class Goal:
+    """Base of the goals of this module (see the module docstring for the protocol).
+
+    Subclasses define ``name``, ``check(plants)`` and ``measure(K, plants)``;
+    calling a goal returns its measure (the value to minimise).
+    """
+
+    name: str
+
+    def check(self, plants) -> None:  # pragma: no cover - every goal defines it
+        """``ValueError`` naming the argument that does not fit ``plants``."""
+        raise NotImplementedError
+
+    def measure(self, K, plants) -> np.ndarray:  # pragma: no cover
+        """The goal's quantity per design, shape (B,)."""
+        raise NotImplementedError
+
+    def __call__(self, K, plants) -> np.ndarray:
+        """The value to minimise for each design, shape (B,) (the measure)."""
+        return self.measure(K, plants)
+
+    def __repr__(self) -> str:
+        over = getattr(self, "over", None)
+        return f"{type(self).__name__}(name={self.name!r}" + (f", over={over!r})" if over else ")")
+
+
+def _set(obj, **values) -> None:
+    for k, v in values.items():
+        object.__setattr__(obj, k, v)
+
+
+# ---------------------------------------------------------------- time domain
+class Response:
+    """A closed-loop response shared by the time-domain goals made from it.
+
+    From ``x[0] = x0`` every design runs ``u[k] = sat(K (x[k] - r[k]))``,
+    ``x[k+1] = F x[k] + G u[k]`` for ``steps`` samples on every scenario in
+    one batched simulation (:class:`robustctl.batchsim.LinearSimulator`). The
+    goals of :meth:`error`, :meth:`peak_input` and :meth:`settling_time` read
+    that one simulation: it is kept for the last ``(K, plants)`` (same plants
+    objects, equal gains), so several goals of one population cost one run.
+
+    Parameters
+    ----------
+    x0 : (n,) or (S, n) array_like
+        Initial state, shared or one per scenario (a per-scenario ``x0`` or
+        ``reference`` ties the goals to lists of S plants: the Monte Carlo
+        selection, which evaluates goals on one plant at a time, needs shared ones).
+    steps : int
+        Number of samples ``T`` (``k = 0 .. T-1``; the horizon is ``T dt``).
+    reference : (T, n) or (S, T, n) array_like, optional
+        State reference ``r`` (tracking); default zero (regulation).
+    u_limit : float or (m,) array_like, optional
+        Saturation ``|u_j| <= u_limit_j``; default none.
+    backend : {"numba", "numpy"}
+        The compiled kernel or the numpy reference (:mod:`robustctl.batchsim`).
+    bound : float
+        Divergence bound on ``|x - r|`` (a run beyond it is frozen there; see
+        :mod:`robustctl.batchsim`), so a saturated loop that drifts away gets
+        a large finite error.
+    """
+
+    def __init__(self, x0, steps: int, reference=None, u_limit=None,
+                 backend: Literal["numba", "numpy"] = "numba", *, bound: float = DEFAULT_BOUND):
+        x = as_float_array(x0, "x0")
+        if x.ndim not in (1, 2) or x.size == 0 or not np.all(np.isfinite(x)):
+            raise ValueError(f"x0 must be a finite (n,) or (S, n) array, got shape {x.shape}")
+        self.x0 = x
+        self.steps = check_int(steps, "steps")
+        if reference is None:
+            self.reference = None
+        else:
+            r = as_float_array(reference, "reference")
+            if r.ndim not in (2, 3) or not np.all(np.isfinite(r)):
+                raise ValueError(f"reference must be a finite (T, n) or (S, T, n) array, got shape {r.shape}")
+            if r.shape[-2] != self.steps:
+                raise ValueError(f"reference must have steps={self.steps} samples along axis {r.ndim - 2}, "
+                                 f"got shape {r.shape}")
+            self.reference = r
+        if u_limit is None:
+            self.u_limit = None
+        else:
+            lim = as_float_array(u_limit, "u_limit")
+            if lim.ndim > 1 or lim.size == 0 or not np.all(np.isfinite(lim)) or np.any(lim <= 0):
+                raise ValueError(f"u_limit must be a positive number or a (m,) array of them, got {u_limit!r}")
+            self.u_limit = lim
+        self.backend = cast(Literal["numba", "numpy"], check_choice(backend, "backend", BACKENDS))
+        self.bound = check_positive_scalar(bound, "bound", allow_inf=True)
+        self._sim: tuple[tuple[rc.Plant, ...], LinearSimulator] | None = None
+        self._last: tuple[tuple[rc.Plant, ...], np.ndarray, SimulationResult] | None = None
+        self._keep = False      # a goal made from this response reads trajectories (not only sums)
+
+    def _register(self, trajectories: bool) -> None:
+        """A goal made from this response: keep trajectories in every run if it reads them."""
+        self._keep = self._keep or trajectories
+
+    # -- checks and simulation ----------------------------------------------------------
+    def check(self, plants) -> None:
+        """``ValueError`` naming ``x0``, ``reference`` or ``u_limit`` if it does not fit ``plants``."""
+        plants = check_scenarios(plants)
+        S, n, m = len(plants), plants[0].n, plants[0].m
+        if self.x0.shape[-1] != n or (self.x0.ndim == 2 and self.x0.shape[0] != S):
+            raise ValueError(f"x0 must have shape ({n},) or ({S}, {n}) (states; scenarios, states) for "
+                             f"these plants, got shape {self.x0.shape}")
+        r = self.reference
+        if r is not None and (r.shape[-1] != n or (r.ndim == 3 and r.shape[0] != S)):
+            raise ValueError(f"reference must have shape ({self.steps}, {n}) or ({S}, {self.steps}, {n}) "
+                             f"for these plants, got shape {r.shape}")
+        if self.u_limit is not None and self.u_limit.size not in (1, m):
+            raise ValueError(f"u_limit must be a number or have {m} entries (the plants' inputs), "
+                             f"got shape {self.u_limit.shape}")
+
+    def simulator(self, plants) -> LinearSimulator:
+        """The simulator of ``plants`` (built once per list of plant objects)."""
+        key = tuple(check_scenarios(plants))
+        if self._sim is not None and len(self._sim[0]) == len(key) \
+                and all(a is b for a, b in zip(self._sim[0], key, strict=True)):
+            return self._sim[1]
+        self.check(key)
+        n = key[0].n
+        F, G = _stacks(list(key))
+        ref = np.zeros((self.steps, n)) if self.reference is None else self.reference
+        r0 = ref[..., 0, :]
+        sim = LinearSimulator(F, G, ref, x0=self.x0 - r0, u_limit=self.u_limit, bound=self.bound, dt=key[0].dt)
+        self._sim = (key, sim)
+        return sim
+
+    def simulate(self, K, plants, *, trajectories: bool = True) -> SimulationResult:
+        """The batched run of the gains ``K`` (B, m, n) on ``plants`` (kept for the next call with the same ones).
+
+        ``trajectories=False`` keeps only the squared-error sums (enough for MSE and
+        ISE) unless a goal made from this response reads trajectories (so the
+        goals of one population share one run).
+        """
+        trajectories = trajectories or self._keep
+        sim = self.simulator(plants)
+        key = self._sim[0] if self._sim is not None else ()
+        Kb = _gains(K, list(key))
+        last = self._last
+        if last is not None and last[0] is key and last[1].shape == Kb.shape and np.array_equal(last[1], Kb) \
+                and (last[2].errors is not None or not trajectories):
+            return last[2]
+        res = sim.run(Kb, keep_trajectories=trajectories, backend=self.backend)
+        self._last = (key, Kb, res)
+        return res
+
+    # -- goals -------------------------------------------------------------------------
+    def error(self, states=None, measure: str = "mse", *, weights=None, over: str = "mean",
+              name: str | None = None) -> ErrorGoal:
+        """The error goal (MSE, ISE or IAE of ``x - r`` summed over ``states``); see :class:`ErrorGoal`."""
+        return ErrorGoal(self, states, measure, weights=weights, over=over, name=name)
+
+    def peak_input(self, inputs=None, *, over: str = "max", name: str | None = None) -> PeakInput:
+        """The largest applied ``|u_j|`` (``inputs``: default all); see :class:`PeakInput`."""
+        return PeakInput(self, inputs, over=over, name=name)
+
+    def settling_time(self, states=None, tol: float = 0.02, *, over: str = "mean",
+                      name: str | None = None) -> SettlingTime:
+        """The settling time of ``states`` into ``tol`` of their peak; see :class:`SettlingTime`."""
+        return SettlingTime(self, states, tol, over=over, name=name)
+
+    def __repr__(self) -> str:
+        return (f"Response(x0 shape {self.x0.shape}, steps={self.steps}, "
+                f"reference={'none' if self.reference is None else self.reference.shape}, "
+                f"u_limit={None if self.u_limit is None else self.u_limit.tolist()})")
+
+
+def _state_names(idx: tuple[int, ...] | None) -> str:
+    return "x" if idx is None else ",".join(f"x{i}" for i in idx)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class ErrorGoal(Goal):
+    """Error of chosen states along a :class:`Response`: MSE, ISE or IAE, summed over the states.
+
+    Per design and scenario, with ``e = x - r`` and weights ``w`` (default 1):
+    ``mse = sum_i w_i (1/T) sum_k e_i[k]^2``, ``ise = sum_i w_i dt sum_k e_i[k]^2``,
+    ``iae = sum_i w_i dt sum_k |e_i[k]|``; then the mean (default) or the max
+    over the scenarios. A run that diverges (a saturated loop drifting away)
+    is held at the divergence bound, hence a large finite error.
+
+    Parameters
+    ----------
+    response : Response
+    states : int or sequence of int, optional
+        State indices (default all).
+    measure : {"mse", "ise", "iae"}
+    weights : (len(states),) array_like, optional
+        Non-negative weights of the states (e.g. to mix units).
+    over : {"mean", "max"}
+    name : str, optional
+    """
+
+    response: Response
+    states: Any = None
+    measure_name: str = "mse"
+    weights: Any = None
+    over: str = "mean"
+    name: str = ""
+
+    def __init__(self, response: Response, states=None, measure: str = "mse", *, weights=None,
+                 over: str = "mean", name: str | None = None):
+        if not isinstance(response, Response):
+            raise TypeError(f"response must be a moo.tuning Response, got {type(response).__name__}")
+        idx = _indices(states, "states", "state")
+        measure = check_choice(measure, "measure", MEASURES)
+        w = None
+        if weights is not None:
+            w = as_float_array(weights, "weights")
+            size = "the chosen states" if idx is None else len(idx)
+            if w.ndim != 1 or (idx is not None and w.size != len(idx)) or not np.all(np.isfinite(w)) \
+                    or np.any(w < 0):
+                raise ValueError(f"weights must be {size} finite non-negative numbers, got {weights!r}")
+        response._register(measure == "iae")
+        _set(self, response=response, states=idx, measure_name=measure, weights=w,
+             over=check_choice(over, "over", OVER),
+             name=name if name is not None else f"{measure}({_state_names(idx)})")
+
+    def check(self, plants) -> None:
+        """``ValueError`` if ``states``, ``weights`` or the response's arguments do not fit ``plants``."""
+        self.response.check(plants)
+        n = plants[0].n
+        _check_range(self.states, n, "states", "state")
+        if self.states is None and self.weights is not None and self.weights.size != n:
+            raise ValueError(f"weights must have {n} entries (one per state), got {self.weights.size}")
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The error of each design, shape (B,)."""
+        self.check(plants)
+        res = self.response.simulate(K, plants, trajectories=self.measure_name == "iae")
+        idx = list(range(plants[0].n)) if self.states is None else list(self.states)
+        dt = plants[0].dt
+        if self.measure_name == "iae":
+            assert res.errors is not None
+            per_state = np.abs(res.errors[..., idx]).sum(axis=2) * dt
+        else:
+            per_state = res.sq_error_sum[..., idx] * (1.0 / res.T if self.measure_name == "mse" else dt)
+        w = np.ones(len(idx)) if self.weights is None else self.weights
+        return _reduce(per_state @ w, self.over)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class PeakInput(Goal):
+    """The largest applied (saturated) input ``max_k max_j |u_j[k]|`` along a :class:`Response`.
+
+    Parameters
+    ----------
+    response : Response
+    inputs : int or sequence of int, optional
+        Input indices (default all).
+    over : {"mean", "max"}
+        Default ``"max"``: the worst scenario (an actuator limit).
+    name : str, optional
+    """
+
+    response: Response
+    inputs: Any = None
+    over: str = "max"
+    name: str = ""
+
+    def __init__(self, response: Response, inputs=None, *, over: str = "max", name: str | None = None):
+        if not isinstance(response, Response):
+            raise TypeError(f"response must be a moo.tuning Response, got {type(response).__name__}")
+        idx = _indices(inputs, "inputs", "input")
+        label = "u" if idx is None else ",".join(f"u{i}" for i in idx)
+        response._register(True)
+        _set(self, response=response, inputs=idx, over=check_choice(over, "over", OVER),
+             name=name if name is not None else f"peak |{label}|")
+
+    def check(self, plants) -> None:
+        """``ValueError`` if ``inputs`` or the response's arguments do not fit ``plants``."""
+        self.response.check(plants)
+        _check_range(self.inputs, plants[0].m, "inputs", "input")
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The peak input of each design, shape (B,)."""
+        self.check(plants)
+        res = self.response.simulate(K, plants)
+        assert res.inputs is not None
+        u = res.inputs if self.inputs is None else res.inputs[..., list(self.inputs)]
+        return _reduce(np.abs(u).max(axis=(2, 3)), self.over)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class SettlingTime(Goal):
+    """Settling time of chosen states along a :class:`Response`.
+
+    For each state ``i`` the band is ``tol`` times the state's peak error
+    ``max_k |e_i[k]|`` on that run; the settling time is ``dt k*``, ``k*`` the
+    first sample from which every chosen ``|e_i[k]|`` stays within its band
+    (0 if it never leaves it; the horizon ``T dt`` if it is still outside at
+    the last sample, and for a diverged run). Then the mean (default) or the
+    max over the scenarios.
+
+    Parameters
+    ----------
+    response : Response
+    states : int or sequence of int, optional
+        State indices (default all).
+    tol : float
+        Relative band, in (0, 1).
+    over : {"mean", "max"}
+    name : str, optional
+    """
+
+    response: Response
+    states: Any = None
+    tol: float = 0.02
+    over: str = "mean"
+    name: str = ""
+
+    def __init__(self, response: Response, states=None, tol: float = 0.02, *, over: str = "mean",
+                 name: str | None = None):
+        if not isinstance(response, Response):
+            raise TypeError(f"response must be a moo.tuning Response, got {type(response).__name__}")
+        idx = _indices(states, "states", "state")
+        tol = check_positive_scalar(tol, "tol")
+        if tol >= 1:
+            raise ValueError(f"tol must be in (0, 1) (a fraction of the peak error), got {tol}")
+        response._register(True)
+        _set(self, response=response, states=idx, tol=tol, over=check_choice(over, "over", OVER),
+             name=name if name is not None else f"settling time({_state_names(idx)})")
+
+    def check(self, plants) -> None:
+        """``ValueError`` if ``states`` or the response's arguments do not fit ``plants``."""
+        self.response.check(plants)
+        _check_range(self.states, plants[0].n, "states", "state")
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The settling time of each design in seconds, shape (B,)."""
+        self.check(plants)
+        res = self.response.simulate(K, plants)
+        assert res.errors is not None
+        e = np.abs(res.errors if self.states is None else res.errors[..., list(self.states)])   # (B, S, T, q)
+        outside = (e > self.tol * e.max(axis=2, keepdims=True)).any(axis=3)                     # (B, S, T)
+        T = outside.shape[2]
+        last = T - 1 - np.argmax(outside[..., ::-1], axis=2)                                    # last sample outside
+        k_star = np.where(outside.any(axis=2), last + 1, 0)
+        k_star = np.where(res.diverged, T, k_star)
+        return _reduce(k_star * plants[0].dt, self.over)
+
+
+# ---------------------------------------------------------------- closed loop
+@dataclass(frozen=True, eq=False, repr=False)
+class SpectralRadius(Goal):
+    """Spectral radius ``max |eig(F + G K)|`` of the closed loop, the max (default) or mean over the scenarios."""
+
+    over: str = "max"
+    name: str = "spectral radius"
+
+    def __post_init__(self):
+        check_choice(self.over, "over", OVER)
+
+    def check(self, plants) -> None:
+        """Only the plants themselves are checked."""
+        check_scenarios(plants)
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The spectral radius of each design, shape (B,)."""
+        plants = check_scenarios(plants)
+        A = _closed_loops(_gains(K, plants), plants)
+        return _reduce(np.asarray(rc.spectral_radius(A)), self.over)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class PoleRegion(Goal):
+    """Largest violation of a pole region: ``<= 0`` with every closed-loop pole inside.
+
+    ``max`` over the poles ``z`` of ``F + G K`` and over the regions of the
+    largest eigenvalue of the region's characteristic function
+    ``L + M z + M' conj(z)`` (Chilali & Gahinet 1996; negative inside the
+    region). For ``Disk(c, r)`` it is ``max |z - c| - r``; for a half-plane
+    ``Re z < b``, ``2 (max Re z - b)``.
+
+    Parameters
+    ----------
+    region : Region or sequence of Region
+        :class:`robustctl.Disk`, :class:`robustctl.HalfPlane`,
+        :class:`robustctl.ConicSector`, or a list (their intersection), in the
+        ``z`` plane of the discrete plants.
+    over : {"mean", "max"}
+    name : str, optional
+    """
+
+    region: Any
+    over: str = "max"
+    name: str = ""
+
+    def __post_init__(self):
+        try:
+            regions = as_regions(self.region)
+        except TypeError:
+            regions = ()
+        if not regions:
+            raise TypeError(f"region must be a robustctl Disk, HalfPlane, ConicSector or a non-empty list of "
+                            f"them, got {type(self.region).__name__}")
+        _set(self, region=regions, over=check_choice(self.over, "over", OVER),
+             name=self.name or "pole region")
+
+    def check(self, plants) -> None:
+        """Only the plants themselves are checked."""
+        check_scenarios(plants)
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The largest violation of each design, shape (B,)."""
+        plants = check_scenarios(plants)
+        z = np.linalg.eigvals(_closed_loops(_gains(K, plants), plants))        # (B, S, n)
+        worst = np.full(z.shape[:2], -np.inf)
+        for reg in self.region:
+            assert isinstance(reg, Region)
+            L, M = reg.L, reg.M
+            f = L + M * z[..., None, None] + M.T * np.conj(z)[..., None, None]   # Hermitian (B, S, n, k, k)
+            worst = np.maximum(worst, np.linalg.eigvalsh(f)[..., -1].max(axis=2))
+        return _reduce(worst, self.over)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class _Channel(Goal):
+    """A performance channel ``x+ = A x + Bw w``, ``z = (Cz + Dzu K) x`` of the closed loop."""
+
+    Bw: Any
+    Cz: Any
+    Dzu: Any = None
+    over: str = "max"
+    name: str = ""
+
+    def __post_init__(self):
+        Bw, Cz = _matrix(self.Bw, "Bw", "column"), _matrix(self.Cz, "Cz", "row")
+        Dzu = None if self.Dzu is None else _matrix(self.Dzu, "Dzu", "row")
+        if Dzu is not None and Dzu.shape[0] != Cz.shape[0]:
+            raise ValueError(f"Dzu must have {Cz.shape[0]} rows (the rows of Cz), got shape {Dzu.shape}")
+        _set(self, Bw=Bw, Cz=Cz, Dzu=Dzu, over=check_choice(self.over, "over", OVER),
+             name=self.name or self._default_name)
+
+    _default_name = ""
+
+    def check(self, plants) -> None:
+        """``ValueError`` naming ``Bw``, ``Cz`` or ``Dzu`` if its size does not fit ``plants``."""
+        plants = check_scenarios(plants)
+        n, m = plants[0].n, plants[0].m
+        if self.Bw.shape[0] != n:
+            raise ValueError(f"Bw must have {n} rows (the number of states of the plants), got shape {self.Bw.shape}")
+        if self.Cz.shape[1] != n:
+            raise ValueError(f"Cz must have {n} columns (the number of states of the plants), "
+                             f"got shape {self.Cz.shape}")
+        if self.Dzu is not None and self.Dzu.shape[1] != m:
+            raise ValueError(f"Dzu must have {m} columns (the number of inputs of the plants), "
+                             f"got shape {self.Dzu.shape}")
+
+    def _output(self, K: np.ndarray) -> np.ndarray:
+        """``C_K = Cz + Dzu K``, shape (B, l, n)."""
+        C = np.broadcast_to(self.Cz, (K.shape[0], *self.Cz.shape))
+        return C if self.Dzu is None else C + self.Dzu @ K
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class H2Norm(_Channel):
+    """H2 norm of the channel ``w -> z = Cz x + Dzu u`` of the closed loop ``x+ = (F + G K) x + Bw w``.
+
+    ``||T_zw||_2^2 = trace(C_K P C_K')``, ``C_K = Cz + Dzu K``, ``P`` the
+    controllability Gramian ``P = A P A' + Bw Bw'`` (batched squared Smith
+    iteration; module docstring); with white ``w`` of unit intensity it is the
+    steady-state variance of ``z``. The max (default) or mean over the scenarios.
+
+    Parameters
+    ----------
+    Bw : (n, q) array_like (1-D: one column)
+    Cz : (l, n) array_like (1-D: one row)
+    Dzu : (l, m) array_like, optional
+    over : {"mean", "max"}
+    name : str, optional
+    """
+
+    _default_name = "H2 norm"
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The H2 norm of each design, shape (B,)."""
+        self.check(plants)
+        plants = list(plants)
+        Kb = _gains(K, plants)
+        A = _closed_loops(Kb, plants)                                     # (B, S, n, n)
+        P = np.broadcast_to(self.Bw @ self.Bw.T, A.shape).copy()
+        Aj = A.copy()
+        done = np.zeros(A.shape[:2], dtype=bool)
+        for _ in range(_SMITH_MAX):
+            inc = Aj @ P @ np.swapaxes(Aj, -1, -2)
+            P += inc
+            done = np.abs(inc).max(axis=(-2, -1)) <= _SMITH_RTOL * np.abs(P).max(axis=(-2, -1))
+            if done.all():
+                break
+            Aj = Aj @ Aj
+        C = self._output(Kb)[:, None]                                     # (B, 1, l, n)
+        h2sq = np.einsum("bsln,bsnk,bslk->bs", C, P, np.broadcast_to(C, (*A.shape[:2], *C.shape[2:])))
+        value = np.sqrt(np.maximum(h2sq, 0.0))
+        value[~done | ~np.isfinite(value)] = np.inf
+        return _reduce(value, self.over)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class HinfNorm(_Channel):
+    """H-infinity norm of the channel ``w -> z = Cz x + Dzu u`` of ``x+ = (F + G K) x + Bw w``.
+
+    ``||(Cz + Dzu K)(zI - F - G K)^-1 Bw||_inf = 1 / margin`` of
+    ``robustctl.robust_stability((plant, K), NormBounded(Bw, Cz, Dzu))`` (the
+    small-gain value; 0 where the channel is zero), per scenario; the max
+    (default) or mean over the scenarios.
+
+    Parameters
+    ----------
+    Bw : (n, q) array_like (1-D: one column)
+    Cz : (l, n) array_like (1-D: one row)
+    Dzu : (l, m) array_like, optional
+    over : {"mean", "max"}
+    name : str, optional
+    """
+
+    _default_name = "Hinf norm"
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The H-infinity norm of each design, shape (B,)."""
+        self.check(plants)
+        plants = list(plants)
+        Kb = _gains(K, plants)
+        Dzu = np.zeros((self.Cz.shape[0], plants[0].m)) if self.Dzu is None else self.Dzu
+        unc = rc.NormBounded(self.Bw, self.Cz, Dzu)
+        with np.errstate(divide="ignore"):
+            norms = np.stack([1.0 / _robust_margins(p, Kb, unc) for p in plants], axis=1)   # (B, S)
+        return _reduce(norms, self.over)
+
+
+# ---------------------------------------------------------------- robustness
+@dataclass(frozen=True, eq=False, repr=False)
+class RobustMargin(Goal):
+    """The certified robust-stability margin against a norm-bounded uncertainty (a quantity to maximise).
+
+    ``margin = 1 / ||(EF + EG K)(zI - F - G K)^-1 H||_inf`` of
+    :func:`robustctl.robust_stability` ``((nominal, K), uncertainty)``: the
+    loop is quadratically stable for every ``||Delta|| <= margin``
+    (``inf`` if the uncertainty does not reach the loop). :meth:`measure`
+    returns the margin, to which bounds refer
+    (``at_least(RobustMargin(unc), 1.0)``: certified); as an objective the
+    goal is minimised as ``1 / margin`` (the small-gain norm; 0 for an
+    unreachable loop).
+
+    Parameters
+    ----------
+    uncertainty : robustctl.NormBounded
+        E.g. :meth:`robustctl.NormBounded.from_plants` of the scenarios.
+    nominal : robustctl.Plant, optional
+        The plant the uncertainty is about (default: the first scenario).
+    name : str, optional
+    """
+
+    uncertainty: rc.NormBounded
+    nominal: rc.Plant | None = None
+    name: str = "1/robust margin"
+
+    def __post_init__(self):
+        if not isinstance(self.uncertainty, rc.NormBounded):
+            raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(self.uncertainty).__name__}")
+        if self.nominal is not None and not isinstance(self.nominal, rc.Plant):
+            raise TypeError(f"nominal must be a robustctl.Plant or None, got {type(self.nominal).__name__}")
+
+    def _plant(self, plants) -> rc.Plant:
+        plants = check_scenarios(plants)
+        nominal = plants[0] if self.nominal is None else self.nominal
+        try:
+            self.uncertainty.check_plant(nominal)
+        except ValueError as exc:
+            raise ValueError(f"uncertainty does not fit the plants: {exc}") from None
+        if (nominal.n, nominal.m, nominal.dt) != (plants[0].n, plants[0].m, plants[0].dt):
+            raise ValueError(f"nominal must have n={plants[0].n}, m={plants[0].m}, dt={plants[0].dt} like the "
+                             f"plants, got n={nominal.n}, m={nominal.m}, dt={nominal.dt}")
+        return nominal
+
+    def check(self, plants) -> None:
+        """``ValueError`` if the uncertainty or the nominal plant does not fit ``plants``."""
+        self._plant(plants)
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The margin of each design, shape (B,) (to maximise)."""
+        nominal = self._plant(plants)
+        return _robust_margins(nominal, _gains(K, list(plants)), self.uncertainty)
+
+    def __call__(self, K, plants) -> np.ndarray:
+        """``1 / margin`` of each design (to minimise)."""
+        with np.errstate(divide="ignore"):
+            return 1.0 / self.measure(K, plants)
+
+    def __repr__(self) -> str:
+        return f"RobustMargin({self.uncertainty!r}, name={self.name!r})"
+
+
+# ---------------------------------------------------------------- constraints
+@dataclass(frozen=True, eq=False, repr=False)
+class Bound:
+    """A constraint from a goal and a bound, ``<= 0`` where it holds (:func:`at_most`, :func:`at_least`).
+
+    The bound refers to the goal's :meth:`~Goal.measure` (for a user callable,
+    its value): ``at_most``: ``measure - bound``; ``at_least``: ``bound - measure``.
+    """
+
+    goal: Callable[..., Any]
+    bound: float
+    kind: str
+    name: str = field(default="")
+
+    def check(self, plants) -> None:
+        """The goal's own check, if it has one."""
+        check = getattr(self.goal, "check", None)
+        if callable(check):
+            check(plants)
+
+    def __call__(self, K, plants) -> np.ndarray:
+        """The constraint value of each design, shape (B,); ``<= 0`` where it holds."""
+        measure = self.goal.measure if isinstance(self.goal, Goal) else self.goal
+        value = np.asarray(measure(K, plants), dtype=float)
+        return value - self.bound if self.kind == "at_most" else self.bound - value
+
+    def __repr__(self) -> str:
+        return f"{self.kind}({self.goal!r}, {self.bound:g})"
+
+
+def _goal_name(goal) -> str:
+    return str(getattr(goal, "name", None) or getattr(goal, "__name__", None) or type(goal).__name__)
+
+
+def _bound(goal, bound, kind: str, op: str, name: str | None) -> Bound:
+    if not callable(goal):
+        raise TypeError(f"goal must be a goal or a callable f(K, plants) -> (B,), got {type(goal).__name__}")
+    b = check_real(bound, "bound")
+    label = _goal_name(goal)
+    if isinstance(goal, RobustMargin):
+        label = "robust margin"
+    return Bound(goal, b, kind, name if name is not None else f"{label} {op} {b:g}")
+
+
+def at_most(goal, bound: float, *, name: str | None = None) -> Bound:
+    """The constraint ``goal <= bound`` (value ``measure - bound``, ``<= 0`` where it holds).
+
+    ``goal`` is one of this module's goals (its :meth:`~Goal.measure`) or any
+    callable ``f(K, plants) -> (B,)``.
+
+    Examples
+    --------
+    >>> at_most(SpectralRadius(), 0.95)
+    at_most(SpectralRadius(name='spectral radius', over='max'), 0.95)
+    """
+    return _bound(goal, bound, "at_most", "<=", name)
+
+
+def at_least(goal, bound: float, *, name: str | None = None) -> Bound:
+    """The constraint ``goal >= bound`` (value ``bound - measure``, ``<= 0`` where it holds).
+
+    ``at_least(RobustMargin(unc), 1.0)`` holds for the designs certified
+    robustly stable for every ``||Delta|| <= 1``.
+    """
+    return _bound(goal, bound, "at_least", ">=", name)
