@@ -19,8 +19,9 @@ code", Technometrics 21(2), 239-245, 1979.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -34,11 +35,11 @@ SAMPLING_METHODS = ("grid", "lhs")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
-class PlantSamples:
+class PlantSamples(Sequence[Plant]):
     """The plants of :func:`sample_plants` and the parameters behind each (a sequence of plants).
 
-    Iterating, indexing and ``len`` act on the plants, so ``list(samples)`` is
-    the scenario list.
+    A :class:`~collections.abc.Sequence` of the plants (iterating, indexing and
+    ``len`` act on them), so it is a scenario list as it is.
 
     Attributes
     ----------
@@ -57,7 +58,12 @@ class PlantSamples:
     def __len__(self) -> int:
         return len(self.plants)
 
-    def __getitem__(self, i: int) -> Plant:
+    @overload
+    def __getitem__(self, i: int) -> Plant: ...
+    @overload
+    def __getitem__(self, i: slice) -> tuple[Plant, ...]: ...
+
+    def __getitem__(self, i: int | slice) -> Plant | tuple[Plant, ...]:
         return self.plants[i]
 
     def __iter__(self) -> Iterator[Plant]:
