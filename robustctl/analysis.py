@@ -1325,7 +1325,7 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     smallest ``P`` is the stabilising solution of a bounded-real Riccati
     equation and the bound is convex in ``lam``, so a golden-section search
     over ``log lam`` with batched Riccati solves gives every design's bound
-    (:func:`_guaranteed_cost_batch`); designs that are unstable, not
+    (``_guaranteed_cost_batch``); designs that are unstable, not
     robustly stable or not finite are flagged (``reason``) instead of
     raising.
 
