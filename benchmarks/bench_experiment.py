@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_experiment.py [--quick] [--evals 10000] [--runs 50] [--workers 2]
+    python -m benchmarks.bench_experiment [--quick] [--evals 10000] [--runs 50] [--workers 2]
                                           [--problems generic,applied] [--algorithms all] [--out FILE]
 
 Measured in one process, on the same (shared, 2-core) machine; BLAS should
@@ -61,20 +61,18 @@ import time
 from pathlib import Path
 
 import numpy as np
+from pymoo.algorithms.moo.nsga2 import NSGA2
+from pymoo.optimize import minimize
+from pymoo.problems import get_problem
+
+from moo.algorithms import ALGORITHMS
+from moo.experiment import run_seeds
+from moo.problems.applied import AppliedRLQRProblem, PathFollowingErrors
+from moo.problems.generic import RegulationErrors
+from moo.runner import run
+from moo.tuning import RLQRFamily
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))                                   # run from a checkout without install
-
-from pymoo.algorithms.moo.nsga2 import NSGA2  # noqa: E402
-from pymoo.optimize import minimize  # noqa: E402
-from pymoo.problems import get_problem  # noqa: E402
-
-from moo.algorithms import ALGORITHMS  # noqa: E402
-from moo.experiment import run_seeds  # noqa: E402
-from moo.problems.applied import AppliedRLQRProblem, PathFollowingErrors  # noqa: E402
-from moo.problems.generic import RegulationErrors  # noqa: E402
-from moo.runner import run  # noqa: E402
-from moo.tuning import RLQRFamily  # noqa: E402
 
 QUICK_ALGORITHMS = ("nsga2", "maoea-ddfc")
 POP = 92

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_moeas.py [--algorithms a,b,...] [--seeds 10] [--evals 10000]
+    python -m benchmarks.bench_moeas [--algorithms a,b,...] [--seeds 10] [--evals 10000]
                                      [--dtlz1-evals 60000] [--out benchmarks/results/moeas.md]
 
 Each algorithm of :data:`moo.algorithms.ALGORITHMS` (or those named) runs,

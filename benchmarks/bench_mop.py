@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_mop.py [--pop 92] [--elementwise 16] [--evals 10000] [--seed 1]
+    python -m benchmarks.bench_mop [--pop 92] [--elementwise 16] [--evals 10000] [--seed 1]
                                    [--repeats 2] [--skip-runs] [--out benchmarks/results/mop.md]
 
 Measured in one run, on the same machine (timings on a shared machine are noisy):
@@ -50,9 +50,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # run from a checkout without install
-
 from pymoo.core.problem import ElementwiseProblem, Problem
 from pymoo.optimize import minimize
 

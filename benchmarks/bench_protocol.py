@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_protocol.py [--parts protocol,dense,paper,wfg] [--algorithms a,b,...] [--wfg-evals 25000]
+    python -m benchmarks.bench_protocol [--parts protocol,dense,paper,wfg] [--algorithms a,b,...] [--wfg-evals 25000]
                                         [--problems dtlz1,...] [--objectives 3,5,8] [--runs 20]
                                         [--processes 2] [--out benchmarks/results/protocol.md]
 

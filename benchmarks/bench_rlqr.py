@@ -25,7 +25,7 @@ reference in the same process, best of ``--repeat`` interleaved:
   1-2 designs) and all in one call;
 * the ``ill`` truck designs above, ``max_iter=2000``.
 
-    python benchmarks/bench_rlqr.py [--repeat 5]
+    python -m benchmarks.bench_rlqr [--repeat 5]
 """
 
 from __future__ import annotations
