@@ -225,6 +225,19 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
         No backend finds the stabilising solution of the Riccati equation,
         e.g. ``(Q^1/2, F)`` has an unobservable mode on the unit circle (an
         integrator whose state ``Q`` does not weight); the message says why.
+
+    Examples
+    --------
+    A double integrator sampled at 0.1 s; python-control returns ``-K``:
+
+    >>> import numpy as np, control, robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> ctrl = rc.lqr(plant, Q=np.diag([1.0, 0.1]), R=[[0.01]])
+    >>> ctrl.K.round(4)
+    array([[-7.613 , -4.5849]])
+    >>> K_pc, _, _ = control.dlqr(plant.F, plant.G, np.diag([1.0, 0.1]), [[0.01]])
+    >>> bool(np.allclose(ctrl.K, -K_pc)), ctrl.is_stabilizing()
+    (True, True)
     """
     check_plant(plant, discrete_for="lqr")
     Q, R = _weights(plant, Q, R)

@@ -381,6 +381,22 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     NotStabilizingError
         (a ``ConvergenceError``) The steady state was reached but ``F + G K``
         is not Schur stable, with ``check_stability`` True (the default).
+
+    Examples
+    --------
+    With no uncertainty (``EF = 0``, ``EG = 0``) the RLQR is the LQR
+    (python-control returns ``-K``); with an uncertain input gain it
+    certifies robust stability for every ``||Delta|| <= 1``:
+
+    >>> import numpy as np, control, robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> nominal = rc.rlqr(plant, [[0.0, 0.0]], [[0.0]], 1e10)
+    >>> bool(np.allclose(nominal.K, -control.dlqr(plant.F, plant.G, np.eye(2), np.eye(1))[0], rtol=1e-6))
+    True
+    >>> H, EF, EG = [[0.0], [0.1]], [[0.0, 0.0]], [[0.3]]         # G + H Delta EG: input gain 1 +- 30 %
+    >>> robust = rc.rlqr(plant, EF, EG, 1e4, H=H)
+    >>> rc.robust_stability(robust, rc.NormBounded(H, EF, EG)).certified
+    True
     """
     d = build(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, uncertainty=uncertainty, batch=False)
     implementation = check_choice(implementation, "implementation", _IMPLEMENTATIONS)
