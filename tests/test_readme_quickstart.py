@@ -11,7 +11,7 @@ README = Path(__file__).resolve().parents[1] / "README.md"
 def test_readme_tuning_quick_start_runs_and_certifies():
     text = README.read_text()
     section = text[text.index("## Tuning a controller"):text.index("## Reproducing the paper")]
-    code = re.search(r"```python\n(.*?)```", section, flags=re.S).group(1)
+    code = re.search(r"```python\n(.*?)```", section, flags=re.DOTALL).group(1)
     assert len(code.splitlines()) <= 25                # the limit for the quick start
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
