@@ -156,24 +156,17 @@ class AppliedRLQRProblem(TuningProblem):
     max_iter : int
         Steps of the plain recursion :func:`robustctl.rlqr_gains` may take for
         a design that neither the doubling nor the Newton refinement settles;
-        a design not converged by then counts as not computable. Default 500.
-        With ``fallback="newton"`` only designs with ``E_G1 / E_G2`` within
-        about 1e-5 of 1 (a nearly singular split of the doubled column, a
-        region SPEA2+SDE's runs crowd into) reach the recursion at all:
-        uniformly random designs (3000) and ratios ``1 +- 2e-3`` (1500) need
-        at most 26 steps; of 4500 designs with ratios ``1 +- 1e-5`` and the
-        552 of six SPEA2+SDE generations, caps of 500 and 2000 give identical
-        objectives (300: one design of the 4500 differs), and each step of the
-        recursion costs about 60 us per call whatever the number of designs,
-        so the cap bounds the cost of a population (one SPEA2+SDE run of
-        10000 evaluations: 15.2 s with a cap of 2000, 5.6 s with 500, on the
-        loaded 2-core machine).
+        a design not converged by then counts as not computable. Default 500:
+        with ``fallback="newton"`` only nearly singular splits of the doubled
+        column (``E_G1 / E_G2`` within about 1e-5 of 1) reach the recursion,
+        and larger caps change no objective there while each step costs the
+        same whatever the population (the measurements are in the
+        documentation's Validation pages).
     fallback : {"newton", "recursion"}
         How :func:`robustctl.rlqr_gains` treats the designs the doubling
         leaves unsettled (those ill-conditioned ``E_G1 ~ E_G2`` splits): Newton
-        refinement of the doubling result (default; within 4e-11 of a 1e-13
-        reference recursion, and on ill-conditioned designs about 12x cheaper
-        than the plain recursion: 24 against 294 us per design in
+        refinement of the doubling result (default; closer to the fixed point
+        and cheaper than the plain recursion on ill-conditioned designs,
         ``benchmarks/bench_rlqr.py``), or the plain recursion.
     path : ReferencePath, optional
         Reference path (default :func:`robustctl.path.default_route`, 540 s).

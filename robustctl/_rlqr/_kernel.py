@@ -30,11 +30,9 @@ Same arithmetic, same rules:
 
 Compilation: ``cache=True``, ``nogil=True`` (``robustctl._simkernel._jit``),
 two entry points (``_recursion``, whose single step is ``max_iter = 1``, and
-``_doubling``), each compiled once: about 6 s and 5 s on a fresh clone
-(2-core machine at load 1.5-3.5; slice assignments cost twice that to
-compile and are written as loops), then
-0.03-0.06 s to load from the cache in each new process once numba is loaded
-(the simulation kernel loads it too).
+``_doubling``), each compiled once on a fresh clone (slice assignments cost
+twice as much to compile and are written as loops), then loaded from the
+cache in each new process (``benchmarks/bench_experiment.py`` measures both).
 """
 
 from __future__ import annotations
