@@ -111,28 +111,6 @@ def _refine(F, G, Q, R, P) -> tuple[np.ndarray, float]:
     return P, res
 
 
-def check_stabilizable_balanced(plant: Plant) -> None:
-    """:func:`robustctl.stability.check_stabilizable` on ``(D^-1 F D, D^-1 G)``, ``D`` balancing ``F``.
-
-    Stabilisability is invariant under a change of state coordinates, but the
-    PBH rank test's tolerance is relative to ``||[F G]||``: a plant in badly
-    chosen units (states scaled 1e-8..1e8, so ``||F||`` is huge while its
-    eigenvalues are not) would be refused although its modes are all
-    controllable. Balancing ``F`` (LAPACK ``gebal``, powers of two, so exact;
-    Parlett & Reinsch, *Numer. Math.* 13, 1969) undoes such a scaling before
-    the test; a plant that is already balanced is tested as given.
-    """
-    F, G = plant.F, plant.G
-    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(G))):
-        check_stabilizable(plant)
-        return
-    _, (scale, _) = scipy.linalg.matrix_balance(F, permute=False, separate=True)
-    if np.all(scale == 1.0):
-        check_stabilizable(plant)
-        return
-    check_stabilizable(Plant(F / scale[:, None] * scale[None, :], G / scale[:, None], plant.dt), "plant")
-
-
 def _unobservable_on_circle(F, Q) -> np.ndarray:
     """Eigenvalues of ``F`` on the unit circle that ``Q^1/2`` does not see (PBH test on ``(F', Q^1/2)``)."""
     w, V = np.linalg.eigh(Q)
@@ -218,8 +196,8 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     Raises
     ------
     NotStabilizableError
-        ``(F, G)`` is not stabilisable (PBH test, :mod:`robustctl.stability`,
-        on the plant with ``F`` balanced, ``check_stabilizable_balanced``);
+        ``(F, G)`` is not stabilisable (PBH test on the plant with ``F``
+        balanced, :mod:`robustctl.stability`);
         ``rlqr``, ``hinf`` and ``h2`` raise the same (it is also an ``InfeasibleError``).
     ConvergenceError
         No backend finds the stabilising solution of the Riccati equation,
@@ -241,7 +219,7 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     """
     check_plant(plant, discrete_for="lqr")
     Q, R = _weights(plant, Q, R)
-    check_stabilizable_balanced(plant)
+    check_stabilizable(plant)
     P, backend = _dare(plant.F, plant.G, Q, R)
     K = _gain(plant.F, plant.G, R, P)
     return Controller(K, "lqr", plant, {"P": P, "backend": backend,

@@ -34,6 +34,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+import scipy.linalg
 
 from ._validation import as_float_array, as_matrix, check_square
 from .errors import NotStabilizableError
@@ -139,9 +140,22 @@ def is_stable(A, *, discrete: bool, margin: float = STABILITY_MARGIN) -> bool:
 
 
 def _pair(F, G) -> tuple[np.ndarray, np.ndarray, float]:
-    """``(F, G, max(1, ||[F G]||_2))`` after checking their shapes."""
+    """``(D^-1 F D, D^-1 G, max(1, ||[D^-1 F D  D^-1 G]||_2))`` after checking their shapes, ``D`` balancing ``F``.
+
+    Eigenvalues and the PBH rank are invariant under a change of state
+    coordinates, but the test's tolerances are relative to ``||[F G]||``: a
+    plant in badly chosen units (states scaled 1e-8..1e8, so ``||F||`` is huge
+    while its eigenvalues are not) would be refused although its modes are all
+    controllable. Balancing ``F`` (LAPACK ``gebal``, powers of two, so exact;
+    Parlett & Reinsch, *Numer. Math.* 13, 1969) undoes such a scaling first; a
+    balanced plant is tested as given.
+    """
     F = check_square(as_matrix(F, "F"), "F")
     G = as_matrix(G, "G", rows=F.shape[0], vector="column", rows_what="the number of states, from F")
+    if np.all(np.isfinite(F)) and np.all(np.isfinite(G)):
+        _, (d, _) = scipy.linalg.matrix_balance(F, permute=False, separate=True)
+        if not np.all(d == 1.0):
+            F, G = F / d[:, None] * d[None, :], G / d[:, None]
     return F, G, max(1.0, float(np.linalg.norm(np.hstack([F, G]), 2)))
 
 

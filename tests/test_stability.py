@@ -192,3 +192,21 @@ def test_certificate_agrees_with_eigenvalues_on_hard_stacks():
     np.testing.assert_array_equal(rc.is_schur_stable(A), want)
     assert want[:1000].all() and not want[1000:2000].any() and want[2000]
     np.testing.assert_array_equal(rc.is_schur_stable(A, margin=0.01), _rho(A) < 0.99)
+
+
+def test_pbh_test_is_invariant_to_badly_scaled_state_units():
+    """Stabilisability does not depend on units: the PBH test runs on F balanced (one place, for every design)."""
+    rng = np.random.default_rng(7)
+    F = rng.normal(size=(4, 4)) * 0.6 + 0.9 * np.eye(4)            # unstable modes, all controllable
+    G = rng.normal(size=(4, 1))
+    F[3, :3], G[3] = 0.0, 0.0
+    F[3, 3] = 1.5                                                   # ... but the last: unstable, uncontrollable
+    T = np.diag(10.0 ** np.array([-8.0, -3.0, 4.0, 8.0]))          # states in absurd units
+    Ts, Gs = np.linalg.solve(T, F @ T), np.linalg.solve(T, G)
+    stuck = rc.Plant(Ts, Gs, 0.1).unstabilizable_modes
+    np.testing.assert_allclose(stuck, [1.5], rtol=1e-9)             # the true unstabilisable mode, and only it
+    T3 = T[:3, :3]
+    ok = rc.Plant(np.linalg.solve(T3, F[:3, :3] @ T3), np.linalg.solve(T3, G[:3]), 0.1)
+    assert ok.is_stabilizable                                       # refused before F was balanced
+    K = rc.lqr(ok, Q=T3.T @ T3).K                                   # the unit-free LQR, in these units
+    assert rc.is_schur_stable(ok.F + ok.G @ K)
