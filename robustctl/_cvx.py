@@ -8,11 +8,13 @@ the package calls ``Problem.solve``.
 
 Conventions
 -----------
-* An LMI ``M >= 0`` is always imposed on the explicitly symmetrised block
-  ``(M + M') / 2`` minus ``margin * I``. (cvxpy's ``M >> 0`` only constrains
-  the symmetric part of ``M``; writing it out makes the intention visible and
-  keeps a non-symmetric block from passing silently: the asymmetry is
-  checked after the solve.)
+* An LMI ``M >= 0`` is imposed as ``M - margin * I >> 0``: cvxpy's PSD
+  constraint constrains the symmetric part ``(M + M') / 2`` (and passes the
+  solver its lower triangle), so the blocks, symmetric by construction, are
+  not symmetrised again (that doubled the expression tree that cvxpy
+  canonicalises: a third of its compilation time). A block that is not
+  symmetric does not pass silently: the asymmetry is checked after the
+  solve, with the certificate.
 * A status of ``optimal`` is accepted; ``optimal_inaccurate`` is accepted
   only if the certificate holds, and is recorded; ``infeasible`` (also
   ``infeasible_inaccurate``) raises :class:`~robustctl.errors.InfeasibleError`
@@ -39,12 +41,15 @@ __all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "value", "totals", 
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
-# computation, and the problems are small.
+# computation, and the problems are small. One thread for its sparse LDL
+# (faer; by default one per core): the designs are run side by side in
+# processes (moo's runner), and on the shared cores the second thread
+# costs more CPU time than it saves.
 SOLVER_TOL = 1e-10
 _CLARABEL = dict(tol_gap_abs=SOLVER_TOL, tol_gap_rel=SOLVER_TOL, tol_feas=SOLVER_TOL,
                  tol_infeas_abs=1e-10, tol_infeas_rel=1e-10, tol_ktratio=1e-8,
                  reduced_tol_gap_abs=1e-7, reduced_tol_gap_rel=1e-7, reduced_tol_feas=1e-7,
-                 max_iter=200)
+                 max_iter=200, max_threads=1)
 # Certificate: an LMI block counts as satisfied if its smallest eigenvalue is
 # at least -_CERT_TOL * max(1, largest |entry|) (solver rounding).
 _CERT_TOL = 1e-7
@@ -163,7 +168,7 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
     ----------
     objective : cvxpy.Minimize or cvxpy.Maximize
     lmis : sequence of LMI
-        Each block is imposed as ``(M + M')/2 - margin I >> 0``.
+        Each block is imposed as ``M - margin I >> 0`` (cvxpy: the symmetric part of ``M``).
     constraints : sequence of cvxpy constraints
         Anything else (equalities, scalar bounds).
     solver : str
@@ -190,7 +195,7 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
     cons = list(constraints)
     for lmi in lmis:
         M = lmi.M
-        cons.append(0.5 * (M + M.T) - lmi.margin * np.eye(M.shape[0]) >> 0)
+        cons.append(M - lmi.margin * np.eye(M.shape[0]) >> 0)
     prob = cp.Problem(objective, cons)
     # A solver failure ("insufficient progress" at tight tolerances on nearly
     # degenerate problems) is retried twice with 100x looser tolerances, after
