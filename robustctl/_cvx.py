@@ -41,15 +41,15 @@ __all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "value", "totals", 
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
-# computation, and the problems are small. One thread for its sparse LDL
-# (faer; by default one per core): the designs are run side by side in
-# processes (moo's runner), and on the shared cores the second thread
-# costs more CPU time than it saves.
+# computation, and the problems are small. The other settings are
+# Clarabel's defaults (chordal decomposition, equilibration, faer's LDL on
+# its default threads): switching them measured no better on the
+# H-infinity level minimisation (benchmarks/results/hinf.md).
 SOLVER_TOL = 1e-10
 _CLARABEL = dict(tol_gap_abs=SOLVER_TOL, tol_gap_rel=SOLVER_TOL, tol_feas=SOLVER_TOL,
                  tol_infeas_abs=1e-10, tol_infeas_rel=1e-10, tol_ktratio=1e-8,
                  reduced_tol_gap_abs=1e-7, reduced_tol_gap_rel=1e-7, reduced_tol_feas=1e-7,
-                 max_iter=200, max_threads=1)
+                 max_iter=200)
 # Certificate: an LMI block counts as satisfied if its smallest eigenvalue is
 # at least -_CERT_TOL * max(1, largest |entry|) (solver rounding).
 _CERT_TOL = 1e-7
