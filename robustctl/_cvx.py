@@ -133,11 +133,12 @@ def _evaluate(lmis: Sequence[LMI], who: str) -> tuple[dict[str, float], dict[str
     return cert, scales
 
 
-def _settings(solver: str, tol: float, refine: bool = True) -> dict:
+def _settings(solver: str, tol: float, refine: bool = True, decompose: bool = True) -> dict:
     if solver != "CLARABEL":
         return {}
     out = dict(_CLARABEL)
-    out.update(tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol, iterative_refinement_enable=refine)
+    out.update(tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol, iterative_refinement_enable=refine,
+               chordal_decomposition_enable=decompose)
     return out
 
 
@@ -161,7 +162,7 @@ def check_solver(solver) -> str:
 
 def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, solver: str = "CLARABEL",
               tol: float = SOLVER_TOL, infeasible_msg: str = "the LMI problem is infeasible",
-              fast: bool = False) -> SolveReport:
+              fast: bool = False, decompose: bool = True) -> SolveReport:
     """Solve ``objective`` subject to the LMI blocks and the other constraints.
 
     Parameters
@@ -184,6 +185,12 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
         if its status is ``optimal``. Suits problems whose solution is
         checked again (e.g. a level minimisation whose gain is certified
         separately); margins of centring problems come out smaller.
+    decompose : bool
+        Clarabel only: its chordal decomposition of the PSD blocks (the
+        default). A block whose sparsity leaves one clique of nearly its own
+        size (the discrete H-infinity block: ``2 n`` of ``2 n + p``) gains
+        nothing from it but overlap variables that couple the cliques in the
+        KKT system; ``False`` factors the block whole.
 
     Returns
     -------
@@ -209,7 +216,7 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
             with warnings.catch_warnings():
                 # cvxpy warns on 'optimal_inaccurate'; the status is checked below instead.
                 warnings.simplefilter("ignore", UserWarning)
-                prob.solve(solver=solver, **_settings(solver, attempt_tol, refine))
+                prob.solve(solver=solver, **_settings(solver, attempt_tol, refine, decompose))
         except cp.error.SolverError as exc:
             failure = f"{solver} failed ({exc})"
         except BaseException as exc:  # a Rust panic inside Clarabel surfaces as pyo3's PanicException

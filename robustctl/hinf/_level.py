@@ -90,7 +90,7 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
                          blocks(problem, data, V, level_sq, z_scale=z_scale),
                          solver=problem.solver, tol=tol.LEVEL_TOL if preconditioned else tol.LEVEL_TOL_GENERAL,
                          infeasible_msg=f"no H-infinity state feedback: {problem.infeasibility()}",
-                         fast=preconditioned)
+                         fast=preconditioned, decompose=not preconditioned)
     return Solved(V.values(), float(_cvx.value(level_sq)), rep)
 
 
