@@ -47,8 +47,8 @@ import json  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
-from pathlib import Path  # noqa: E402
 import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import control  # noqa: E402
 import numpy as np  # noqa: E402
@@ -200,8 +200,7 @@ def before_after(before: str, sizes, rounds: int, reps: int) -> None:
             b.append(sdp_cpu(before, n, 0, reps))
             a.append(sdp_cpu(here, n, 0, reps))
         tb, ta = np.median([r["cpu"] for r in b]), np.median([r["cpu"] for r in a])
-        spread = f"{min(r['cpu'] for r in b):.3f}-{max(r['cpu'] for r in b):.3f}/" \
-                 f"{min(r['cpu'] for r in a):.3f}-{max(r['cpu'] for r in a):.3f}"
+        spread = "/".join(f"{min(r['cpu'] for r in x):.3f}-{max(r['cpu'] for r in x):.3f}" for x in (b, a))
         print(f"{n:4d} {tb:11.4f} {ta:10.4f} {tb / ta:12.2f} {spread:>24} "
               f"{a[0]['gamma_opt'] / b[0]['gamma_opt'] - 1:18.1e} {b[0]['iterations']:>7}/{a[0]['iterations']:<7}")
 

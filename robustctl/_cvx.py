@@ -202,7 +202,7 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
     cons = list(constraints)
     for lmi in lmis:
         M = lmi.M
-        cons.append(M - lmi.margin * np.eye(M.shape[0]) >> 0)
+        cons.append(cp.PSD(M - lmi.margin * np.eye(M.shape[0])))
     prob = cp.Problem(objective, cons)
     # A solver failure ("insufficient progress" at tight tolerances on nearly
     # degenerate problems) is retried twice with 100x looser tolerances, after
