@@ -42,9 +42,10 @@ __all__ = ["LMI", "SolveReport", "solve_sdp", "certificate", "value", "totals", 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
 # computation, and the problems are small. The other settings are
-# Clarabel's defaults (chordal decomposition, equilibration, faer's LDL on
-# its default threads): switching them measured no better on the
-# H-infinity level minimisation (benchmarks/results/hinf.md).
+# Clarabel's defaults (equilibration, faer's LDL on its default threads,
+# chordal decomposition unless the caller asks for whole blocks with
+# ``decompose=False``): other values measured no better on the H-infinity
+# level minimisation (benchmarks/results/hinf.md).
 SOLVER_TOL = 1e-10
 _CLARABEL = dict(tol_gap_abs=SOLVER_TOL, tol_gap_rel=SOLVER_TOL, tol_feas=SOLVER_TOL,
                  tol_infeas_abs=1e-10, tol_infeas_rel=1e-10, tol_ktratio=1e-8,
