@@ -26,7 +26,13 @@ scaled by hand (:func:`units`: the synthesis scales them inside, so both are
 the same problem for the solver). Robust against polytopic H-infinity on the
 truck is in ``bench_analysis.py``.
 
+``--before ROOT`` times only the SDP path (the whole ``hinf`` call, CPU time of the process) of the
+checkout at ROOT (e.g. the main branch) against this one, each in a fresh subprocess that imports
+``robustctl`` from its own tree, alternating the two for ``--rounds`` rounds and taking medians (on a
+shared machine the load changes between runs; interleaving spreads it over both).
+
 Usage: python -m benchmarks.bench_hinf [--sizes 4 10 20 50] [--reps 3] [--seeds 5] [--sdp-max-n 50]
+       python -m benchmarks.bench_hinf --before /work/main [--sizes 4 10 20] [--rounds 5] [--reps 3]
 """
 
 from __future__ import annotations
@@ -37,8 +43,12 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
+import json  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import control  # noqa: E402
 import numpy as np  # noqa: E402
@@ -141,13 +151,73 @@ def cl_norm(plant, K, Bw, Cz, Dzu) -> float:
     return float(control.linfnorm(sys, tol=1e-10)[0])
 
 
+# The SDP path of one checkout, timed in a subprocess (``robustctl`` imported from ROOT via PYTHONPATH):
+# the plants of ``case`` rebuilt from the same seeds; prints the median CPU time per call and gamma_opt.
+_TIMER = """
+import json, sys, time
+import numpy as np
+from robustctl import Plant
+from robustctl.hinf import hinf
+n, seed, reps = (int(a) for a in sys.argv[1:4])
+def case(n, seed):
+    rng = np.random.default_rng(seed)
+    m, q, p = 2, 2, 4
+    F = rng.normal(size=(n, n))
+    F *= 1.05 / np.max(np.abs(np.linalg.eigvals(F)))
+    G, Bw = rng.normal(size=(n, m)), rng.normal(size=(n, q))
+    Cz = np.vstack([rng.normal(size=(p - m, n)), np.zeros((m, n))])
+    Dzu = np.vstack([np.zeros((p - m, m)), np.eye(m)])
+    return Plant(F, G, 0.1), Bw, Cz, Dzu
+w = case(3, 0)
+hinf(w[0], Bw=w[1], Cz=w[2], Dzu=w[3])
+plant, Bw, Cz, Dzu = case(n, seed)
+cpu = []
+for _ in range(reps):
+    t0 = time.process_time()
+    ctrl = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
+    cpu.append(time.process_time() - t0)
+print(json.dumps({"cpu": float(np.median(cpu)), "gamma_opt": ctrl.gamma_opt, "iterations": ctrl.info["iterations"]}))
+"""
+
+
+def sdp_cpu(root: str, n: int, seed: int, reps: int) -> dict:
+    """The median CPU time of ``reps`` SDP-path calls of the checkout at ``root`` (a fresh subprocess)."""
+    env = dict(os.environ, PYTHONPATH=str(Path(root).resolve()))
+    out = subprocess.run([sys.executable, "-c", _TIMER, str(n), str(seed), str(reps)], env=env, cwd=root,
+                         capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def before_after(before: str, sizes, rounds: int, reps: int) -> None:
+    """The SDP path of ``before`` against this checkout, alternating in fresh subprocesses; medians over rounds."""
+    here = str(Path(__file__).resolve().parents[1])
+    print(f"SDP path (whole hinf call, CPU time per call, median of {reps} per round, median over {rounds} "
+          f"alternating rounds): before = {before}, after = {here}")
+    print(f"{'n':>4} {'before [s]':>11} {'after [s]':>10} {'before/after':>12} {'rounds b/a':>24} "
+          f"{'gamma_opt rel diff':>18} {'iterations b/a':>15}")
+    for n in sizes:
+        b, a = [], []
+        for _ in range(rounds):
+            b.append(sdp_cpu(before, n, 0, reps))
+            a.append(sdp_cpu(here, n, 0, reps))
+        tb, ta = np.median([r["cpu"] for r in b]), np.median([r["cpu"] for r in a])
+        spread = "/".join(f"{min(r['cpu'] for r in x):.3f}-{max(r['cpu'] for r in x):.3f}" for x in (b, a))
+        print(f"{n:4d} {tb:11.4f} {ta:10.4f} {tb / ta:12.2f} {spread:>24} "
+              f"{a[0]['gamma_opt'] / b[0]['gamma_opt'] - 1:18.1e} {b[0]['iterations']:>7}/{a[0]['iterations']:<7}")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=int, nargs="+", default=[4, 10, 20, 50])
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--seeds", type=int, default=5, help="random plants per size (one for n > 10)")
     ap.add_argument("--sdp-max-n", type=int, default=50, help="largest n for the SDP path (about 90 s at n = 50)")
+    ap.add_argument("--before", help="another checkout: time its SDP path against this one's (only that)")
+    ap.add_argument("--rounds", type=int, default=5, help="alternating rounds for --before")
     args = ap.parse_args(argv)
+    if args.before:
+        before_after(args.before, args.sizes, args.rounds, args.reps)
+        return
 
     warm = case(3)
     for synthesis in ("lmi", "riccati"):  # import cvxpy, fill caches

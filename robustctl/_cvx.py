@@ -8,11 +8,13 @@ the package calls ``Problem.solve``.
 
 Conventions
 -----------
-* An LMI ``M >= 0`` is always imposed on the explicitly symmetrised block
-  ``(M + M') / 2`` minus ``margin * I``. (cvxpy's ``M >> 0`` only constrains
-  the symmetric part of ``M``; writing it out makes the intention visible and
-  keeps a non-symmetric block from passing silently: the asymmetry is
-  checked after the solve.)
+* An LMI ``M >= 0`` is imposed as ``M - margin * I >> 0``: cvxpy's PSD
+  constraint constrains the symmetric part ``(M + M') / 2`` (and passes the
+  solver its lower triangle), so the blocks, symmetric by construction, are
+  not symmetrised again (that doubled the expression tree that cvxpy
+  canonicalises: a third of its compilation time). A block that is not
+  symmetric does not pass silently: the asymmetry is checked after the
+  solve, with the certificate.
 * A status of ``optimal`` is accepted; ``optimal_inaccurate`` is accepted
   only if the certificate holds, and is recorded; ``infeasible`` (also
   ``infeasible_inaccurate``) raises :class:`~robustctl.errors.InfeasibleError`
@@ -39,7 +41,11 @@ __all__ = ["LMI", "SolveReport", "solve_sdp", "check_solver", "certificate", "va
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
-# computation, and the problems are small.
+# computation, and the problems are small. The other settings are
+# Clarabel's defaults (equilibration, faer's LDL on its default threads,
+# chordal decomposition unless the caller asks for whole blocks with
+# ``decompose=False``): other values measured no better on the H-infinity
+# level minimisation (benchmarks/results/hinf.md).
 SOLVER_TOL = 1e-10
 _CLARABEL = dict(tol_gap_abs=SOLVER_TOL, tol_gap_rel=SOLVER_TOL, tol_feas=SOLVER_TOL,
                  tol_infeas_abs=1e-10, tol_infeas_rel=1e-10, tol_ktratio=1e-8,
@@ -128,11 +134,12 @@ def _evaluate(lmis: Sequence[LMI], who: str) -> tuple[dict[str, float], dict[str
     return cert, scales
 
 
-def _settings(solver: str, tol: float, refine: bool = True) -> dict:
+def _settings(solver: str, tol: float, refine: bool = True, decompose: bool = True) -> dict:
     if solver != "CLARABEL":
         return {}
     out = dict(_CLARABEL)
-    out.update(tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol, iterative_refinement_enable=refine)
+    out.update(tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol, iterative_refinement_enable=refine,
+               chordal_decomposition_enable=decompose)
     return out
 
 
@@ -156,14 +163,14 @@ def check_solver(solver) -> str:
 
 def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, solver: str = "CLARABEL",
               tol: float = SOLVER_TOL, infeasible_msg: str = "the LMI problem is infeasible",
-              fast: bool = False) -> SolveReport:
+              fast: bool = False, decompose: bool = True) -> SolveReport:
     """Solve ``objective`` subject to the LMI blocks and the other constraints.
 
     Parameters
     ----------
     objective : cvxpy.Minimize or cvxpy.Maximize
     lmis : sequence of LMI
-        Each block is imposed as ``(M + M')/2 - margin I >> 0``.
+        Each block is imposed as ``M - margin I >> 0`` (cvxpy: the symmetric part of ``M``).
     constraints : sequence of cvxpy constraints
         Anything else (equalities, scalar bounds).
     solver : str
@@ -179,6 +186,12 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
         if its status is ``optimal``. Suits problems whose solution is
         checked again (e.g. a level minimisation whose gain is certified
         separately); margins of centring problems come out smaller.
+    decompose : bool
+        Clarabel only: its chordal decomposition of the PSD blocks (the
+        default). A block whose sparsity leaves one clique of nearly its own
+        size (the discrete H-infinity block: ``2 n`` of ``2 n + p``) gains
+        nothing from it but overlap variables that couple the cliques in the
+        KKT system; ``False`` factors the block whole.
 
     Returns
     -------
@@ -190,7 +203,7 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
     cons = list(constraints)
     for lmi in lmis:
         M = lmi.M
-        cons.append(0.5 * (M + M.T) - lmi.margin * np.eye(M.shape[0]) >> 0)
+        cons.append(cp.PSD(M - lmi.margin * np.eye(M.shape[0])))
     prob = cp.Problem(objective, cons)
     # A solver failure ("insufficient progress" at tight tolerances on nearly
     # degenerate problems) is retried twice with 100x looser tolerances, after
@@ -204,7 +217,7 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
             with warnings.catch_warnings():
                 # cvxpy warns on 'optimal_inaccurate'; the status is checked below instead.
                 warnings.simplefilter("ignore", UserWarning)
-                prob.solve(solver=solver, **_settings(solver, attempt_tol, refine))
+                prob.solve(solver=solver, **_settings(solver, attempt_tol, refine, decompose))
         except cp.error.SolverError as exc:
             failure = f"{solver} failed ({exc})"
         except BaseException as exc:  # a Rust panic inside Clarabel surfaces as pyo3's PanicException

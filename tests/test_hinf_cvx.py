@@ -46,6 +46,37 @@ def test_fast_attempt_agrees_with_the_refined_solve():
     assert values[1] == pytest.approx(exact, rel=1e-7)
 
 
+@pytest.mark.parametrize("decompose", [True, False])
+def test_whole_block_factorisation_gives_the_same_optimum(monkeypatch, decompose):
+    """decompose=False (no chordal decomposition in Clarabel) reaches the solver and the exact optimum.
+
+    ``[[X - I, A X, 0], [X A', X, 0], [0, 0, t - 1]] >= 0`` (cliques ``2 n`` and 1) and ``X <= t I``: the
+    Schur complement is ``X - I - A X A' >= 0``, so the smallest ``t`` is ``lambda_max`` of the
+    solution of ``X = A X A' + I`` (it exceeds 1).
+    """
+    import scipy.linalg
+
+    rng = np.random.default_rng(4)
+    A = rng.normal(size=(5, 5))
+    A *= 0.9 / np.max(np.abs(np.linalg.eigvals(A)))
+    seen = []
+    real = cp.Problem.solve
+
+    def spy(self, *args, **kwargs):
+        seen.append(kwargs.get("chordal_decomposition_enable"))
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(cp.Problem, "solve", spy)
+    X, t = cp.Variable((5, 5), symmetric=True), cp.Variable()
+    Z = np.zeros((5, 1))
+    block = cp.bmat([[X - np.eye(5), A @ X, Z], [X @ A.T, X, Z], [Z.T, Z.T, cp.reshape(t - 1.0, (1, 1), order="F")]])
+    rep = _cvx.solve_sdp(cp.Minimize(t), [_cvx.LMI("schur", block), _cvx.LMI("upper", t * np.eye(5) - X)],
+                         tol=1e-9, decompose=decompose)
+    exact = np.linalg.eigvalsh(scipy.linalg.solve_discrete_lyapunov(A, np.eye(5))).max()
+    assert exact > 1.0 and rep.value == pytest.approx(exact, rel=1e-7)
+    assert seen and set(seen) == {decompose}
+
+
 def test_infeasible_lmi_raises_with_the_callers_message():
     X = cp.Variable((2, 2), symmetric=True)
     with pytest.raises(InfeasibleError, match="no X for the test"):

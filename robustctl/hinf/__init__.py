@@ -125,15 +125,30 @@ lists them; every tolerance is named in ``robustctl.hinf._tolerances``):
   ``backoff=0``). ``info["synthesis"]`` names the path.
 * Certificates at a candidate point (arrays) are evaluated with numpy
   (``np.block``), without building cvxpy expressions.
+* The level minimisation of one plant asks Clarabel to factor the
+  H-infinity block whole (no chordal decomposition): its cliques are
+  ``2 n`` and ``n + p`` of ``2 n + p`` rows, so the decomposition saves
+  almost nothing in the dense front and its overlap variables couple the
+  cliques in the KKT system (fewer iterations and a cheaper factorisation
+  per iteration on the benchmark plants). Polytopes keep the decomposition.
 
-Formulations tried for the level minimisation and not kept: eliminating
-``Y`` (elimination lemma, Gahinet & Apkarian 1994) leaves
-``N'(Phi(X) - Abar X Abar')N >= 0`` and ``X >= Bw Bw'`` (blocks
-``n + p - m`` and ``n`` instead of ``2 n + p``), but every entry of the first
-block depends on every entry of ``X``; Clarabel's KKT then has a dense front
-of about ``n^2`` rows and the solve was no faster at n = 20 and several times
-slower at n = 30 than the full LMI, whose chordal cliques (``2 n`` and
-``n + p``) keep the coefficient map sparse.
+Where the time goes: nearly all of it is Clarabel's interior-point
+iterations on the dense ``(2 n + p)(2 n + p + 1) / 2`` front of the KKT
+system (cvxpy's compilation and Clarabel's setup are a small part from
+n = 20 on); there is no second solve in the default path of one discrete
+plant. Formulations tried for the level minimisation and not kept, all
+exact: eliminating ``Y`` (elimination lemma, Gahinet & Apkarian 1994)
+leaves ``N'(Phi(X) - Abar X Abar')N >= 0`` and ``X >= Bw Bw'`` (blocks
+``n + p - m`` and ``n`` instead of ``2 n + p``); the Schur complement with
+respect to the middle ``X`` block with ``Z >= Y X^-1 Y'`` lifted as
+``[[Z, Y], [Y', X]] >= 0`` (blocks ``n + p`` and ``n + m``); either in the
+modal or real Schur coordinates of ``F``, or with a dense congruence of the
+second block. Every entry of the smaller blocks depends on every entry of
+``X``; with that dense coefficient map Clarabel's sparse LDL (faer) was
+slower per iteration than on the full LMI, whose coefficient map stays
+sparse. Coordinates in which the solver's own optimal ``X`` is ``I`` save a
+few iterations only, and scaling the level, Clarabel's step length,
+regularisation, equilibration and presolve settings did not help.
 
 References
 ----------

@@ -4,8 +4,9 @@ The LMIs are non-strict here: the minimum is the infimum over strictly
 feasible points. :func:`minimise_level` tries, in order:
 
 1. the preferred coordinates (the LQR ones of a single plant, at
-   ``LEVEL_TOL`` with a first attempt without iterative refinement;
-   otherwise the balanced ones at ``LEVEL_TOL_GENERAL``);
+   ``LEVEL_TOL`` with a first attempt without iterative refinement and
+   without Clarabel's chordal decomposition; otherwise the balanced ones
+   at ``LEVEL_TOL_GENERAL``);
 2. if that solver fails (``ConvergenceError``) in the LQR coordinates: the
    balanced ones;
 3. if the extended (slack-variable) problem still fails: the standard one
@@ -90,7 +91,7 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
                          blocks(problem, data, V, level_sq, z_scale=z_scale),
                          solver=problem.solver, tol=tol.LEVEL_TOL if preconditioned else tol.LEVEL_TOL_GENERAL,
                          infeasible_msg=f"no H-infinity state feedback: {problem.infeasibility()}",
-                         fast=preconditioned)
+                         fast=preconditioned, decompose=not preconditioned)
     return Solved(V.values(), float(_cvx.value(level_sq)), rep)
 
 
