@@ -54,7 +54,7 @@ import control  # noqa: E402
 import numpy as np  # noqa: E402
 
 from robustctl import Plant  # noqa: E402
-from robustctl.hinf import hinf  # noqa: E402
+from robustctl._hinf import hinf  # noqa: E402
 
 
 # ---------------------------------------------------------------- the independent peer
@@ -157,7 +157,7 @@ _TIMER = """
 import json, sys, time
 import numpy as np
 from robustctl import Plant
-from robustctl.hinf import hinf
+from robustctl._hinf import hinf
 n, seed, reps = (int(a) for a in sys.argv[1:4])
 def case(n, seed):
     rng = np.random.default_rng(seed)

@@ -15,6 +15,7 @@ True
 Sign convention everywhere: ``u = K x``.
 """
 
+from ._hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from ._margins_report import MarginsReport, margins_report
 from ._rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule, rlqr_step, rlqr_step_block
 from .analysis import (
@@ -40,7 +41,6 @@ from .errors import (
     RobustCtlError,
 )
 from .h2 import H2Controller, h2
-from .hinf import HinfController, hinf  # cvxpy itself is imported on first use
 from .input_memory import InputMemoryFeedback
 from .lqr import lqr
 from .performance import lq_output

@@ -13,7 +13,7 @@ __all__ = ["design", "METHODS"]
 METHODS = {
     "lqr": "robustctl.lqr:lqr",
     "rlqr": "robustctl._rlqr:rlqr",
-    "hinf": "robustctl.hinf:hinf",
+    "hinf": "robustctl._hinf:hinf",
     "h2": "robustctl.h2:h2",
 }
 

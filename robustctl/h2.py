@@ -1,6 +1,6 @@
 r"""H2 state feedback by LMI optimisation (cvxpy + Clarabel), with optional pole regions.
 
-Plant and gain as in :mod:`robustctl.hinf` (``u = K x``)::
+Plant and gain as in :func:`robustctl.hinf` (``u = K x``)::
 
     x+ = F x + Bw w + G u         (discrete; x' = ... for dt = None)
     z  = Cz x + Dzw w + Dzu u
@@ -29,7 +29,7 @@ state at once, here ``x0 = Bw e_i``), value ``trace(Bw' P Bw)`` with ``P``
 the stabilising Riccati solution: the tests check the LMI optimum against
 scipy's DARE / CARE.
 
-Numerics: the data go through the coordinates of :mod:`robustctl.hinf`
+Numerics: the data go through the coordinates of :func:`robustctl.hinf`
 (``w`` and ``z`` scaled to unit size, since ``||T_zw||_2`` is homogeneous
 in both and the gain does not depend on them; balancing, ``||Bw|| = 1``,
 ``z`` compressed to a factor with the same Gram matrix, which is all the H2
@@ -52,13 +52,13 @@ import scipy.linalg
 from numpy.typing import ArrayLike
 
 from . import _cvx
+from ._hinf import _tolerances as tol
+from ._hinf._coordinates import Coordinates, channel_scales, normalised, recentred
+from ._hinf._lmis import Point, region_blocks, variables
+from ._hinf._problem import validate
+from ._hinf._synthesis import check_closed_loop
 from .controller import Controller
 from .errors import ConvergenceError, InfeasibleError
-from .hinf import _tolerances as tol
-from .hinf._coordinates import Coordinates, channel_scales, normalised, recentred
-from .hinf._lmis import Point, region_blocks, variables
-from .hinf._problem import validate
-from .hinf._synthesis import check_closed_loop
 from .plant import Plant
 from .regions import Region, describe_regions
 

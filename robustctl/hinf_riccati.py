@@ -1,7 +1,7 @@
 """Reference H-infinity state feedback by bisection on the game Riccati equation.
 
 This module is the *independent* reference that the LMI synthesis in
-:mod:`robustctl.hinf` is tested and benchmarked against. It shares no code
+:func:`robustctl.hinf` is tested and benchmarked against. It shares no code
 with it: no cvxpy, no LMI, only Riccati equations and eigenvalue problems.
 
 Plant (discrete time, ``dt > 0``; continuous time when ``dt is None``)::

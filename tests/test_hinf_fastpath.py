@@ -23,7 +23,7 @@ import pytest
 
 import robustctl as rc
 from robustctl import Plant
-from robustctl.hinf import _riccati_path
+from robustctl._hinf import _riccati_path
 from robustctl.uncertainty import NormBounded
 
 RTOL = 1e-5

@@ -1,4 +1,4 @@
-"""The stages of the LMI H-infinity synthesis (robustctl.hinf._*) one by one, and every fallback path.
+"""The stages of the LMI H-infinity synthesis (robustctl._hinf._*) one by one, and every fallback path.
 
 The references are independent of the LMI code: python-control's ``linfnorm``
 of the closed loop, the game-Riccati bisection ``robustctl.hinf_riccati``,
@@ -20,8 +20,8 @@ import scipy.linalg
 from test_hinf import MSD_BW, MSD_CZ, MSD_DZU, cl_norm, msd, random_case, worst_case_input
 
 from robustctl import ConvergenceError, InfeasibleError, Plant
-from robustctl.hinf import _coordinates, _gains, _level, _lmis, _problem, _synthesis, hinf
-from robustctl.hinf import _tolerances as tol
+from robustctl._hinf import _coordinates, _gains, _level, _lmis, _problem, _synthesis, hinf
+from robustctl._hinf import _tolerances as tol
 from robustctl.hinf_riccati import hinf_riccati
 
 RTOL = 1e-5

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from robustctl.hinf import hinf
+from robustctl._hinf import hinf
 from robustctl.models.truck import STEER_LIMIT, truck_plant
 
 OVERLOADS = (0.0, 100.0, 200.0, 300.0)

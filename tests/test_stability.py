@@ -143,7 +143,7 @@ def test_spectral_abscissa_matches_the_eigenvalues():
 def test_every_stability_decision_uses_the_one_margin(discrete):
     """A loop inside the margin (rho = 1 - 1e-12, or abscissa -1e-12) is unstable for the controller, the
     LMI syntheses' internal check, the robust analysis and the worst-case search alike."""
-    from robustctl.hinf._synthesis import check_closed_loop
+    from robustctl._hinf._synthesis import check_closed_loop
 
     edge = 1.0 if discrete else 0.0
     plant = rc.Plant([[edge + 1e-12]], [[1.0]], 1.0 if discrete else None)

@@ -76,8 +76,8 @@ the same ``X`` as the H-infinity bound.
 
 Numerics
 --------
-The synthesis is a sequence of pure stages (:mod:`robustctl.hinf._synthesis`
-lists them; every tolerance is named in ``robustctl.hinf._tolerances``):
+The synthesis is a sequence of pure stages (:mod:`robustctl._hinf._synthesis`
+lists them; every tolerance is named in ``robustctl._hinf._tolerances``):
 
 * Coordinates (:mod:`._coordinates`): ``w`` and ``z`` scaled to unit size
   first (``||Bw~|| = 1``, or unit energy when ``u_max`` is given, and

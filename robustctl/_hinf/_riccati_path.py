@@ -1,4 +1,4 @@
-"""The ``synthesis="riccati"`` fast path of :func:`robustctl.hinf` for the plain problem.
+"""The ``synthesis="riccati"`` fast path of :mod:`robustctl._hinf` for the plain problem.
 
 One plant, no input bound, pole region or uncertainty (standard LMI, free
 level). In the balanced, unit-channel coordinates of :func:`._coordinates.normalised`:
@@ -10,7 +10,7 @@ level). In the balanced, unit-channel coordinates of :func:`._coordinates.normal
 2. the gain ``K`` of the saddle point at ``(1 + backoff / 2) gamma_opt``
    (well inside the feasible set, so ``K`` is moderate even where the
    optimum needs an unbounded gain);
-3. the LMI certificate of :mod:`robustctl.hinf` at ``(1 + backoff)
+3. the LMI certificate of :mod:`robustctl._hinf` at ``(1 + backoff)
    gamma_opt``: a strictly feasible ``(X, K X)`` built from the closed loop's
    bounded-real Riccati equation and accepted only on the eigenvalues of
    every LMI block (:func:`._gains.riccati_certified`), the same check as the

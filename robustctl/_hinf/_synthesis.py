@@ -76,8 +76,8 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
 
     ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u`` (discrete plant) or
     ``x' = F x + Bw w + G u`` (continuous plant, ``plant.dt is None``; ``F``,
-    ``G`` are then ``A``, ``B``). The LMIs are given in the docstring of :mod:`robustctl.hinf`;
-    the stages in that of :mod:`robustctl.hinf._synthesis`.
+    ``G`` are then ``A``, ``B``). The LMIs are given in the docstring of :mod:`robustctl._hinf`;
+    the stages in that of :mod:`robustctl._hinf._synthesis`.
 
     Parameters
     ----------
@@ -132,7 +132,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         ``||Delta||_2 <= 1`` (also time-varying) around every vertex: the
         bound ``gamma`` then holds for every such plant (quadratic
         stability and performance, by the S-procedure with one multiplier
-        per vertex; see :mod:`robustctl.hinf`). The convex counterpart of
+        per vertex; see :mod:`robustctl._hinf`). The convex counterpart of
         :func:`robustctl.rlqr`. ``H = 0`` or ``[EF EG] = 0`` is the nominal
         design. Pole regions apply to the nominal vertices. Standard LMI only.
     solver : str, default "CLARABEL"
@@ -146,7 +146,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         optimal level by bisection on the game Riccati equation, the gain of
         its saddle point at ``(1 + backoff / 2) gamma_opt``, and the same LMI
         certificate at ``(1 + backoff) gamma_opt`` checked by eigenvalues
-        (:mod:`robustctl.hinf._riccati_path`); if that certificate is not
+        (:mod:`robustctl._hinf._riccati_path`); if that certificate is not
         strictly positive the SDP is solved instead. ``info["synthesis"]``
         says which path returned the gain (``info["fallback"]`` why the SDP
         was needed). With ``"riccati"`` cvxpy is imported, and ``solver``

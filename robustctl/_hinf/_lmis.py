@@ -3,7 +3,7 @@
 The blocks (each ``M >= margin I``, see :class:`robustctl._cvx.LMI`) are
 built from a :class:`Point`, which holds either cvxpy variables (to solve)
 or arrays (to evaluate a candidate's certificate with the very same code).
-The maths is in the docstring of :mod:`robustctl.hinf`.
+The maths is in the docstring of :mod:`robustctl._hinf`.
 """
 
 from __future__ import annotations
@@ -101,7 +101,7 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
     variable); ``z_scale`` multiplies ``z``. The constant disturbance block
     ``I`` is eliminated by a Schur complement (``q`` rows smaller, still
     linear). With an uncertainty in ``data`` (and multipliers in ``V``) the
-    block is the robust one of :mod:`robustctl.hinf` (S-procedure).
+    block is the robust one of :mod:`robustctl._hinf` (S-procedure).
     """
     Ip = np.eye(data.p)
     Cz, Dzu, Dzw = z_scale * data.Cz, z_scale * data.Dzu, z_scale * data.Dzw
