@@ -171,27 +171,45 @@ def check_plant(value, name: str = "plant", *, discrete_for: str | None = None) 
     return value
 
 
+def check_plants(plants, name: str = "plants", *, like: Plant | None = None, reference: str | None = None,
+                 non_empty: bool = True, discrete_for: str | None = None) -> list[Plant]:
+    """``plants`` as a list of :class:`~robustctl.Plant` of one size and sampling time.
+
+    Every plant must have the ``n``, ``m`` and ``dt`` of ``like`` (default
+    ``plants[0]``), which ``reference`` names in the messages (default
+    ``"<name>[0]"``); with ``discrete_for`` each must be discrete-time. The
+    one check of a plant set: polytope vertices, the scenarios of a tuning
+    problem, the plants of :meth:`NormBounded.from_plants
+    <robustctl.NormBounded.from_plants>`. ``TypeError`` for anything but a
+    list (or tuple) of plants (an empty one too, with ``non_empty``),
+    ``ValueError`` naming ``<name>[i]`` for a size or sampling time that differs.
+    """
+    what = f"a {'non-empty ' if non_empty else ''}list of robustctl.Plant"
+    if isinstance(plants, Plant) or not isinstance(plants, Sequence) or isinstance(plants, (str, bytes)):
+        raise TypeError(f"{name} must be {what}, got {type(plants).__name__}")
+    if non_empty and len(plants) == 0:
+        raise TypeError(f"{name} must be {what}, got an empty {type(plants).__name__}")
+    out = [check_plant(p, f"{name}[{i}]", discrete_for=discrete_for) for i, p in enumerate(plants)]
+    ref = like if like is not None else (out[0] if out else None)
+    reference = reference or f"{name}[0]"
+    for i, p in enumerate(out):
+        assert ref is not None
+        if (p.n, p.m) != (ref.n, ref.m):
+            raise ValueError(f"{name}[{i}] must have n={ref.n} states and m={ref.m} inputs like {reference}, "
+                             f"got n={p.n}, m={p.m}")
+        if p.dt != ref.dt:
+            raise ValueError(f"{name}[{i}] must have the sampling time of {reference} (dt={ref.dt}), got dt={p.dt}")
+    return out
+
+
 def check_vertices(plant: Plant, vertices, *, reference: str = "plant", non_empty: bool = False) -> list[Plant]:
     """``[plant, *vertices]``, each vertex checked to be a :class:`~robustctl.Plant` of ``plant``'s size and ``dt``.
 
     The vertices of a polytope ``conv{plant, *vertices}`` (e.g. the ``vertices``
     of :func:`robustctl.hinf` and :func:`robustctl.robust_stability`).
     ``vertices=None`` (and, unless ``non_empty``, an empty list) is the plant
-    alone. ``reference`` names ``plant`` in the messages. ``TypeError`` for
-    anything but a list (or tuple) of plants, ``ValueError`` naming
-    ``vertices[i]`` for a size or sampling time that differs from ``plant``'s.
+    alone. ``reference`` names ``plant`` in the messages (:func:`check_plants`).
     """
     if vertices is None and not non_empty:
         return [plant]
-    if isinstance(vertices, Plant) or not isinstance(vertices, Sequence) or isinstance(vertices, (str, bytes)) \
-            or (non_empty and len(vertices) == 0):
-        raise TypeError(f"vertices must be a {'non-empty ' if non_empty else ''}list of robustctl.Plant")
-    for i, v in enumerate(vertices):
-        check_plant(v, f"vertices[{i}]")
-        if (v.n, v.m) != (plant.n, plant.m):
-            raise ValueError(f"vertices[{i}] must have n={plant.n} states and m={plant.m} inputs like {reference}, "
-                             f"got n={v.n}, m={v.m}")
-        if v.dt != plant.dt:
-            raise ValueError(f"vertices[{i}] must have the sampling time of {reference} (dt={plant.dt}), "
-                             f"got dt={v.dt}")
-    return [plant, *vertices]
+    return [plant, *check_plants(vertices, "vertices", like=plant, reference=reference, non_empty=non_empty)]

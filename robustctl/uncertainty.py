@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_batch, as_float_array, as_matrix, check_int, check_positive_scalar
-from .plant import Plant, _frozen, check_plant
+from .plant import Plant, _frozen, check_plant, check_plants
 
 __all__ = ["NormBounded", "check_norm_bounded"]
 
@@ -196,17 +196,7 @@ class NormBounded:
         True
         """
         check_plant(nominal, "nominal")
-        if isinstance(plants, Plant) or not isinstance(plants, Sequence) or isinstance(plants, (str, bytes)) \
-                or len(plants) == 0:
-            raise TypeError("plants must be a non-empty list of robustctl.Plant")
-        for i, plant in enumerate(plants):
-            check_plant(plant, f"plants[{i}]")
-            if (plant.n, plant.m) != (nominal.n, nominal.m):
-                raise ValueError(f"plants[{i}] must have n={nominal.n} states and m={nominal.m} inputs like "
-                                 f"nominal, got n={plant.n}, m={plant.m}")
-            if plant.dt != nominal.dt:
-                raise ValueError(f"plants[{i}] must have the sampling time of nominal (dt={nominal.dt}), "
-                                 f"got dt={plant.dt}")
+        plants = check_plants(plants, "plants", like=nominal, reference="nominal")
         cap = None if rank is None else check_int(rank, "rank")
         tol = check_positive_scalar(tol, "tol")
         if tol >= 1:

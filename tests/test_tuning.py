@@ -150,13 +150,13 @@ def test_problem_constraints_and_nan_flag():
 
 def test_problem_bad_input():
     fam = tuning.LQRFamily(PLANT)
-    with pytest.raises(ValueError, match="scenarios must all have the same size"):
+    with pytest.raises(ValueError, match=r"scenarios\[1\] must have n=2 states and m=1 inputs like scenarios\[0\]"):
         tuning.TuningProblem(fam, [PLANT, rc.Plant(np.eye(3), np.ones((3, 1)), dt=0.1)], [effort])
-    with pytest.raises(ValueError, match="scenarios must all have the same sampling time"):
+    with pytest.raises(ValueError, match=r"scenarios\[1\] must have the sampling time of scenarios\[0\]"):
         tuning.TuningProblem(fam, [PLANT, rc.Plant(PLANT.F, PLANT.G, dt=0.2)], [effort])
     with pytest.raises(TypeError, match="scenarios must be a non-empty list"):
         tuning.TuningProblem(fam, PLANT, [effort])
-    with pytest.raises(ValueError, match="scenarios must not be empty"):
+    with pytest.raises(TypeError, match=r"scenarios must be a non-empty list of robustctl\.Plant, got an empty list"):
         tuning.TuningProblem(fam, [], [effort])
     with pytest.raises(ValueError, match=r"bounds inverted.*xl\[1\]"):
         tuning.TuningProblem(fam, SCENARIOS, [effort], xl=[0, 2, 0], xu=[1, 1, 1])

@@ -277,11 +277,11 @@ def test_bad_input(plants, gains):
         RobustMargin(np.eye(3))
     with pytest.raises(ValueError, match="uncertainty does not fit the plants"):
         RobustMargin(rc.NormBounded(np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)))).check(plants)
-    with pytest.raises(ValueError, match=r"plants must all have the same size: .* plants\[1\] has n=2"):
+    with pytest.raises(ValueError, match=r"plants\[1\] must have n=\d states .* like plants\[0\], got n=2"):
         check_scenarios([plants[0], rc.Plant(np.eye(2), np.ones((2, 2)), DT)])
     with pytest.raises(ValueError, match=r"plants\[0\] must be discrete-time"):
         SpectralRadius().check([rc.Plant(A_C, B_C, None)])
-    with pytest.raises(ValueError, match="plants must not be empty"):
+    with pytest.raises(TypeError, match=r"plants must be a non-empty list of robustctl\.Plant, got an empty list"):
         SpectralRadius().check([])
     with pytest.raises(ValueError, match="K must have 2 rows"):
         SpectralRadius()(np.zeros((2, 1, 3)), plants)

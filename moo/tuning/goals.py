@@ -81,7 +81,15 @@ import numpy as np
 import robustctl as rc
 from robustctl.batchsim import BACKENDS, DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
 from robustctl.regions import Region, as_regions
-from robustctl.validation import as_float_array, as_matrix, check_choice, check_int, check_positive_scalar, check_real
+from robustctl.validation import (
+    as_float_array,
+    as_matrix,
+    check_choice,
+    check_int,
+    check_plants,
+    check_positive_scalar,
+    check_real,
+)
 
 __all__ = ["Goal", "Response", "ErrorGoal", "PeakInput", "SettlingTime", "SpectralRadius", "PoleRegion",
            "H2Norm", "HinfNorm", "RobustMargin", "Bound", "at_most", "at_least", "check_scenarios",
@@ -99,29 +107,11 @@ _SMITH_MAX = 64
 
 # ---------------------------------------------------------------- shared checks
 def check_scenarios(plants, name: str = "plants") -> list[rc.Plant]:
-    """``plants`` as a list of discrete-time plants of one ``n``, ``m`` and ``dt``.
+    """``plants`` as a non-empty list of discrete-time plants of one ``n``, ``m`` and ``dt``.
 
-    ``TypeError`` for anything but a non-empty sequence of :class:`robustctl.Plant`
-    (``ValueError`` for an empty one), ``ValueError`` naming ``name[i]`` for a
-    continuous plant, or a size or sampling time unlike ``name[0]``'s.
+    :func:`robustctl.validation.check_plants`, with messages naming ``name[i]``.
     """
-    if isinstance(plants, rc.Plant) or not isinstance(plants, Sequence) or isinstance(plants, (str, bytes)):
-        raise TypeError(f"{name} must be a non-empty list of robustctl.Plant, got {type(plants).__name__}")
-    if len(plants) == 0:
-        raise ValueError(f"{name} must not be empty (give at least the nominal plant)")
-    first = plants[0]
-    for i, p in enumerate(plants):
-        if not isinstance(p, rc.Plant):
-            raise TypeError(f"{name}[{i}] must be a robustctl.Plant, got {type(p).__name__}")
-        if not p.is_discrete:
-            raise ValueError(f"{name}[{i}] must be discrete-time (dt > 0); discretise it first")
-        if (p.n, p.m) != (first.n, first.m):
-            raise ValueError(f"{name} must all have the same size: {name}[0] has n={first.n}, m={first.m}, "
-                             f"{name}[{i}] has n={p.n}, m={p.m}")
-        if p.dt != first.dt:
-            raise ValueError(f"{name} must all have the same sampling time: {name}[0] has dt={first.dt}, "
-                             f"{name}[{i}] has dt={p.dt}")
-    return list(plants)
+    return check_plants(plants, name, discrete_for="tuning")
 
 
 def _gains(K, plants: list[rc.Plant]) -> np.ndarray:
