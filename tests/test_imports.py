@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import main_many
 
 from moo.__main__ import main
 
@@ -79,27 +80,6 @@ def _moo(args, env, cwd):
                           timeout=300, check=False)
 
 
-# One interpreter for many command lines (the user module is importable through PYTHONPATH).
-_MANY = """
-import contextlib, io, json, sys
-from moo.__main__ import main
-out = []
-for argv in json.loads(sys.argv[1]):
-    err, so = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(so):
-        code = main(argv)
-    out.append([code, err.getvalue(), so.getvalue()])
-print(json.dumps(out))
-"""
-
-
-def _main_many(argvs, env, cwd):
-    """``main(argv)`` for each argv in one interpreter: [(exit code, stderr, stdout), ...]."""
-    proc = subprocess.run([sys.executable, "-c", _MANY, json.dumps(argvs)], env=env, cwd=cwd, capture_output=True,
-                          text=True, timeout=300, check=False)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout.splitlines()[-1])
-
 
 def _front_of(F):
     """The non-dominated rows of ``F`` (a plain O(n^2) filter: an independent check of moocore)."""
@@ -112,7 +92,7 @@ def _front_of(F):
 def test_user_problem_and_moea_through_run_experiment_stats_and_plot(user_module):
     tmp, env = user_module
     out, res = tmp / "run.json", tmp / "res"
-    results = _main_many([
+    results = main_many([
         ["run", "--problem", "usermoo:problem", "--algorithm", "usermoo:plain_nsga2", "--molsp", "--seed", "1",
          "--evals", "400", "--pop-size", "20", "--out", str(out)],
         # on a process pool: the user's MOEA beside a registry one, plain and with MO-LSP
@@ -176,7 +156,7 @@ def test_a_bad_import_path_is_one_line_exit_2_nothing_run(user_module):
         argvs.append(["experiment", "--problem", grid["--problem"], "--algorithms", grid["--algorithms"],
                       "--runs", "1", "--evals", "100", "--out", str(tmp / "res")])
         messages += [message, message]
-    for argv, message, (code, err, _) in zip(argvs, messages, _main_many(argvs, env, tmp), strict=True):
+    for argv, message, (code, err, _) in zip(argvs, messages, main_many(argvs, env, tmp), strict=True):
         assert code == 2 and err.count("\n") == 1 and message in err, (argv, err)
     assert not (tmp / "run.json").exists() and not (tmp / "res").exists()
 

@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
 import textwrap
 from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.linalg
+from conftest import main_many
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -57,27 +56,6 @@ def not_tuning():
 
 RUN = ["--problem", "userplant:problem", "--algorithm", "nsga2", "--molsp", "--seed", "1", "--evals", "400",
        "--pop-size", "20"]
-
-# One interpreter for many command lines (the user module is importable through PYTHONPATH).
-_MANY = """
-import contextlib, io, json, sys
-from moo.__main__ import main
-out = []
-for argv in json.loads(sys.argv[1]):
-    err, so = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(so):
-        code = main(argv)
-    out.append([code, err.getvalue(), so.getvalue()])
-print(json.dumps(out))
-"""
-
-
-def _main_many(argvs, env, cwd):
-    """``main(argv)`` for each argv in one interpreter: [(exit code, stderr, stdout), ...]."""
-    proc = subprocess.run([sys.executable, "-c", _MANY, json.dumps(argvs)], env=env, cwd=cwd, capture_output=True,
-                          text=True, timeout=300, check=False)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout.splitlines()[-1])
 
 
 def _user():
@@ -144,7 +122,7 @@ def test_user_tuning_problem_run_experiment_stats_plot_select(user_env):
     tmp, env = user_env
     run, res = tmp / "run.json", tmp / "res"
     sel = ["--problem", "userplant:problem", "--n-sims", "300"]
-    results = _main_many([
+    results = main_many([
         ["run", *RUN, "--out", str(run)],
         ["experiment", "--problem", "userplant:problem", "--algorithms", "nsga2", "--runs", "2", "--evals", "200",
          "--pop-size", "20", "--workers", "2", "--out", str(res)],
@@ -203,7 +181,7 @@ def test_select_bad_source_or_problem_is_a_one_line_error(user_env):
     tmp, env = user_env
     run = tmp / "run.json"
     mixed = tmp / "mixed"
-    results = _main_many([
+    results = main_many([
         ["run", *RUN[:-4], "--evals", "40", "--pop-size", "20", "--out", str(run)],
         ["select", str(run), "--problem", "userplant:not_tuning", "--seed", "0"],
         ["select", str(run), "--problem", "zdt1", "--seed", "0"],
@@ -226,5 +204,5 @@ def test_select_bad_source_or_problem_is_a_one_line_error(user_env):
         path = mixed / "userplant~problem" / "nsga2+molsp" / f"seed_{seed}.json"
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(dict(rec, seed=seed, budget=budget)))
-    (code, err, _), = _main_many([["select", str(mixed), "--problem", "userplant:problem", "--seed", "0"]], env, tmp)
+    (code, err, _), = main_many([["select", str(mixed), "--problem", "userplant:problem", "--seed", "0"]], env, tmp)
     assert code == 2 and "mixes two settings" in err and "seed_2.json" in err
