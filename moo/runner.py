@@ -75,7 +75,7 @@ from moo.algorithms.operators import POP_SIZE
 from moo.indicators import hypervolume
 from moo.molsp import molsp as add_molsp
 
-__all__ = ["RunResult", "PreparedRun", "prepare", "run", "check_budget", "setup_name"]
+__all__ = ["RunResult", "PreparedRun", "prepare", "prepare_on", "run", "check_budget", "setup_name"]
 
 
 def _versions() -> dict[str, str]:
@@ -295,6 +295,14 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
     NotImplementedError
         A registered problem or algorithm whose module is not available.
     """
+    problem_key, algorithm_key = check_problem_name(problem), check_algorithm_name(algorithm)
+    seed, evals, pop_size, molsp, max_leaders = _run_options(seed, evals, pop_size, molsp, max_leaders)
+    prob = build_problem(problem_key, n_obj, setup=setup)
+    return prepare_on(prob, problem_key, algorithm_key, seed=seed, evals=evals, molsp=molsp, pop_size=pop_size,
+                      max_leaders=max_leaders)
+
+
+def _run_options(seed, evals, pop_size, molsp, max_leaders) -> tuple[int, int, int, bool, int | None]:
     seed = check_int(seed, "seed", 0)
     evals = check_int(evals, "evals", 1)
     pop_size = check_int(pop_size, "pop_size", 4)
@@ -304,14 +312,25 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
         max_leaders = check_int(max_leaders, "max_leaders", 1)
         if not molsp:
             raise ValueError("max_leaders needs molsp=True")
-    problem_key, algorithm_key = check_problem_name(problem), check_algorithm_name(algorithm)
-    prob = build_problem(problem_key, n_obj, setup=setup)
-    alg = check_budget(prob, algorithm_key, evals=evals, pop_size=pop_size)
+    return seed, evals, pop_size, bool(molsp), max_leaders
+
+
+def prepare_on(problem, problem_name: str, algorithm: str, *, seed: int, evals: int, molsp: bool = False,
+               pop_size: int = POP_SIZE, max_leaders: int | None = None) -> PreparedRun:
+    """:func:`prepare` for a problem already built (a pymoo problem with ``hv_ref_point``/``molsp_ref_point``).
+
+    ``problem_name`` is what the record calls it (``moo.tuning.tune`` runs a
+    :class:`~moo.tuning.TuningProblem` as ``"tuning"``); the other arguments
+    are those of :func:`prepare`, checked the same way.
+    """
+    algorithm_key = check_algorithm_name(algorithm)
+    seed, evals, pop_size, molsp, max_leaders = _run_options(seed, evals, pop_size, molsp, max_leaders)
+    alg = check_budget(problem, algorithm_key, evals=evals, pop_size=pop_size)
     if molsp:
-        alg = add_molsp(alg, ref_point=np.asarray(prob.molsp_ref_point, dtype=float), max_leaders=max_leaders)
-    return PreparedRun(problem_name=problem_key, algorithm_name=algorithm_key, seed=seed, evals=evals,
-                       molsp=bool(molsp), max_leaders=max_leaders, problem=prob, algorithm=alg,
-                       setup=setup_name(prob))
+        alg = add_molsp(alg, ref_point=np.asarray(problem.molsp_ref_point, dtype=float), max_leaders=max_leaders)
+    return PreparedRun(problem_name=problem_name, algorithm_name=algorithm_key, seed=seed, evals=evals,
+                       molsp=molsp, max_leaders=max_leaders, problem=problem, algorithm=alg,
+                       setup=setup_name(problem))
 
 
 def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | None = None,

@@ -18,8 +18,7 @@ import robustctl as rc
 
 from .._validation import check_int
 from ..algorithms.operators import POP_SIZE
-from ..molsp import molsp as add_molsp
-from ..runner import PreparedRun, RunResult, check_budget
+from ..runner import RunResult, prepare_on
 from .problem import TuningProblem
 from .selection import Selection, select
 
@@ -198,19 +197,6 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
     """
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"problem must be a moo.tuning.TuningProblem, got {type(problem).__name__}")
-    seed = check_int(seed, "seed", 0)
-    evals = check_int(evals, "evals", 1)
-    pop_size = POP_SIZE if pop_size is None else check_int(pop_size, "pop_size", 4)
-    if not isinstance(molsp, (bool, np.bool_)):
-        raise TypeError(f"molsp must be a bool, got {type(molsp).__name__}")
-    if max_leaders is not None:
-        max_leaders = check_int(max_leaders, "max_leaders", 1)
-        if not molsp:
-            raise ValueError("max_leaders needs molsp=True")
-    alg = check_budget(problem, algorithm, evals=evals, pop_size=pop_size)
-    if molsp:
-        alg = add_molsp(alg, ref_point=np.asarray(problem.molsp_ref_point, dtype=float), max_leaders=max_leaders)
-    prepared = PreparedRun(problem_name="tuning", algorithm_name=algorithm.lower(), seed=seed, evals=evals,
-                           molsp=bool(molsp), max_leaders=max_leaders, problem=problem, algorithm=alg)
-    record = prepared.run(progress)
+    record = prepare_on(problem, "tuning", algorithm, seed=seed, evals=evals, molsp=molsp,
+                        pop_size=POP_SIZE if pop_size is None else pop_size, max_leaders=max_leaders).run(progress)
     return TuningResult(problem=problem, X=record.X, F=record.F, run=record)
