@@ -53,8 +53,11 @@ from pathlib import Path  # noqa: E402
 import control  # noqa: E402
 import numpy as np  # noqa: E402
 
-from robustctl import Plant  # noqa: E402
-from robustctl._hinf import hinf  # noqa: E402
+from robustctl import (  # noqa: E402
+    Plant,
+    hinf,
+    lq_output,
+)
 
 
 # ---------------------------------------------------------------- the independent peer
@@ -136,7 +139,7 @@ def units(reps: int) -> dict:
 
     plant = truck_plant(0.0)
     Q, R = authors_weights()
-    Bw, Cz, Dzu = np.ones((4, 1)), np.vstack([np.sqrt(Q), np.zeros((1, 4))]), np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+    Bw, (Cz, Dzu) = np.ones((4, 1)), lq_output(Q, R)
     s = 1.0 / np.sqrt(R[0, 0])
     raw, t_raw = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu), reps)
     by_hand, t_hand = best_time(lambda: hinf(plant, Bw=Bw, Cz=s * Cz, Dzu=s * Dzu), reps)
@@ -157,7 +160,7 @@ _TIMER = """
 import json, sys, time
 import numpy as np
 from robustctl import Plant
-from robustctl._hinf import hinf
+from robustctl import hinf
 n, seed, reps = (int(a) for a in sys.argv[1:4])
 def case(n, seed):
     rng = np.random.default_rng(seed)

@@ -28,8 +28,7 @@ plant = truck.truck_plant(0.0)
 Q, R = truck.lqr_weights()
 _, _, Gk = truck.discretise(0.0)
 Bw = np.column_stack([[0.0, 0.0, 1.0, 0.0], Gk[0] / 200.0])
-Cz = np.vstack([np.sqrt(Q), np.zeros((1, 4))])
-Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+Cz, Dzu = rc.lq_output(Q, R)                  # z = [Q^1/2 x; R^1/2 u]
 
 free = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
 bounds = [0.1, 0.2, 0.3, 0.45, 0.7, 1.0]

@@ -41,8 +41,7 @@ rlqr = rc.design("rlqr", plant2, EF[0], EG[0], mu[0], Q=Q2, R=R2,
 # disturbances: a rho impulse and the curvature of a 200 m bend
 _, _, Gk = truck.discretise(0.0)       # curvature input of the ZOH model
 Bw = np.column_stack([[0.0, 0.0, 1.0, 0.0], Gk[0] / 200.0])
-Cz = np.vstack([np.sqrt(Q), np.zeros((1, 4))])
-Dzu = np.vstack([np.zeros((4, 1)), np.sqrt(R)])
+Cz, Dzu = rc.lq_output(Q, R)                  # z = [Q^1/2 x; R^1/2 u]
 hinf = rc.design("hinf", plant, Bw=Bw, Cz=Cz, Dzu=Dzu,
                  u_max=truck.STEER_LIMIT, w_energy=1.0)
 
