@@ -245,8 +245,8 @@ def test_sdp_fallback_when_the_riccati_certificate_fails(monkeypatch, norm):
     def failing(A, B, C, gamma, *, discrete):
         return np.full(A.shape, np.nan), np.zeros(A.shape[0], dtype=bool)
 
-    monkeypatch.setattr(analysis._hinfnorm, "bounded_real_riccati", failing)
-    monkeypatch.setattr(analysis._hinfnorm, "riccati_one", lambda A, B, C, gamma, *, discrete: None)
+    monkeypatch.setattr(_hinfnorm, "bounded_real_riccati", failing)
+    monkeypatch.setattr(_hinfnorm, "riccati_one", lambda A, B, C, gamma, *, discrete: None)
     res = rc.robust_stability((plant, np.stack([K, K])), unc)
     assert (res.info["path"] == "sdp").all() and res.info["sdp_solves"] == 2 and res.certified.all()
     assert np.allclose(res.margin, reference.margin, rtol=1e-12 if norm == "level-set" else 1e-9)
