@@ -3,6 +3,7 @@ against a `dask scheduler` with two `dask worker` processes. Small grids (ZDT1, 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -92,9 +93,9 @@ def test_worker_killed_mid_grid_loses_nothing(tmp_path, serial, cluster):
     assert _content(tmp_path) == serial                      # every record, each the serial one
 
 
-@pytest.fixture
-def dask_processes(tmp_path):
-    """A `dask scheduler` and two `dask worker` processes on 127.0.0.1; yields the scheduler's address."""
+@contextlib.contextmanager
+def _dask_cluster(tmp_path, n_workers: int):
+    """A `dask scheduler` and ``n_workers`` `dask worker` processes on 127.0.0.1: yields (address, scheduler)."""
     sched_file = tmp_path / "scheduler.json"
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
     procs = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
@@ -106,11 +107,11 @@ def dask_processes(tmp_path):
             time.sleep(0.05)
         procs += [subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
                                     "--nthreads", "1", "--no-dashboard", "--host", "127.0.0.1"], cwd=REPO, env=env,
-                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for _ in range(2)]
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for _ in range(n_workers)]
         with distributed.Client(scheduler_file=str(sched_file), timeout=60) as client:
-            client.wait_for_workers(2, timeout=60)
+            client.wait_for_workers(n_workers, timeout=60)
             address = client.scheduler.address
-        yield address
+        yield address, procs[0]
     finally:
         for proc in procs[1:]:
             proc.kill()                      # the workers: no graceful shutdown needed
@@ -120,6 +121,13 @@ def dask_processes(tmp_path):
                 proc.wait(timeout=20)
             except subprocess.TimeoutExpired:
                 proc.kill()
+
+
+@pytest.fixture
+def dask_processes(tmp_path):
+    """A `dask scheduler` and two `dask worker` processes on 127.0.0.1; yields the scheduler's address."""
+    with _dask_cluster(tmp_path, 2) as (address, _):
+        yield address
 
 
 def test_cli_on_dask_scheduler_and_two_workers(tmp_path, serial, dask_processes, capsys):
@@ -154,26 +162,8 @@ def test_cli_dask_argument_errors(tmp_path, capsys):
 @pytest.fixture
 def scheduler_and_worker(tmp_path):
     """A `dask scheduler` and one `dask worker` (processes); yields (address, scheduler process)."""
-    sched_file = tmp_path / "scheduler.json"
-    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
-    procs = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
-                               "--no-dashboard", "--scheduler-file", str(sched_file)],
-                              cwd=REPO, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
-    try:
-        deadline = time.monotonic() + 60
-        while not sched_file.exists() and time.monotonic() < deadline:
-            time.sleep(0.05)
-        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
-                                       "--nthreads", "1", "--no-dashboard", "--host", "127.0.0.1"], cwd=REPO,
-                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        with distributed.Client(scheduler_file=str(sched_file), timeout=60) as client:
-            client.wait_for_workers(1, timeout=60)
-            address = client.scheduler.address
-        yield address, procs[0]
-    finally:
-        for proc in procs:
-            proc.kill()
-            proc.wait(timeout=20)
+    with _dask_cluster(tmp_path, 1) as cluster:
+        yield cluster
 
 
 @pytest.mark.slow
