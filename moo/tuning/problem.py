@@ -299,8 +299,8 @@ class TuningProblem(Problem):
 
         .. math::
 
-            r_{hv} = f^+ + 	ext{margin}\; d, \qquad
-            r_{molsp} = \max(f^{max}, f^+) + 	ext{margin}\; d,
+            r_{hv} = f^+ + \text{margin}\; d, \qquad
+            r_{molsp} = \max(f^{max}, f^+) + \text{margin}\; d,
 
         so every non-dominated sampled design dominates ``r_hv`` and every
         acceptable one ``r_molsp`` (MO-LSP then finds leaders from the first
