@@ -142,7 +142,7 @@ class TuningProblem(Problem):
     last_flags : (B,) object ndarray
         Why each design of the last evaluated population was penalised
         (``""`` for none): the family's reason, ``"unstable"``, or
-        ``"<goal> returned nan"``.
+        ``"<goal> returned nan"`` (or ``inf``).
 
     Raises
     ------
@@ -370,7 +370,8 @@ class TuningProblem(Problem):
                 idx = np.flatnonzero(run)[bad]
                 names = [*self.objective_names, *self.constraint_names]
                 for i, row in zip(idx, vals[bad], strict=True):
-                    flags[i] = f"{names[int(np.flatnonzero(~np.isfinite(row))[0])]} returned nan"
+                    first = int(np.flatnonzero(~np.isfinite(row))[0])
+                    flags[i] = f"{names[first]} returned {row[first]}"
                 J[idx] = np.inf                       # flagged: the penalty p on every objective
                 C[idx] = np.inf
         self.last_flags = flags
