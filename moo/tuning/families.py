@@ -110,10 +110,12 @@ class DesignFamily(Protocol):
         ...
 
 
-def _input_map(input_map, plant: rc.Plant) -> np.ndarray | None:
+def _input_map(input_map, plant: rc.Plant) -> tuple[np.ndarray | None, rc.Plant]:
+    """The checked input map ``M`` (or None) and the design plant ``(F, G M)`` (``plant`` itself without one)."""
     if input_map is None:
-        return None
-    return as_matrix(input_map, "input_map", rows=plant.m, rows_what="the plant's number of inputs")
+        return None, plant
+    M = as_matrix(input_map, "input_map", rows=plant.m, rows_what="the plant's number of inputs")
+    return M, rc.Plant(plant.F, plant.G @ M, dt=plant.dt)
 
 
 def _bounds(value, name: str, default: np.ndarray) -> np.ndarray:
@@ -214,9 +216,7 @@ class RLQRFamily:
                  log_mu_bound: float = 100.0):
         plant = check_plant(plant, "plant", discrete_for="RLQRFamily")
         self.plant = plant
-        self.input_map = _input_map(input_map, plant)
-        self.design_plant = plant if self.input_map is None else rc.Plant(plant.F, plant.G @ self.input_map,
-                                                                          dt=plant.dt)
+        self.input_map, self.design_plant = _input_map(input_map, plant)
         n, m = self.design_plant.n, self.design_plant.m
         self.H = np.ones((n, 1)) if H is None else as_matrix(H, "H", rows=n, rows_what="the number of states")
         self.l = self.H.shape[1]
@@ -371,9 +371,7 @@ class LQRFamily:
                  max_iter: int = 100):
         plant = check_plant(plant, "plant", discrete_for="LQRFamily")
         self.plant = plant
-        self.input_map = _input_map(input_map, plant)
-        self.design_plant = plant if self.input_map is None else rc.Plant(plant.F, plant.G @ self.input_map,
-                                                                          dt=plant.dt)
+        self.input_map, self.design_plant = _input_map(input_map, plant)
         if not self.design_plant.is_stabilizable:
             raise ValueError("plant must be stabilisable (with the input map) for LQRFamily")
         n, m = self.design_plant.n, self.design_plant.m
