@@ -341,26 +341,27 @@ def _paper(problem) -> bool:
     return isinstance(problem, (GenericRLQRProblem, AppliedRLQRProblem))
 
 
+def _design_set(X: np.ndarray, K_front: np.ndarray, extras: list[tuple[str, str, np.ndarray, np.ndarray]],
+                z_random: np.ndarray, K_random: np.ndarray) -> DesignSet:
+    """``[front (N), *extras, random]``; each extra is ``(label, kind, K (1, m, n), z (1, n_var))``."""
+    N = X.shape[0]
+    K = np.concatenate([K_front, *(K_e for _, _, K_e, _ in extras), K_random])
+    return DesignSet(K=K, z=np.concatenate([X, *(z_e for *_, z_e in extras), z_random[None]]),
+                     labels=(*(str(i + 1) for i in range(N)), *(lab for lab, *_ in extras), "random"),
+                     kinds=(*["front"] * N, *(kind for _, kind, *_ in extras), "random"),
+                     ok=np.all(np.isfinite(K), axis=(1, 2)))
+
+
 def _general_designs(problem: TuningProblem, X: np.ndarray, seed) -> DesignSet:
     """Front, the family's nominal design (if it has ``nominal()``), random: for any TuningProblem."""
     z_random = np.asarray(_rng(seed).uniform(problem.xl, problem.xu))
     K_all = problem.gains(np.vstack([X, z_random])).K
     N = X.shape[0]
-    Ks, zs = [K_all[:N]], [X]
-    labels, kinds = [str(i + 1) for i in range(N)], ["front"] * N
+    extras = []
     nominal = getattr(problem.family, "nominal", None)
     if callable(nominal):
-        Ks.append(problem.check_gains(nominal()))
-        zs.append(np.full((1, problem.n_var), np.nan))
-        labels.append("nominal")
-        kinds.append("nominal")
-    Ks.append(K_all[N:])
-    zs.append(z_random[None])
-    labels.append("random")
-    kinds.append("random")
-    K = np.concatenate(Ks)
-    return DesignSet(K=K, z=np.concatenate(zs), labels=tuple(labels), kinds=tuple(kinds),
-                     ok=np.all(np.isfinite(K), axis=(1, 2)))
+        extras.append(("nominal", "nominal", problem.check_gains(nominal()), np.full((1, problem.n_var), np.nan)))
+    return _design_set(X, K_all[:N], extras, z_random, K_all[N:])
 
 
 def build_designs(problem: TuningProblem, X_front, *, seed=None) -> DesignSet:
@@ -394,25 +395,14 @@ def build_designs(problem: TuningProblem, X_front, *, seed=None) -> DesignSet:
     K_rlqr = np.where(batch.ok[:, None, None], batch.K, np.nan)
     K_nom = rc.lqr(problem.plant, Q=problem.Q, R=problem.R).K
     N = X.shape[0]
-    Ks = [K_rlqr[:N], K_nom[None]]
-    zs = [X, np.full((1, problem.n_var), np.nan)]
-    labels = [str(i + 1) for i in range(N)] + ["nominal"]
-    kinds = ["front"] * N + ["nominal"]
+    extras = [("nominal", "nominal", K_nom[None], np.full((1, problem.n_var), np.nan))]
     if isinstance(problem, AppliedRLQRProblem):
         u = morais2022.algebraic_uncertainty("printed")
         a = rc.rlqr_gains(problem.plant, u.EF, u.EG, np.array([u.mu]), Q=problem.Q, R=problem.R, H=u.H,
                           alpha=problem.alpha, max_iter=problem.max_iter)
-        Ks.append(np.where(a.ok[:, None, None], a.K, np.nan))
-        zs.append(np.concatenate([u.EF.ravel(), u.EG.ravel(), [np.log10(u.mu) ** 2]])[None])
-        labels.append("RLQR^A")
-        kinds.append("rlqr_a")
-    Ks.append(K_rlqr[N:])
-    zs.append(z_random[None])
-    labels.append("random")
-    kinds.append("random")
-    K = np.concatenate(Ks)
-    return DesignSet(K=K, z=np.concatenate(zs), labels=tuple(labels), kinds=tuple(kinds),
-                     ok=np.all(np.isfinite(K), axis=(1, 2)))
+        extras.append(("RLQR^A", "rlqr_a", np.where(a.ok[:, None, None], a.K, np.nan),
+                       np.concatenate([u.EF.ravel(), u.EG.ravel(), [np.log10(u.mu) ** 2]])[None]))
+    return _design_set(X, K_rlqr[:N], extras, z_random, K_rlqr[N:])
 
 
 # ---------------------------------------------------------------------------
