@@ -43,6 +43,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
+import inspect  # noqa: E402
 import json  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
@@ -155,22 +156,15 @@ def cl_norm(plant, K, Bw, Cz, Dzu) -> float:
 
 
 # The SDP path of one checkout, timed in a subprocess (``robustctl`` imported from ROOT via PYTHONPATH):
-# the plants of ``case`` rebuilt from the same seeds; prints the median CPU time per call and gamma_opt.
+# the plants of ``case`` (its source, inserted below) rebuilt from the same seeds; prints the median CPU time
+# per call and gamma_opt.
 _TIMER = """
 import json, sys, time
 import numpy as np
 from robustctl import Plant
 from robustctl import hinf
 n, seed, reps = (int(a) for a in sys.argv[1:4])
-def case(n, seed):
-    rng = np.random.default_rng(seed)
-    m, q, p = 2, 2, 4
-    F = rng.normal(size=(n, n))
-    F *= 1.05 / np.max(np.abs(np.linalg.eigvals(F)))
-    G, Bw = rng.normal(size=(n, m)), rng.normal(size=(n, q))
-    Cz = np.vstack([rng.normal(size=(p - m, n)), np.zeros((m, n))])
-    Dzu = np.vstack([np.zeros((p - m, m)), np.eye(m)])
-    return Plant(F, G, 0.1), Bw, Cz, Dzu
+{case}
 w = case(3, 0)
 hinf(w[0], Bw=w[1], Cz=w[2], Dzu=w[3])
 plant, Bw, Cz, Dzu = case(n, seed)
@@ -179,14 +173,15 @@ for _ in range(reps):
     t0 = time.process_time()
     ctrl = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
     cpu.append(time.process_time() - t0)
-print(json.dumps({"cpu": float(np.median(cpu)), "gamma_opt": ctrl.gamma_opt, "iterations": ctrl.info["iterations"]}))
+print(json.dumps({{"cpu": float(np.median(cpu)), "gamma_opt": ctrl.gamma_opt, "iterations": ctrl.info["iterations"]}}))
 """
 
 
 def sdp_cpu(root: str, n: int, seed: int, reps: int) -> dict:
     """The median CPU time of ``reps`` SDP-path calls of the checkout at ``root`` (a fresh subprocess)."""
     env = dict(os.environ, PYTHONPATH=str(Path(root).resolve()))
-    out = subprocess.run([sys.executable, "-c", _TIMER, str(n), str(seed), str(reps)], env=env, cwd=root,
+    code = _TIMER.format(case=inspect.getsource(case))
+    out = subprocess.run([sys.executable, "-c", code, str(n), str(seed), str(reps)], env=env, cwd=root,
                          capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
