@@ -296,10 +296,8 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
         A registered problem or algorithm whose module is not available.
     """
     problem_key, algorithm_key = check_problem_name(problem), check_algorithm_name(algorithm)
-    seed, evals, pop_size, molsp, max_leaders = _run_options(seed, evals, pop_size, molsp, max_leaders)
-    prob = build_problem(problem_key, n_obj, setup=setup)
-    return prepare_on(prob, problem_key, algorithm_key, seed=seed, evals=evals, molsp=molsp, pop_size=pop_size,
-                      max_leaders=max_leaders)
+    options = _run_options(seed, evals, pop_size, molsp, max_leaders)
+    return _prepared(build_problem(problem_key, n_obj, setup=setup), problem_key, algorithm_key, *options)
 
 
 def _run_options(seed, evals, pop_size, molsp, max_leaders) -> tuple[int, int, int, bool, int | None]:
@@ -323,8 +321,13 @@ def prepare_on(problem, problem_name: str, algorithm: str, *, seed: int, evals: 
     :class:`~moo.tuning.TuningProblem` as ``"tuning"``); the other arguments
     are those of :func:`prepare`, checked the same way.
     """
-    algorithm_key = check_algorithm_name(algorithm)
-    seed, evals, pop_size, molsp, max_leaders = _run_options(seed, evals, pop_size, molsp, max_leaders)
+    return _prepared(problem, problem_name, check_algorithm_name(algorithm),
+                     *_run_options(seed, evals, pop_size, molsp, max_leaders))
+
+
+def _prepared(problem, problem_name: str, algorithm_key: str, seed: int, evals: int, pop_size: int, molsp: bool,
+              max_leaders: int | None) -> PreparedRun:
+    """The run of checked options: the algorithm built for ``problem`` (MO-LSP around it if asked)."""
     alg = check_budget(problem, algorithm_key, evals=evals, pop_size=pop_size)
     if molsp:
         alg = add_molsp(alg, ref_point=np.asarray(problem.molsp_ref_point, dtype=float), max_leaders=max_leaders)
