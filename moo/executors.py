@@ -42,6 +42,7 @@ from __future__ import annotations
 import os
 import re
 import threading
+import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from contextlib import AbstractContextManager, contextmanager
@@ -75,7 +76,7 @@ def _exit_with_parent(parent: int) -> None:
 
     def watch() -> None:
         while True:
-            threading.Event().wait(PARENT_POLL)
+            time.sleep(PARENT_POLL)
             if os.getppid() != parent:
                 os._exit(1)
 
