@@ -316,7 +316,7 @@ def _keep_elsewhere(record: dict, out) -> str:
 def _cmd_experiment(args) -> int:
     from moo.executors import open_executor
     from moo.experiment import RunFailedError, prepare
-    from moo.store import ResultsDirBusyError
+    from moo.store import ResultsDirBusyError, SettingsMismatchError
 
     if args.molsp_max_leaders is not None:
         if args.max_leaders is not None:
@@ -346,9 +346,7 @@ def _cmd_experiment(args) -> int:
                       "written stay: free the space and rerun the same command to resume", 1)
     except ResultsDirBusyError as exc:
         return _error(str(exc), 2)
-    except ValueError as exc:
-        if "other settings" not in str(exc):
-            return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
+    except SettingsMismatchError as exc:
         return _error(_flagged(str(exc)), 2)
     except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
@@ -413,7 +411,7 @@ def _cmd_stats(args) -> int:
         try:
             write(path)
         except OSError as exc:
-            return _error(f"cannot write {path} ({_os_reason(exc)}); no partial file is left", 1)
+            return _write_failed(exc, path)
     return 0
 
 

@@ -47,20 +47,11 @@ import numpy as np
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.problem import Problem
 
-__all__ = ["is_import_path", "load_factory", "build_problem", "build_algorithm", "check_algorithm_name",
-           "check_problem_name", "safe_name"]
+from moo.store import is_import_path
+
+__all__ = ["load_factory", "build_problem", "build_algorithm", "check_algorithm_name", "check_problem_name"]
 
 _PATH = re.compile(r"^[A-Za-z_][\w]*(\.[A-Za-z_][\w]*)*:[A-Za-z_][\w]*(\.[A-Za-z_][\w]*)*$")
-
-
-def is_import_path(name: object) -> bool:
-    """True for a string of the form ``module.path:factory`` (a colon marks an import path)."""
-    return isinstance(name, str) and ":" in name
-
-
-def safe_name(name: str) -> str:
-    """``name`` as a file or directory name: an import path's ``:`` becomes ``~`` (portable)."""
-    return name.replace(":", "~")
 
 
 def _first_line(exc: BaseException) -> str:

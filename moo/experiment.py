@@ -99,6 +99,7 @@ from moo.store import (
     problem_dir,
     read_record,
     read_settings,
+    settings_mismatch,
     validate_record,
     variant_dir,
     write_json_atomic,
@@ -263,9 +264,8 @@ def _is_done(spec: RunSpec, out: Path, expected: dict, legacy_setup=None,
     got = {k: rec.get(k, legacy_setup) if k == "setup" else rec[k] for k in expected}
     wrong = {k: (got[k], v) for k, v in expected.items() if got[k] != v}
     if wrong:
-        what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, (got, want) in wrong.items())
-        raise ValueError(f"{path} holds a run with other settings: {what}; use another out directory "
-                         "or the settings of that run")
+        raise settings_mismatch(f"{path} holds a run with other settings:", [(k, g, w) for k, (g, w) in wrong.items()],
+                                "use another out directory or the settings of that run")
     return True
 
 
@@ -301,9 +301,10 @@ def _check_legacy_dir(out: Path, settings: dict, legacy_setup) -> None:
                     settings["base_seed"]
         wrong = {k: (got[k], v) for k, v in want.items() if got[k] != v}
         if wrong:
-            what = ", ".join(f"{k} {g!r} (this grid: {w!r})" for k, (g, w) in wrong.items())
-            raise ValueError(f"{rec['_path']} holds a run with other settings: {what}; a results directory "
-                             "holds one setting: use another out directory or the settings of that run")
+            raise settings_mismatch(f"{rec['_path']} holds a run with other settings:",
+                                    [(k, g, w) for k, (g, w) in wrong.items()],
+                                    "a results directory holds one setting: use another out directory or the "
+                                    "settings of that run")
 
 
 def _expected(spec: RunSpec, n_obj: int, pop_sizes: dict[str, int], setup: str | None) -> dict:

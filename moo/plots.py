@@ -39,7 +39,6 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from moo.experiment import problem_dir
 from moo.stats import (
     INDICATORS,
     LABELS,
@@ -50,7 +49,7 @@ from moo.stats import (
     run_indicators,
     true_front,
 )
-from moo.store import atomic_path
+from moo.store import atomic_path, is_import_path, problem_dir
 
 __all__ = ["FORMATS", "check_formats", "hv_history", "indicator_boxplots", "fronts", "cd_diagram", "plot_results"]
 
@@ -171,7 +170,7 @@ def _median_run(recs: Sequence[dict]) -> dict | None:
 
 
 def _reference(problem: str, n_obj: int) -> np.ndarray | None:
-    known = ":" not in problem and problem.startswith(("zdt", "dtlz"))       # not a user's import path
+    known = not is_import_path(problem) and problem.startswith(("zdt", "dtlz"))
     return true_front(problem, n_obj) if known else None
 
 

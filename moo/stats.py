@@ -94,8 +94,7 @@ from scipy import stats as sps
 
 from moo import indicators as ind
 from moo.algorithms import ALGORITHMS
-from moo.experiment import problem_dir
-from moo.store import write_text_atomic
+from moo.store import is_import_path, problem_dir, write_text_atomic
 
 __all__ = ["INDICATORS", "HIGHER_IS_BETTER", "LABELS", "RunIndicators", "Comparison", "FriedmanResult", "true_front",
            "reference_sets", "run_indicators", "pairwise_test", "rank_sum_test", "holm", "friedman_test",
@@ -283,7 +282,7 @@ def reference_sets(records: Iterable[dict]) -> dict[tuple[str, int], np.ndarray]
         union[(rec["problem"], int(rec["n_obj"]))].append(_front(rec))
     out = {}
     for (problem, m), parts in union.items():
-        if ":" not in problem and problem.startswith(("zdt", "dtlz")):     # an import path is the user's
+        if not is_import_path(problem) and problem.startswith(("zdt", "dtlz")):
             out[(problem, m)] = true_front(problem, m)
             continue
         P = np.vstack(parts)

@@ -69,13 +69,12 @@ try:
 except ImportError:  # pragma: no cover - not POSIX: no advisory lock
     fcntl = None  # type: ignore[assignment]
 
-from moo._imports import is_import_path, safe_name
-
 __all__ = ["write_json_atomic", "write_text_atomic", "atomic_path", "read_record", "validate_record",
            "load_records", "check_consistent", "check_output_file", "prepare_results_dir", "problem_dir",
-           "variant_dir", "lock_results_dir", "ResultsDirBusyError", "CorruptRecordError", "read_settings",
-           "write_settings", "check_settings", "RECORD_NAME", "FAILED_SUFFIX", "SETTINGS_NAME",
-           "DIR_FIELDS", "PROBLEM_FIELDS", "LOCK_NAME"]
+           "variant_dir", "is_import_path", "safe_name", "lock_results_dir", "ResultsDirBusyError",
+           "SettingsMismatchError", "settings_mismatch", "CorruptRecordError", "read_settings", "write_settings",
+           "check_settings", "RECORD_NAME", "FAILED_SUFFIX", "SETTINGS_NAME", "DIR_FIELDS", "PROBLEM_FIELDS",
+           "LOCK_NAME"]
 
 #: File names of finished-run records (``seed_<s>.json``).
 RECORD_NAME = re.compile(r"^seed_(\d+)\.json$")
@@ -97,20 +96,41 @@ class ResultsDirBusyError(ValueError):
     """Another process holds the lock of the results directory."""
 
 
+class SettingsMismatchError(ValueError):
+    """A run or a grid whose settings differ from those of the results directory (the message names them)."""
+
+
+def settings_mismatch(where: str, wrong, remedy: str) -> SettingsMismatchError:
+    """The error for ``where`` holding other settings; ``wrong`` lists ``(name, recorded, this grid's)``."""
+    what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, got, want in wrong)
+    return SettingsMismatchError(f"{where} {what}; {remedy}")
+
+
 class CorruptRecordError(ValueError):
     """A record that reads as JSON but is not a valid run record (the message names the file)."""
 
 
 # ---------------------------------------------------------------------------- naming
 
+def is_import_path(name: object) -> bool:
+    """True for a string of the form ``module.path:factory`` (a colon marks an import path)."""
+    return isinstance(name, str) and ":" in name
+
+
+def safe_name(name: str) -> str:
+    """``name`` as a file or directory name: an import path's ``:`` becomes ``~`` (portable)."""
+    return name.replace(":", "~")
+
+
 def problem_dir(problem: str, n_obj: int | None) -> str:
     """Directory name of a problem: its name (``:`` as ``~``), with ``-m<M>`` for DTLZ given ``n_obj``.
 
     An import path gets no ``-m<M>``: a directory holds one ``n_obj`` of it.
     """
-    key = problem if is_import_path(problem) else problem.lower()
-    with_m = n_obj is not None and key.startswith("dtlz") and not is_import_path(key)
-    return f"{key}-m{n_obj}" if with_m else safe_name(key)
+    if is_import_path(problem):
+        return safe_name(problem)
+    key = problem.lower()
+    return f"{key}-m{n_obj}" if n_obj is not None and key.startswith("dtlz") else key
 
 
 def variant_dir(algorithm: str, molsp: bool) -> str:
@@ -379,9 +399,8 @@ def check_settings(out: str | os.PathLike, recorded: dict, wanted: dict) -> bool
                     (wanted["problem"], wanted["n_obj"]) and pdir != wanted["problem_dir"]:
                 wrong.append(("problem directory", pdir, wanted["problem_dir"]))
     if wrong:
-        what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, got, want in wrong)
-        raise ValueError(f"{Path(out) / SETTINGS_NAME}: the directory holds runs with other settings: {what}; "
-                         "use another out directory or the directory's settings")
+        raise settings_mismatch(f"{Path(out) / SETTINGS_NAME}: the directory holds runs with other settings:", wrong,
+                                "use another out directory or the directory's settings")
     return entry is None
 
 
