@@ -345,7 +345,8 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
         except (InfeasibleError, ConvergenceError):
             res = None
         if res is not None and res.P is not None:
-            score, cert = _verify_one(_stability_blocks_fast(A, r * H, E, res.P, discrete))
+            scores, certs = _verify(_batched_blocks(A[None], (r * H)[None], E[None], res.P[None], discrete))
+            score, cert = float(scores[0]), {key: float(v[0]) for key, v in certs.items()}
             if score > _STRICT or best[1] is None:
                 best = (score, res.P, cert)
                 path = "sdp" if score > _STRICT else None
@@ -359,7 +360,7 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
 
 
 def _certify_one(A, Hr, E, P, discrete: bool) -> tuple[float, dict[str, float]]:
-    """:func:`_verify_one` of :func:`_stability_blocks_fast` (``P`` symmetric), with fewer small array operations."""
+    """:func:`_verify` of :func:`_batched_blocks` for one design (``P`` symmetric), with fewer array operations."""
     n, p = A.shape[0], Hr.shape[1]
     M = np.empty((n + p, n + p))
     if discrete:
@@ -380,33 +381,6 @@ def _certify_one(A, Hr, E, P, discrete: bool) -> tuple[float, dict[str, float]]:
         lo, hi = float(w[0]), float(w[-1])
         cert[key] = lo
         score = min(score, lo / max(1.0, abs(lo), abs(hi)))
-    return score, cert
-
-
-def _stability_blocks_fast(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
-    """:func:`_stability_blocks` at radius 1 of ``(A, Hr, E)`` without block_diag."""
-    n, p = A.shape[0], Hr.shape[1]
-    AH = np.concatenate([A, Hr], axis=1)
-    if discrete:
-        M = -(AH.T @ P @ AH)
-        M[:n, :n] += P
-    else:
-        S = P @ AH
-        M = np.zeros((n + p, n + p))
-        M[:n, :] = -S
-        M[:, :n] -= S.T
-    M[:n, :n] -= E.T @ E
-    M[n:, n:] += _hinfnorm.eye(p)
-    return {"P": P, "lyapunov": M}
-
-
-def _verify_one(blocks: Mapping[str, np.ndarray]) -> tuple[float, dict[str, float]]:
-    """:func:`_verify` of one design."""
-    score, cert = np.inf, {}
-    for key, M in blocks.items():
-        ev = _hinfnorm.eigvalsh(0.5 * (M + M.T)[None])[0]
-        cert[key] = float(ev[0])
-        score = min(score, float(ev[0]) / max(1.0, abs(float(ev[0])), abs(float(ev[-1]))))
     return score, cert
 
 
