@@ -132,10 +132,12 @@ def dare(F, G, Q=None, R=None) -> tuple[np.ndarray, str]:
     arguments are checked like :func:`lqr`'s (``Q``, ``R`` may be ``None``: identity).
     """
     plant = Plant(F, G, 1.0)
-    return _dare(plant.F, plant.G, *_weights(plant, Q, R))
+    P, backend, _, _ = _dare(plant.F, plant.G, *_weights(plant, Q, R))
+    return P, backend
 
 
-def _dare(F, G, Q, R) -> tuple[np.ndarray, str]:
+def _dare(F, G, Q, R) -> tuple[np.ndarray, str, np.ndarray, float]:
+    """``(P, backend, K, relative residual)``: the stabilising solution, its gain ``u = K x`` (see :func:`dare`)."""
     reasons = []
     unstable = False
     for backend in ("slycot", "scipy"):
@@ -159,12 +161,13 @@ def _dare(F, G, Q, R) -> tuple[np.ndarray, str]:
         if not (np.all(np.isfinite(P)) and res < _RESIDUAL_TOL):
             reasons.append(f"{backend}: relative residual {res:.3g}")
             continue
-        A = F + G @ _gain(F, G, R, P)
+        K = _gain(F, G, R, P)
+        A = F + G @ K
         if not is_schur_stable(A):
             unstable = True
             reasons.append(f"{backend}: the solution leaves F + G K with spectral radius {spectral_radius(A):.17g}")
             continue
-        return P, backend
+        return P, backend, K, res
     why = "(is (F, G) stabilisable and (Q^1/2, F) detectable?)"
     if unstable:
         circle = _unobservable_on_circle(F, Q)
@@ -220,7 +223,5 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     check_plant(plant, discrete_for="lqr")
     Q, R = _weights(plant, Q, R)
     check_stabilizable(plant)
-    P, backend = _dare(plant.F, plant.G, Q, R)
-    K = _gain(plant.F, plant.G, R, P)
-    return Controller(K, "lqr", plant, {"P": P, "backend": backend,
-                                        "residual": _residual(plant.F, plant.G, Q, R, P)})
+    P, backend, K, residual = _dare(plant.F, plant.G, Q, R)
+    return Controller(K, "lqr", plant, {"P": P, "backend": backend, "residual": residual})
