@@ -127,7 +127,7 @@ class MarginsReport:
                 f"margin=\n{np.array2string(self.margin, precision=4)})")
 
 
-def _model(name: str, model, plant: Plant) -> NormBounded | list[Plant]:
+def _model(name: str, model) -> NormBounded | list[Plant]:
     if isinstance(model, NormBounded):
         return model
     if isinstance(model, (str, bytes)) or not isinstance(model, Sequence) or not model \
@@ -206,7 +206,7 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
     if not isinstance(models, Mapping) or not models:
         raise TypeError("models must be a non-empty mapping of name -> NormBounded or list of Plant")
     laws = {str(c): _law(str(c), law) for c, law in controllers.items()}
-    checked = {str(k): _model(str(k), m, plant) for k, m in models.items()}
+    checked = {str(k): _model(str(k), m) for k, m in models.items()}
     results: dict[str, Mapping[str, RobustStability | str]] = {}
     for name, law in laws.items():
         nominal = law.augmented_plant(plant)

@@ -252,9 +252,7 @@ def code_manoeuvre(*, params: truck.TruckParameters | None = None) -> ReferenceP
     set-up (:data:`SETUPS`) along it is the code's ``x_ref`` (at our 0.1 s
     sampling, ZOH model).
     """
-    p = truck.PAPER_PARAMETERS if params is None else params
-    if not isinstance(p, truck.TruckParameters):
-        raise TypeError(f"params must be a TruckParameters, got {type(p).__name__}")
+    p = truck._params(params)
     _, a_per_kappa = truck.steady_state_cornering(0.0, params=p)
     L = 5.0 * p.v
     offset = 0.01 * L**2 / (2.0 * np.pi * a_per_kappa)
