@@ -72,7 +72,7 @@ from robustctl.pathfollow import PathFollowing, PathFollowingSetup
 
 from .._validation import as_matrix, check_int
 from ..tuning import TuningProblem
-from ..tuning.selection import SelectionResult, default_weights, monte_carlo_selection, scenario_errors
+from ..tuning.selection import SelectionResult, check_weights, default_weights, draw_errors, monte_carlo_selection
 from .applied import AppliedRLQRProblem
 from .generic import GenericRLQRProblem
 
@@ -514,15 +514,5 @@ def _general_selection(problem: TuningProblem, X_front, n_sims: int, seed, sampl
         F, _ = problem.evaluate_gains(designs.K[:designs.n_front])
         fin = np.all(np.isfinite(F), axis=1)
         weights = default_weights(F[fin] if fin.any() else np.ones((1, problem.n_obj)))
-    if sampler is None:
-        draws = draw_rng.integers(0, len(problem.scenarios), size=n_sims)
-        used = np.unique(draws)
-        per = scenario_errors(problem, designs.K, [problem.scenarios[i] for i in used], weights)
-        errors = per[:, np.searchsorted(used, draws)]
-    else:
-        if not callable(sampler):
-            raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, "
-                            f"got {type(sampler).__name__}")
-        draws = np.full(n_sims, -1)
-        errors = scenario_errors(problem, designs.K, [sampler(draw_rng) for _ in range(n_sims)], weights)
+    errors, draws = draw_errors(problem, designs.K, n_sims, draw_rng, sampler, check_weights(weights, problem.n_obj))
     return DesignSelection(designs=designs, deltas=draws, errors=errors, result=monte_carlo_selection(errors))

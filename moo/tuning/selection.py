@@ -43,7 +43,8 @@ import robustctl as rc
 
 from .._validation import as_float_array, check_int
 
-__all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "scenario_errors", "default_weights"]
+__all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "scenario_errors", "draw_errors",
+           "check_weights", "default_weights"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -159,11 +160,36 @@ def default_weights(F) -> np.ndarray:
     return np.where(np.isfinite(spread) & (spread > 0), 1.0 / np.where(spread > 0, spread, 1.0), 1.0)
 
 
-def _weights(weights, n_obj: int) -> np.ndarray:
+def check_weights(weights, n_obj: int) -> np.ndarray:
+    """``weights`` as ``n_obj`` finite non-negative floats (``ValueError`` naming ``weights`` otherwise)."""
     w = as_float_array(weights, "weights").ravel()
     if w.shape != (n_obj,) or not np.all(np.isfinite(w)) or np.any(w < 0):
         raise ValueError(f"weights must be {n_obj} finite non-negative numbers (one per objective), got {w}")
     return w
+
+
+def draw_errors(problem, K, n_sims: int, rng: np.random.Generator,
+                sampler: Callable[[np.random.Generator], rc.Plant] | None, weights) -> tuple[np.ndarray, np.ndarray]:
+    """The (designs, simulations) errors of ``K`` on ``n_sims`` drawn plants, and the draws.
+
+    Each simulation draws a scenario of ``problem`` (its index in ``draws``),
+    or a plant from ``sampler(rng)`` (``draws`` -1); every used scenario is
+    simulated once (:func:`scenario_errors`).
+    """
+    if sampler is None:
+        draws = rng.integers(0, len(problem.scenarios), size=n_sims)
+        used = np.unique(draws)
+        per = scenario_errors(problem, K, [problem.scenarios[i] for i in used], weights)
+        return per[:, np.searchsorted(used, draws)], draws
+    if not callable(sampler):
+        raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, got {type(sampler).__name__}")
+    plants = []
+    for _ in range(n_sims):
+        p = sampler(rng)
+        if not isinstance(p, rc.Plant):
+            raise TypeError(f"sampler must return a robustctl.Plant, got {type(p).__name__}")
+        plants.append(p)
+    return scenario_errors(problem, K, plants, weights), np.full(n_sims, -1)
 
 
 def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights) -> np.ndarray:
@@ -172,7 +198,7 @@ def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights) -> np.ndarr
     ``+inf`` where a design has NaN gains, is unstable on that plant or a goal is not finite there.
     """
     K = problem.check_gains(K)
-    w = _weights(weights, problem.n_obj)
+    w = check_weights(weights, problem.n_obj)
     E = np.empty((K.shape[0], len(plants)))
     for p, plant in enumerate(plants):
         F, _ = problem.evaluate_gains(K, [plant])
@@ -268,26 +294,8 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
         Ff = as_float_array(F, "F")
         fin = np.all(np.isfinite(Ff), axis=1) if Ff.ndim == 2 else None
         weights = default_weights(Ff[fin] if fin is not None and fin.any() else Ff)
-    w = _weights(weights, problem.n_obj)
-    if sampler is None:
-        S = len(problem.scenarios)
-        draws = rng.integers(0, S, size=n_sims)
-        used = np.unique(draws)
-        per = scenario_errors(problem, Kc, [problem.scenarios[i] for i in used], w)
-        col = np.searchsorted(used, draws)
-        E = per[:, col]
-    else:
-        if not callable(sampler):
-            raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, "
-                            f"got {type(sampler).__name__}")
-        draws = np.full(n_sims, -1)
-        plants = []
-        for _ in range(n_sims):
-            p = sampler(rng)
-            if not isinstance(p, rc.Plant):
-                raise TypeError(f"sampler must return a robustctl.Plant, got {type(p).__name__}")
-            plants.append(p)
-        E = scenario_errors(problem, Kc, plants, w)
+    w = check_weights(weights, problem.n_obj)
+    E, draws = draw_errors(problem, Kc, n_sims, rng, sampler, w)
     res = monte_carlo_selection(E)
     Kbest = Kc[res.best]
     ctrl = rc.Controller(Kbest, method, problem.scenarios[0] if plant is None else plant,
