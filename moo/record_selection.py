@@ -46,6 +46,7 @@ import robustctl as rc
 from ._validation import check_int
 from .store import load_records, read_record, validate_record
 from .tuning import TuningProblem
+from .tuning.tune import design_plant
 
 __all__ = ["RecordFront", "RecordSelection", "load_source", "front_from_records", "select_from_records",
            "select_on_front"]
@@ -250,18 +251,11 @@ class RecordSelection:
                 f"front={len(self.front)})")
 
 
-def _design_plant(problem) -> rc.Plant:
-    plant = getattr(problem, "plant", None)
-    if not isinstance(plant, rc.Plant):
-        plant = getattr(problem.family, "plant", None)
-    return plant if isinstance(plant, rc.Plant) else problem.scenarios[0]
-
-
 def _margin(problem, K: np.ndarray) -> float | None:
     uncertainty = getattr(problem, "uncertainty", None)
     if not isinstance(uncertainty, rc.NormBounded) or not np.all(np.isfinite(K)):
         return None
-    return _plain(rc.robust_stability((_design_plant(problem), K), uncertainty).margin)
+    return _plain(rc.robust_stability((design_plant(problem), K), uncertainty).margin)
 
 
 def select_from_records(records: list[dict], problem, *, problem_name: str, algorithm: str | None = None,
@@ -297,12 +291,10 @@ def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=Non
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"select needs a moo.tuning.TuningProblem, got a {type(problem).__name__}")
     n_sims = check_int(n_sims, "n_sims", 1)
-    from .problems.applied import AppliedRLQRProblem
-    from .problems.generic import GenericRLQRProblem
-    from .problems.selection import select_design
+    from .problems.selection import is_paper_problem, select_design
     from .tuning.tune import select_front
 
-    if isinstance(problem, (GenericRLQRProblem, AppliedRLQRProblem)):      # the paper's: their own rule
+    if is_paper_problem(problem):                                           # the paper's: their own rule
         ds = select_design(problem, front.X, n_sims=n_sims, seed=seed)
         best = ds.best
         index = best if ds.designs.kinds[best] == "front" else None

@@ -78,7 +78,7 @@ from .generic import GenericRLQRProblem
 
 __all__ = [
     "SelectionResult", "DesignSet", "DesignSelection", "monte_carlo_selection", "draw_deltas",
-    "overload_from_delta", "generic_errors", "applied_errors", "build_designs", "select_design",
+    "overload_from_delta", "generic_errors", "applied_errors", "build_designs", "select_design", "is_paper_problem",
     "MAX_OVERLOAD", "BRYSON_SCALES", "error_scales",
 ]
 
@@ -337,7 +337,8 @@ def _check_problem(problem) -> None:
                         f"AppliedRLQRProblem), got {type(problem).__name__}")
 
 
-def _paper(problem) -> bool:
+def is_paper_problem(problem) -> bool:
+    """True for the paper's two problems, which keep the paper's design sets and selection rule."""
     return isinstance(problem, (GenericRLQRProblem, AppliedRLQRProblem))
 
 
@@ -386,7 +387,7 @@ def build_designs(problem: TuningProblem, X_front, *, seed=None) -> DesignSet:
     """
     _check_problem(problem)
     X = as_matrix(X_front, "X_front", cols=problem.n_var, cols_what="the problem's number of variables")
-    if not _paper(problem):
+    if not is_paper_problem(problem):
         return _general_designs(problem, X, seed)
     if np.any(X[:, -1] < 0):
         raise ValueError(f"X_front's last variable, (log10 mu)^2, must be >= 0, got {X[:, -1].min():g}")
@@ -486,7 +487,7 @@ def select_design(problem: TuningProblem, X_front, *, n_sims: int = 1000, seed=N
     """
     _check_problem(problem)
     n_sims = check_int(n_sims, "n_sims", 1)
-    if not _paper(problem):
+    if not is_paper_problem(problem):
         if path is not None or scales is not None:
             raise ValueError("path and scales apply to the applied problem only; give None")
         return _general_selection(problem, X_front, n_sims, seed, sampler, weights)

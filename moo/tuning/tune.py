@@ -22,7 +22,7 @@ from ..runner import RunResult, prepare_on
 from .problem import TuningProblem
 from .selection import Selection, select
 
-__all__ = ["tune", "TuningResult", "select_front"]
+__all__ = ["tune", "TuningResult", "select_front", "design_plant"]
 
 
 def _method(family) -> str:
@@ -30,7 +30,7 @@ def _method(family) -> str:
     return {"RLQRFamily": "rlqr", "LQRFamily": "lqr"}.get(name, "tuned")
 
 
-def _design_plant(problem: TuningProblem) -> rc.Plant:
+def design_plant(problem: TuningProblem) -> rc.Plant:
     """The family's design plant (``family.plant``), else the first scenario."""
     plant = getattr(problem.family, "plant", None)
     return plant if isinstance(plant, rc.Plant) else problem.scenarios[0]
@@ -67,7 +67,7 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
         raise ValueError("the front is empty (no design stabilised every scenario): nothing to select")
     X = problem.population(X, "X")
     return select(problem, problem.gains(X).K, F=F, n_sims=n_sims, seed=seed, sampler=sampler, weights=weights,
-                  plant=_design_plant(problem), method=_method(problem.family))
+                  plant=design_plant(problem), method=_method(problem.family))
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -96,7 +96,7 @@ class TuningResult:
         return self.problem.gains(self.X).K
 
     def _plant(self) -> rc.Plant:
-        return _design_plant(self.problem)
+        return design_plant(self.problem)
 
     def controllers(self) -> list[rc.Controller]:
         """One :class:`robustctl.Controller` per front design (its ``info`` holds ``z`` and the objectives).
