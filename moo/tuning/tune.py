@@ -9,6 +9,7 @@ hypervolume history at ``hv_ref_point``), so a tuning run is the same run
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -90,10 +91,12 @@ class TuningResult:
     F: np.ndarray
     run: RunResult
 
-    @property
+    @functools.cached_property
     def gains(self) -> np.ndarray:
-        """Gains (N, m, n) of the front (``u = K x`` for the scenario plants; NaN rows: failed designs)."""
-        return self.problem.gains(self.X).K
+        """Gains (N, m, n) of the front (``u = K x`` for the scenarios; NaN rows: failed designs), designed once."""
+        K = self.problem.gains(self.X).K
+        K.flags.writeable = False
+        return K
 
     def _plant(self) -> rc.Plant:
         return design_plant(self.problem)
