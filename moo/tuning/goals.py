@@ -286,10 +286,10 @@ class Response:
 
     def simulator(self, plants) -> LinearSimulator:
         """The simulator of ``plants`` (built once per list of plant objects)."""
+        if self._sim is not None and isinstance(plants, Sequence) and len(self._sim[0]) == len(plants) \
+                and all(a is b for a, b in zip(self._sim[0], plants, strict=True)):
+            return self._sim[1]                   # the same plant objects: checked when the simulator was built
         key = tuple(check_scenarios(plants))
-        if self._sim is not None and len(self._sim[0]) == len(key) \
-                and all(a is b for a, b in zip(self._sim[0], key, strict=True)):
-            return self._sim[1]
         self.check(key)
         n = key[0].n
         F, G = _stacks(list(key))
@@ -308,7 +308,8 @@ class Response:
         """
         trajectories = trajectories or self._keep
         sim = self.simulator(plants)
-        key = self._sim[0] if self._sim is not None else ()
+        assert self._sim is not None              # set by simulator()
+        key = self._sim[0]
         Kb = _gains(K, list(key))
         last = self._last
         if last is not None and last[0] is key and last[1].shape == Kb.shape and np.array_equal(last[1], Kb) \
