@@ -298,10 +298,6 @@ class AppliedRLQRProblem(TuningProblem):
         K = self.check_gains(K)
         return self.errors.per_scenario(K)
 
-    def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
-        """:meth:`mse` (the objectives before aggregation and penalties)."""
-        return self.mse(K)
-
     def __repr__(self) -> str:
         return (f"AppliedRLQRProblem(setup={self.setup.name!r}, n_var={self.n_var}, n_obj={self.n_obj}, "
                 f"overloads={tuple(self.overloads.tolist())}, T={self.path.T}, aggregate={self.aggregate!r})")

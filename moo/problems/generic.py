@@ -324,13 +324,9 @@ class GenericRLQRProblem(TuningProblem):
         e = np.full((*rho.shape, self.plant.n), np.inf)
         some = stable.any(axis=1)
         if some.any():
-            e[some] = self.scenario_objectives(K[some])
+            e[some] = self.errors.per_scenario(K[some])
         e[~stable] = np.inf
         return e, rho
-
-    def scenario_objectives(self, K: np.ndarray) -> np.ndarray:
-        """Regulation errors (B, S, 3) of stable gains (:meth:`regulation_errors` without the screen)."""
-        return self.errors.per_scenario(K)
 
     def __repr__(self) -> str:
         return (f"GenericRLQRProblem(n_var={self.n_var}, n_obj={self.n_obj}, S={self.deltas.size}, "
