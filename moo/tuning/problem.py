@@ -349,12 +349,11 @@ class TuningProblem(Problem):
         return super().evaluate(arr[0] if np.ndim(X) == 1 else arr, *args, **kwargs)
 
     def _evaluate(self, x, out, *args, **kwargs):
-        z = self.population(x, "X")
-        fg = self.gains(z)
+        fg = self.gains(x)                     # checks the population
         ok, K = fg.ok, fg.K
         stable, rho = self.stability(K)
         run = ok & stable.all(axis=1)
-        B = z.shape[0]
+        B = K.shape[0]
         J = np.full((B, self.n_obj), np.inf)
         C = np.full((B, self.n_ieq_constr), np.inf)
         flags = np.where(ok, np.where(run, "", "unstable"), fg.reason).astype(object)
