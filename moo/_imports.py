@@ -144,26 +144,25 @@ def build_algorithm(name: str, *, n_obj: int, pop_size: int) -> Algorithm:
     return alg
 
 
+def _record_key(name: object, registry, unknown: str) -> str:
+    """A registry name in lower case, or an import path as given (stripped); ``ValueError(unknown; valid: ...)``."""
+    if is_import_path(name):
+        assert isinstance(name, str)
+        return name.strip()
+    if not isinstance(name, str) or name.lower() not in registry:
+        raise ValueError(f"{unknown}; valid: {', '.join(registry)} or module.path:factory")
+    return name.lower()
+
+
 def check_problem_name(name: object) -> str:
     """The record key of a problem: a registry name in lower case, an import path as given."""
     from moo.problems import PROBLEMS
 
-    if is_import_path(name):
-        assert isinstance(name, str)
-        return name.strip()
-    if not isinstance(name, str) or name.lower() not in PROBLEMS:
-        raise ValueError(f"unknown problem {name!r}; valid: {', '.join(PROBLEMS)} or module.path:factory")
-    return name.lower()
+    return _record_key(name, PROBLEMS, f"unknown problem {name!r}")
 
 
 def check_algorithm_name(name: object) -> str:
     """The record key of an algorithm: a registry name in lower case, an import path as given."""
     from moo.algorithms import ALGORITHMS
 
-    if is_import_path(name):
-        assert isinstance(name, str)
-        return name.strip()
-    if not isinstance(name, str) or name.lower() not in ALGORITHMS:
-        raise ValueError(f"unknown algorithm {name!r} in algorithms; valid: {', '.join(ALGORITHMS)} "
-                         "or module.path:factory")
-    return name.lower()
+    return _record_key(name, ALGORITHMS, f"unknown algorithm {name!r} in algorithms")
