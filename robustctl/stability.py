@@ -40,7 +40,7 @@ from ._validation import as_float_array, as_matrix, check_square
 from .errors import NotStabilizableError
 
 __all__ = ["STABILITY_MARGIN", "spectral_radius", "spectral_abscissa", "is_schur_stable", "is_stable",
-           "immovable_modes", "unstabilizable_modes", "check_stabilizable"]
+           "stability_of_eigenvalues", "immovable_modes", "unstabilizable_modes", "check_stabilizable"]
 
 #: A discrete loop is stable when ``rho(A) < 1 - STABILITY_MARGIN``.
 STABILITY_MARGIN = 1e-9
@@ -127,6 +127,18 @@ def is_schur_stable(A, margin: float = STABILITY_MARGIN) -> np.ndarray | bool:
     A = _stack(A)
     out = _schur(A.reshape(-1, *A.shape[-2:]), 1.0 - margin).reshape(A.shape[:-2])
     return bool(out) if out.ndim == 0 else out
+
+
+def stability_of_eigenvalues(lam, *, discrete: bool,
+                             margin: float = STABILITY_MARGIN) -> tuple[np.ndarray, np.ndarray]:
+    """``(nominal, stable)`` of eigenvalues already computed, ``lam`` (..., n), row by row.
+
+    ``nominal`` is the spectral radius (``discrete``) or abscissa, ``stable``
+    whether it is below ``1 - margin`` (resp. ``-margin``), the rule of :func:`is_stable`.
+    """
+    lam = np.asarray(lam)
+    nominal = np.abs(lam).max(axis=-1) if discrete else lam.real.max(axis=-1)
+    return nominal, nominal < ((1.0 - margin) if discrete else -margin)
 
 
 def is_stable(A, *, discrete: bool, margin: float = STABILITY_MARGIN) -> bool:

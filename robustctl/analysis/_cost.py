@@ -18,7 +18,7 @@ from .._validation import as_batch, as_matrix, check_performance, check_spd
 from ..controller import Controller
 from ..errors import InfeasibleError
 from ..plant import Plant, _frozen
-from ..stability import STABILITY_MARGIN, is_stable
+from ..stability import is_stable, stability_of_eigenvalues
 from ..uncertainty import NormBounded, check_norm_bounded
 from ._common import (
     _COST_LMI_TOL,
@@ -124,10 +124,7 @@ def _guaranteed_cost_batch(plant: Plant, K: np.ndarray, unc: NormBounded, Q: np.
     E = unc.EF + unc.EG @ Kf
     H = unc.H
     lam_A = _hinfnorm.eigvals(A)
-    if discrete:
-        stable = np.abs(lam_A).max(axis=1) < 1.0 - STABILITY_MARGIN
-    else:
-        stable = lam_A.real.max(axis=1) < -STABILITY_MARGIN
+    _, stable = stability_of_eigenvalues(lam_A, discrete=discrete)
     stable &= finite
     reason = np.where(finite, np.where(stable, "ok", "unstable"), "not finite").astype("<U20")
     bound = np.where(finite, np.inf, np.nan)

@@ -20,7 +20,7 @@ from .. import _cvx, _hinfnorm
 from ..controller import Controller
 from ..errors import ConvergenceError, InfeasibleError
 from ..plant import Plant, _frozen, check_vertices
-from ..stability import STABILITY_MARGIN, is_stable
+from ..stability import is_stable, stability_of_eigenvalues
 from ..uncertainty import NormBounded, check_norm_bounded
 from ._common import (
     _BACKOFF,
@@ -208,12 +208,7 @@ def _norm_bounded_batch(plant: Plant, K: np.ndarray, unc: NormBounded) -> Robust
     A = plant.F + plant.G @ Kf
     E = unc.EF + unc.EG @ Kf
     lam = _hinfnorm.eigvals(A)
-    if discrete:
-        nominal = np.abs(lam).max(axis=1)
-        stable = nominal < 1.0 - STABILITY_MARGIN
-    else:
-        nominal = lam.real.max(axis=1)
-        stable = nominal < -STABILITY_MARGIN
+    nominal, stable = stability_of_eigenvalues(lam, discrete=discrete)
     margin = np.zeros(B)
     if not all_finite:
         stable &= finite
@@ -297,8 +292,9 @@ def _norm_bounded_stability(plant: Plant, K: np.ndarray, unc: NormBounded, *,
     A = plant.F + plant.G @ K
     H, E = unc.H, unc.EF + unc.EG @ K
     lam = _hinfnorm.eigvals(A[None])[0]
-    nominal = float(np.abs(lam).max() if discrete else lam.real.max())
-    if not nominal < ((1.0 - STABILITY_MARGIN) if discrete else -STABILITY_MARGIN):
+    radius, stable = stability_of_eigenvalues(lam, discrete=discrete)
+    nominal = float(radius)
+    if not stable:
         return RobustStability(False, 0.0, 0.0, None, MappingProxyType({}), "norm-bounded",
                                MappingProxyType({"nominal_radius": nominal}))
     g, peak, iterations, h2, method = _hinfnorm.norm_one(A, H, E, lam, discrete=discrete, method=norm)
