@@ -37,7 +37,8 @@ from .errors import ConvergenceError, InfeasibleError
 if TYPE_CHECKING:  # cvxpy itself is imported on first use
     import cvxpy as cp
 
-__all__ = ["LMI", "SolveReport", "solve_sdp", "check_solver", "certificate", "value", "totals", "SOLVER_TOL"]
+__all__ = ["LMI", "SolveReport", "solve_sdp", "check_solver", "SDP_SOLVERS", "certificate", "value", "totals",
+           "SOLVER_TOL"]
 
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
@@ -143,18 +144,30 @@ def _settings(solver: str, tol: float, refine: bool = True, decompose: bool = Tr
     return out
 
 
+#: The SDP solvers that cvxpy can call (:func:`check_solver` checks which are installed).
+SDP_SOLVERS = ("CLARABEL", "SCS", "MOSEK", "CVXOPT", "COPT", "SDPA")
+
+
 @functools.lru_cache(maxsize=1)
 def _installed_sdp_solvers() -> tuple[str, ...]:
     import cvxpy as cp  # installed_solvers() tries every import: ask once
 
-    return tuple(s for s in cp.installed_solvers() if s in ("CLARABEL", "SCS", "MOSEK", "CVXOPT", "COPT", "SDPA"))
+    return tuple(s for s in cp.installed_solvers() if s in SDP_SOLVERS)
 
 
-def check_solver(solver) -> str:
-    """Validate a cvxpy solver name (upper-cased); raise ValueError listing the installed ones."""
+def check_solver(solver, *, installed: bool = True) -> str:
+    """Validate a cvxpy solver name (upper-cased); raise ValueError listing the valid ones.
+
+    ``installed=False`` only checks that it names one of :data:`SDP_SOLVERS`
+    (cvxpy is then not imported; the synthesis's fast path defers the rest).
+    """
     if not isinstance(solver, str):
         raise TypeError(f"solver must be a string naming a cvxpy solver, got {type(solver).__name__}")
     name = solver.upper()
+    if not installed:
+        if name not in SDP_SOLVERS:
+            raise ValueError(f"solver must name a cvxpy SDP solver, one of {list(SDP_SOLVERS)}; got {solver!r}")
+        return name
     sdp = list(_installed_sdp_solvers())
     if name not in sdp:
         raise ValueError(f"solver must be an installed SDP solver, one of {sdp}; got {solver!r}")

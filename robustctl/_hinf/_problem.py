@@ -15,9 +15,6 @@ from ..regions import Region, as_regions, describe_regions
 from ..stability import check_stabilizable, immovable_modes
 from ..uncertainty import NormBounded, check_norm_bounded
 
-#: The SDP solvers that cvxpy can call (whether installed is checked by robustctl._cvx.check_solver).
-SDP_SOLVERS = ("CLARABEL", "SCS", "MOSEK", "CVXOPT", "COPT", "SDPA")
-
 __all__ = ["Problem", "validate", "check_stabilisable", "check_poles_reachable", "check_uncertainty",
            "vertex_name"]
 
@@ -77,7 +74,7 @@ def validate(plant, *, Bw, Cz, Dzu, Dzw, vertices, gamma, u_max, w_energy, backo
              solver, poles=None, uncertainty=None, defer_solver: bool = False) -> Problem:
     """Check every argument of :func:`robustctl.hinf` (errors name the argument) and stabilisability.
 
-    ``defer_solver``: only check that ``solver`` names an SDP solver cvxpy knows (``SDP_SOLVERS``); the
+    ``defer_solver``: only check that ``solver`` names an SDP solver cvxpy knows (``robustctl._cvx.SDP_SOLVERS``); the
     full check (:func:`robustctl._cvx.check_solver`, which imports cvxpy) is left
     to the caller, for a path that may not need an SDP solver at all.
     """
@@ -93,14 +90,7 @@ def validate(plant, *, Bw, Cz, Dzu, Dzw, vertices, gamma, u_max, w_energy, backo
     backoff = check_real(backoff, "backoff", minimum=0.0)
     if check_bool(extended, "extended") and not plant.is_discrete:
         raise ValueError("extended=True is the discrete-time slack-variable LMI; plant is continuous-time (dt=None)")
-    if not defer_solver:
-        solver = _cvx.check_solver(solver)
-    elif not isinstance(solver, str):
-        raise TypeError(f"solver must be a string naming a cvxpy solver, got {type(solver).__name__}")
-    elif solver.upper() not in SDP_SOLVERS:
-        raise ValueError(f"solver must name a cvxpy SDP solver, one of {list(SDP_SOLVERS)}; got {solver!r}")
-    else:
-        solver = solver.upper()
+    solver = _cvx.check_solver(solver, installed=not defer_solver)
     regions = as_regions(poles)
     uncertainty = check_uncertainty(uncertainty, plant)
     for name, given in (("poles", regions), ("uncertainty", uncertainty)):
