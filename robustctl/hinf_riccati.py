@@ -238,8 +238,7 @@ def riccati_level(plant: Plant, gamma: float, *, Bw: ArrayLike, Cz: ArrayLike, D
     """
     data, b, c = _data(plant, Bw, Cz, Dzu, Dzw)
     gamma = check_positive_scalar(gamma, "gamma")
-    level = _level_discrete if plant.is_discrete else _level_continuous
-    sol = level(*data, gamma / (b * c))
+    sol = level_gain(data, gamma / (b * c), discrete=plant.is_discrete)
     return None if sol is None else (sol[0], c**2 * sol[1])
 
 
@@ -299,13 +298,12 @@ def bisect_level(data: _Data, *, discrete: bool, rtol: float, gamma_max: float
     P, iterations)``: ``K`` and ``P`` of the level ``gamma_high``, the smallest
     found feasible. Raises InfeasibleError if no level up to ``gamma_max`` is.
     """
-    level = _level_discrete if discrete else _level_continuous
     lo = float(np.linalg.norm(data[-1], 2))
     hi = max(1.0, 2.0 * lo)
     its = 0
     while True:
         its += 1
-        sol = level(*data, hi)
+        sol = level_gain(data, hi, discrete=discrete)
         if sol is not None:
             break
         lo, hi = hi, 2.0 * hi
@@ -315,7 +313,7 @@ def bisect_level(data: _Data, *, discrete: bool, rtol: float, gamma_max: float
     while hi - lo > rtol * hi:
         mid = np.sqrt(lo * hi) if lo > 0 else 0.5 * hi
         its += 1
-        sol = level(*data, mid)
+        sol = level_gain(data, mid, discrete=discrete)
         if sol is None:
             lo = mid
         else:
