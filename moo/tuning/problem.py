@@ -41,7 +41,7 @@ from robustctl.validation import check_positive_scalar
 
 from .._validation import as_float_array, as_matrix, check_int
 from .families import DesignFamily, FamilyGains, _bounds, check_bounds, population
-from .goals import check_scenarios
+from .goals import _stacks, check_scenarios
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
 
@@ -183,8 +183,7 @@ class TuningProblem(Problem):
         n_obj = len(self.objectives)
         self.hv_ref_point = _ref_point(hv_ref_point, "hv_ref_point", np.full(n_obj, self.penalty))
         self.molsp_ref_point = _ref_point(molsp_ref_point, "molsp_ref_point", self.hv_ref_point)
-        self._F_s = np.stack([p.F for p in self.scenarios])
-        self._G_s = np.stack([p.G for p in self.scenarios])
+        self._F_s, self._G_s = _stacks(self.scenarios)
         self.last_flags = np.zeros(0, dtype=object)
         super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=len(self.constraints), xl=lo, xu=hi, vtype=float)
 
@@ -229,8 +228,7 @@ class TuningProblem(Problem):
         if scenarios is None:
             F_s, G_s = self._F_s, self._G_s
         else:
-            plants = check_scenarios(scenarios, "scenarios")
-            F_s, G_s = np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
+            F_s, G_s = _stacks(check_scenarios(scenarios, "scenarios"))
         return F_s[None] + G_s[None] @ K[:, None]
 
     def closed_loop_radius(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
