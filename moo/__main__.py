@@ -74,7 +74,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import errno
 import os
 import re
 import sys
@@ -85,6 +84,7 @@ from contextlib import contextmanager, nullcontext
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
 from moo.problems import PROBLEMS
+from moo.store import DISK_ERRORS
 
 __all__ = ["main"]
 
@@ -280,9 +280,6 @@ def _cmd_run(args) -> int:
     return 0
 
 
-#: errno values of a write that failed for lack of room or rights (reported in one line, exit 1).
-_DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EACCES, errno.EPERM, errno.EIO})
-
 
 def _os_reason(exc: OSError) -> str:
     """``strerror`` of a disk error (``No space left on device``), else its first line."""
@@ -340,7 +337,7 @@ def _cmd_experiment(args) -> int:
     except ConnectionError as exc:
         return _error(str(exc), 1)
     except OSError as exc:
-        if exc.errno not in _DISK_ERRORS and exc.filename is None:
+        if exc.errno not in DISK_ERRORS and exc.filename is None:
             return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
         return _error(f"cannot write a record in {grid.out} ({_os_reason(exc)}); the records "
                       "written stay: free the space and rerun the same command to resume", 1)

@@ -50,6 +50,7 @@ from multiprocessing import get_context
 from typing import Any
 
 from moo._validation import check_choice, check_int
+from moo.store import DISK_ERRORS
 
 __all__ = ["EXECUTORS", "POOL_RESTARTS", "PARENT_POLL", "SchedulerLostError", "open_executor"]
 
@@ -205,6 +206,8 @@ def _scheduler_lost(client: Any, exc: BaseException) -> bool:
 
     from distributed.comm.core import CommClosedError
 
+    if isinstance(exc, OSError) and exc.errno in DISK_ERRORS:
+        return False                       # the driver's own write failed (a full disk), not the scheduler
     if isinstance(exc, (CancelledError, AsyncCancelled, CommClosedError, OSError, TimeoutError)):
         return True
     return getattr(client, "status", "running") not in ("running", "connecting")

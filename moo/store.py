@@ -55,6 +55,7 @@ records, so they need no shared file system.
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import math
 import os
@@ -74,7 +75,7 @@ __all__ = ["write_json_atomic", "write_text_atomic", "atomic_path", "read_record
            "variant_dir", "is_import_path", "safe_name", "lock_results_dir", "ResultsDirBusyError",
            "SettingsMismatchError", "settings_mismatch", "CorruptRecordError", "read_settings", "write_settings",
            "check_settings", "RECORD_NAME", "FAILED_SUFFIX", "SETTINGS_NAME", "DIR_FIELDS", "PROBLEM_FIELDS",
-           "LOCK_NAME"]
+           "LOCK_NAME", "DISK_ERRORS"]
 
 #: File names of finished-run records (``seed_<s>.json``).
 RECORD_NAME = re.compile(r"^seed_(\d+)\.json$")
@@ -90,6 +91,10 @@ DIR_FIELDS = ("budget", "pop_size", "max_leaders", "base_seed")
 PROBLEM_FIELDS = ("problem", "n_obj", "setup")
 
 _REQUIRED = ("problem", "n_obj", "algorithm", "molsp", "seed", "F")
+
+
+#: errno values of a write that failed for lack of room or rights (a disk error, not a failed run or executor).
+DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EACCES, errno.EPERM, errno.EIO})
 
 
 class ResultsDirBusyError(ValueError):

@@ -197,3 +197,21 @@ def test_unparsable_scheduler_is_a_usage_error(tmp_path, capsys):
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "--scheduler must be an address such as 'tcp://HOST:8786'" in err, err
     assert not (tmp_path / "r").exists()
+
+
+def test_full_disk_under_dask_is_a_disk_error_not_a_lost_scheduler(tmp_path, capsys, monkeypatch):
+    """The driver's record write failing for lack of room is reported as such (exit 1), not as a lost scheduler."""
+    import errno
+
+    from moo.__main__ import main
+
+    def no_space(*args, **kwargs):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "fsync", no_space)             # every atomic write's last step (the driver writes)
+    out = tmp_path / "res"
+    code = main(["experiment", "--problem", "zdt1", "--algorithms", "nsga2", "--runs", "1", "--evals", "40",
+                 "--pop-size", "20", "--out", str(out), "--executor", "dask", "--workers", "1"])
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert code == 1, err
+    assert f"cannot write a record in {out} (No space left on device)" in err and "scheduler" not in err
