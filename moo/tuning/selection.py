@@ -267,7 +267,7 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     ----------
     problem : TuningProblem
     K : (D, m, n) array_like
-        Candidate gains (e.g. a front's, :attr:`TuningResult.gains <moo.tuning.TuningResult.gains>`).
+        Candidate gains (e.g. a front's, ``TuningResult.gains``).
     F : (D, n_obj) array_like, optional
         Their objectives, for the default weights (:func:`default_weights`);
         default: evaluated on the problem's scenarios.
