@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..hinf_riccati import bisect_level, level_gain
-from ._coordinates import Coordinates, lqr_coordinates
+from ._coordinates import Coordinates
 from ._gains import Gain, riccati_certified
 from ._problem import Problem
 
@@ -56,8 +56,12 @@ class RiccatiPath:
     reason: str = ""
 
 
-def riccati_synthesis(problem: Problem, data: Coordinates) -> RiccatiPath:
+def riccati_synthesis(problem: Problem, data: Coordinates, lqr: Coordinates | None) -> RiccatiPath:
     """Steps 1-3 of the module docstring on ``data`` (one plant; levels returned unscaled).
+
+    The certificate is checked in the LQR coordinates ``lqr`` of ``data``
+    (:func:`._coordinates.lqr_coordinates`, where ``X ~ I`` as for the SDP;
+    shared with the SDP fallback), then in ``data`` itself.
 
     Raises InfeasibleError when no level up to ``GAMMA_MAX`` is feasible
     (the plant is stabilisable, as validated, so this means a degenerate
@@ -74,7 +78,7 @@ def riccati_synthesis(problem: Problem, data: Coordinates) -> RiccatiPath:
                            "the game Riccati equation failed its checks at the gain's level")
     K = sol[0]
     gain = None
-    for coords in _certificate_coordinates(problem, data):
+    for coords in (c for c in (lqr, data) if c is not None):
         K_c = K @ np.linalg.solve(data.T, coords.T)   # u = K x_data, x_data = T_data^-1 T_coords x_coords
         gain = riccati_certified(problem, coords, K_c, hi / scale * (1.0 + backoff), backoff, "riccati")
         if gain is not None:
@@ -83,14 +87,6 @@ def riccati_synthesis(problem: Problem, data: Coordinates) -> RiccatiPath:
         return RiccatiPath(None, hi / scale, lo / scale, its,
                            "no strictly positive LMI certificate at the backed-off level")
     return RiccatiPath(gain, hi / scale, lo / scale, its)
-
-
-def _certificate_coordinates(problem: Problem, data: Coordinates):
-    """Where the certificate is checked: the LQR coordinates (``X ~ I``, as for the SDP), then ``data``."""
-    lqr = lqr_coordinates(data, problem.discrete)
-    if lqr is not None:
-        yield lqr
-    yield data
 
 
 def check_plain(problem: Problem) -> None:

@@ -216,7 +216,8 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     w_scale, z_unit = channel_scales(problem.Bw, problem.Cz, problem.Dzu, problem.Dzw, problem.w_energy)
     balanced = normalised([p.F for p in problem.plants], [p.G for p in problem.plants], problem.Bw, problem.Cz,
                           problem.Dzu, problem.Dzw, w_scale, problem.uncertainty, z_unit=z_unit)
-    fast = _riccati(problem, balanced) if synthesis == "riccati" else None
+    lqr = _lqr(problem, balanced)
+    fast = _riccati(problem, balanced, lqr) if synthesis == "riccati" else None
     if fast is not None and fast.gain is None:  # the SDP is needed after all: check the solver now
         problem = replace(problem, solver=_cvx.check_solver(problem.solver))
     solves: tuple[dict, ...]
@@ -224,10 +225,10 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         gain, gamma_opt, used_backoff, solves = fast.gain, fast.gamma_opt, problem.backoff, ()
         level = gamma_opt * (1.0 + used_backoff)
     elif problem.gamma is not None:
-        gain, solves = gain_at_level(problem, _lqr(problem, balanced) or balanced, problem.gamma)
+        gain, solves = gain_at_level(problem, lqr or balanced, problem.gamma)
         level, gamma_opt, used_backoff = problem.gamma, None, None
     else:
-        opt = minimise_level(problem, balanced, _lqr(problem, balanced))
+        opt = minimise_level(problem, balanced, lqr)
         gain, used_backoff, centring = gain_near_optimum(problem, opt)
         level, gamma_opt, solves = opt.gamma_opt * (1.0 + used_backoff), opt.gamma_opt, opt.solves + centring
     K, X = gain.data.to_original(gain.point.gain(), gain.point.nominal_lyapunov())
@@ -246,10 +247,10 @@ def _lqr(problem: Problem, balanced):
     return None if problem.polytopic else lqr_coordinates(balanced, problem.discrete)
 
 
-def _riccati(problem: Problem, balanced) -> RiccatiPath:
+def _riccati(problem: Problem, balanced, lqr) -> RiccatiPath:
     """The fast path; a bisection that finds no level becomes a fallback reason (the SDP then decides)."""
     try:
-        return riccati_synthesis(problem, balanced)
+        return riccati_synthesis(problem, balanced, lqr)
     except InfeasibleError as exc:
         return RiccatiPath(None, float("nan"), float("nan"), 0, str(exc))
 

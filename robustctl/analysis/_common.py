@@ -107,6 +107,28 @@ def _block(A: np.ndarray, B: np.ndarray, P, N, discrete: bool):
     return -(S + S.T) - N
 
 
+def _blocks(A: np.ndarray, H: np.ndarray, P: np.ndarray, W: np.ndarray, lam, discrete: bool) -> np.ndarray:
+    """:func:`_block` for stacks with ``B = H`` and ``N = diag(W, -lam I)``: shape (S, n + p, n + p).
+
+    ``A``, ``P``, ``W`` (S, n, n); ``H`` (S, n, p) or one (n, p) for all;
+    ``lam`` a number or (S,). Discrete: ``[[P - A'PA - W, -A'PH], [-H'PA,
+    lam I - H'PH]]``; continuous: ``[[-He(PA) - W, -PH], [-H'P, lam I]]``.
+    """
+    S, n, p = A.shape[0], A.shape[-1], H.shape[-1]
+    AH = np.concatenate([A, np.broadcast_to(H, (S, n, p))], axis=-1)
+    if discrete:
+        M = -(AH.mT @ P @ AH)
+        M[:, :n, :n] += P
+    else:
+        PAH = P @ AH
+        M = np.zeros((S, n + p, n + p))
+        M[:, :n, :] = -PAH
+        M[:, :, :n] -= PAH.mT
+    M[:, :n, :n] -= W
+    M[:, n:, n:] += np.asarray(lam)[..., None, None] * np.eye(p)
+    return M
+
+
 def _diag(*blocks: np.ndarray) -> np.ndarray:
     return scipy.linalg.block_diag(*blocks)
 

@@ -23,6 +23,7 @@ from ..uncertainty import NormBounded, check_norm_bounded
 from ._common import (
     _COST_LMI_TOL,
     _block,
+    _blocks,
     _Coordinates,
     _diag,
     _loop,
@@ -82,19 +83,7 @@ def _cost_objective(P: np.ndarray, x0: np.ndarray | None) -> np.ndarray:
 
 def _cost_lmi_eigs(A, H, E, QK, P, lam, discrete: bool) -> np.ndarray:
     """Eigenvalues (S, n + p), ascending, of the guaranteed-cost LMI at ``(P, lam)`` for stacks."""
-    S, n = A.shape[0], A.shape[-1]
-    p = H.shape[-1]
-    AH = np.concatenate([A, np.broadcast_to(H, (S, n, p))], axis=-1)
-    if discrete:
-        M = -(AH.mT @ P @ AH)
-        M[:, :n, :n] += P
-    else:
-        Sx = P @ AH
-        M = np.zeros((S, n + p, n + p))
-        M[:, :n, :] = -Sx
-        M[:, :, :n] -= Sx.mT
-    M[:, :n, :n] -= QK + lam[:, None, None] * (E.mT @ E)
-    M[:, n:, n:] += lam[:, None, None] * np.eye(p)
+    M = _blocks(A, H, P, QK + lam[:, None, None] * (E.mT @ E), lam, discrete)
     return np.linalg.eigvalsh(0.5 * (M + M.mT))
 
 

@@ -32,6 +32,7 @@ from ._common import (
     _SDA_MIN_N,
     _STRICT,
     _block,
+    _blocks,
     _Coordinates,
     _diag,
     _loop,
@@ -103,19 +104,7 @@ def _norm_bounded_sdp(plant: Plant, K: np.ndarray, unc: NormBounded) -> RobustSt
 
 def _batched_blocks(A, Hr, E, P, discrete: bool) -> dict[str, np.ndarray]:
     """:func:`_stability_blocks` for stacks (``Hr`` (B, n, p) already scaled by the radius)."""
-    n, p = A.shape[-1], Hr.shape[-1]
-    AH = np.concatenate([A, Hr], axis=-1)
-    if discrete:
-        M = -(AH.mT @ P @ AH)
-        M[:, :n, :n] += P
-    else:
-        S = P @ AH
-        M = np.zeros_like(S, shape=(A.shape[0], n + p, n + p))
-        M[:, :n, :] = -S
-        M[:, :, :n] -= S.mT
-    M[:, :n, :n] -= E.mT @ E
-    M[:, n:, n:] += np.eye(p)
-    return {"P": P, "lyapunov": M}
+    return {"P": P, "lyapunov": _blocks(A, Hr, P, E.mT @ E, 1.0, discrete)}
 
 
 def _verify(blocks: Mapping[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
