@@ -129,9 +129,9 @@ def _stacks(plants: list[rc.Plant]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _closed_loops(K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
-    """``A = F_s + G_s K_b`` of every design and scenario, shape (B, S, n, n)."""
+    """``A = F_s + G_s K_b`` of every design and scenario, shape (B, S, n, n) (the same product as the problem's)."""
     F, G = _stacks(plants)
-    return F[None] + np.einsum("snm,bmk->bsnk", G, K)
+    return F[None] + G[None] @ K[:, None]
 
 
 def _reduce(values: np.ndarray, over: str) -> np.ndarray:
