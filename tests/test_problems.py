@@ -550,7 +550,8 @@ def test_paper_mops_are_tuning_problems_with_one_simulation_per_population(appli
         assert len(p.objectives) == p.n_obj and p.n_ieq_constr == 0
     calls = []
     real = applied_short.errors.per_scenario
-    monkeypatch.setattr(applied_short.errors, "per_scenario", lambda K: calls.append(len(K)) or real(K))
+    monkeypatch.setattr(applied_short.errors, "per_scenario",
+                        lambda K, plants=None: calls.append(len(K)) or real(K, plants))
     F = applied_short.evaluate(APPLIED_Z)
     assert len(calls) == 1                                     # four objectives, one simulation
     stable = F[:, 0] < applied_short.penalty

@@ -33,7 +33,7 @@ from typing import ClassVar, Literal
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import BACKENDS, DEFAULT_BOUND
+from robustctl.batchsim import DEFAULT_BOUND
 from robustctl.models import morais2022, truck
 from robustctl.models.morais2022 import get_setup
 from robustctl.path import ReferencePath, default_route
@@ -41,6 +41,7 @@ from robustctl.pathfollow import PathFollowing, PathFollowingSetup
 from robustctl.validation import check_positive_scalar
 
 from ..tuning import RLQRFamily, TuningProblem
+from ._errors import ErrorColumn, ScenarioErrors
 from .generic import positive_ref_point
 
 __all__ = ["AppliedRLQRProblem", "PathFollowingErrors", "PathFollowingError"]
@@ -50,55 +51,47 @@ Z_LOWER = 1e-6
 Z_UPPER = 500.0
 
 
-class PathFollowingErrors:
-    """The path-following MSEs of gains on the payload scenarios, simulated once per population.
+class PathFollowingErrors(ScenarioErrors):
+    """The path-following MSEs of gains on the payload scenarios (:class:`AppliedRLQRProblem`).
 
     ``sim`` is the problem's :class:`robustctl.pathfollow.PathFollowing`;
     calling with gains ``K`` (B, 2, 4) returns the MSEs (B, 4) combined over the
-    scenarios (``mean`` or ``max``). The last ``K`` array (by identity) and
-    its result are kept, so the four goals :class:`PathFollowingError` of one
-    population cost one simulation. The simulator is built for the problem's
-    payloads: other plant lists are refused.
+    scenarios (``mean`` or ``max``); the last population's result is
+    memoised, so the four goals :class:`PathFollowingError` of one population
+    cost one simulation (:class:`~moo.problems._errors.ScenarioErrors`). The
+    simulator is built for the problem's payloads: other plant lists are
+    refused (``ValueError``).
+
+    Parameters
+    ----------
+    sim : robustctl.pathfollow.PathFollowing
+    plants : list of robustctl.Plant
+        The payload scenarios ``sim`` simulates.
+    aggregate : {"mean", "max"}
+    backend : {"numba", "numpy"}
     """
 
     def __init__(self, sim: PathFollowing, plants: list[rc.Plant], aggregate: str,
                  backend: Literal["numba", "numpy"]):
-        self.sim, self.plants, self.aggregate, self.backend = sim, plants, aggregate, backend
-        self._last: tuple = (None, None)
+        super().__init__(plants, aggregate, backend)
+        self.sim = sim
 
-    def per_scenario(self, K: np.ndarray) -> np.ndarray:
+    def per_scenario(self, K: np.ndarray, plants: list[rc.Plant] | None = None) -> np.ndarray:
         """MSEs (B, S, 4) of gains ``K`` (B, 2, 4), in the order f1..f4 (no penalties)."""
-        return self.sim.run(K, keep_trajectories=False, backend=self.backend).mse()
-
-    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
-        """Combined MSEs (B, 4) (memoised on ``K``)."""
-        if plants is not self.plants:
+        if plants is not None and plants is not self.plants:
             raise ValueError("the applied MOP's goals simulate its own payload scenarios only; "
                              "use moo.problems.selection for other payloads")
-        last_K, last_value = self._last
-        if K is last_K:
-            return last_value
-        e = self.per_scenario(K)
-        value = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
-        self._last = (K, value)
-        return value
+        return self.sim.run(K, keep_trajectories=False, backend=self.backend).mse()
 
 
-class PathFollowingError:
+class PathFollowingError(ErrorColumn):
     """Goal: the path-following MSE ``f_{j+1}`` (:class:`PathFollowingErrors`, column ``j``)."""
 
     NAMES = ("rho MSE", "psidot MSE", "ydot MSE", "theta MSE")
 
-    def __init__(self, errors: PathFollowingErrors, j: int):
-        self.errors, self.j = errors, j
-        self.name = self.NAMES[j]
-
-    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
-        """``errors(K, plants)[:, j]``."""
-        return self.errors(K, plants)[:, self.j]
-
-    def __repr__(self) -> str:
-        return f"PathFollowingError(j={self.j})"
+    def column_name(self, j: int) -> str:
+        """``NAMES[j]``."""
+        return self.NAMES[j]
 
 
 class AppliedRLQRProblem(TuningProblem):
@@ -255,11 +248,6 @@ class AppliedRLQRProblem(TuningProblem):
         if isinstance(overloads, (str, bytes)) or np.ndim(overloads) != 1 or len(overloads) == 0:
             raise ValueError(f"overloads must be a non-empty 1-D sequence of percentages, got {overloads!r}")
         self.overloads = np.asarray(truck.check_overload(list(overloads), "overloads"), dtype=float)
-        if aggregate not in ("mean", "max"):
-            raise ValueError(f"aggregate must be 'mean' or 'max', got {aggregate!r}")
-        if backend not in BACKENDS:
-            raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}")
-        self.aggregate, self.backend = aggregate, backend
         family = RLQRFamily(plant, H=np.ones((plant.n, 1)), Q=Q_default if Q is None else Q,
                             R=R_default if R is None else R, alpha=alpha, max_iter=max_iter, fallback=fallback)
         self.rlqr_family = family
@@ -274,6 +262,7 @@ class AppliedRLQRProblem(TuningProblem):
         G_s2 = G_s @ np.asarray(truck.DOUBLED_INPUT_MAP)
         scenarios = [rc.Plant(F, G, dt=plant.dt) for F, G in zip(F_s, G_s2, strict=True)]
         self.errors = PathFollowingErrors(self._sim, scenarios, aggregate, backend)
+        self.aggregate, self.backend = self.errors.aggregate, self.errors.backend     # checked there
         penalty = check_positive_scalar(penalty, "penalty")
         if penalty <= DEFAULT_BOUND**2:
             raise ValueError(f"penalty must exceed the largest simulated MSE ({DEFAULT_BOUND**2:g}), "

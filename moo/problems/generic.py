@@ -38,10 +38,11 @@ from typing import Literal
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import BACKENDS, LinearSimulator
+from robustctl.batchsim import LinearSimulator
 
 from .._validation import as_matrix, check_int
 from ..tuning import RLQRFamily, TuningProblem
+from ._errors import ErrorColumn, ScenarioErrors
 
 __all__ = ["GenericRLQRProblem", "RegulationErrors", "RegulationError", "positive_ref_point"]
 
@@ -67,14 +68,14 @@ def positive_ref_point(value, name: str, n_obj: int) -> np.ndarray | None:
     return arr
 
 
-class RegulationErrors:
-    r"""The regulation errors of gains on a set of plants, simulated once per population (shared by three goals).
+class RegulationErrors(ScenarioErrors):
+    r"""The regulation errors of gains on a set of plants (:class:`GenericRLQRProblem`).
 
     For gains ``K`` (B, m, n) and plants ``(F_s, G_s)`` the run from each
-    initial state ``x_{0,i}`` gives ``e_{j,s} = sum_i sum_{k=0}^{N} x_j^{(s,i)}[k]^2``
-    (:class:`GenericRLQRProblem`), combined over the plants with ``mean`` or ``max``.
-    The last ``K`` array (by identity) and its result are kept, so the goals
-    :class:`RegulationError` ``(j)`` of one population cost one simulation.
+    initial state ``x_{0,i}`` gives ``e_{j,s} = sum_i sum_{k=0}^{N} x_j^{(s,i)}[k]^2``,
+    combined over the plants with ``mean`` or ``max``; the last population's
+    result is memoised, so the three goals :class:`RegulationError` of one
+    population cost one simulation (:class:`~moo.problems._errors.ScenarioErrors`).
 
     Parameters
     ----------
@@ -88,10 +89,9 @@ class RegulationErrors:
 
     def __init__(self, plants: list[rc.Plant], initial_states: np.ndarray, horizon: int, aggregate: str,
                  backend: Literal["numba", "numpy"]):
-        self.plants, self.initial_states, self.horizon = plants, initial_states, horizon
-        self.aggregate, self.backend = aggregate, backend
+        super().__init__(plants, aggregate, backend)
+        self.initial_states, self.horizon = initial_states, horizon
         self._sim = self._simulator(plants)
-        self._last: tuple = (None, None, None)
 
     def _simulator(self, plants: list[rc.Plant]) -> LinearSimulator:
         n0, n = self.initial_states.shape
@@ -108,30 +108,13 @@ class RegulationErrors:
         sums = sim.run(K, keep_trajectories=False, backend=self.backend).sq_state_sum
         return sums.reshape(K.shape[0], S, n0, n).sum(axis=2)
 
-    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
-        """Combined errors (B, n): ``mean_s`` or ``max_s`` of :meth:`per_scenario` (memoised on ``K``)."""
-        last_K, last_plants, last_value = self._last
-        if K is last_K and plants is last_plants:
-            return last_value
-        e = self.per_scenario(K, plants)
-        value = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
-        self._last = (K, plants, value)
-        return value
 
-
-class RegulationError:
+class RegulationError(ErrorColumn):
     """Goal: the regulation error of state ``j`` (:class:`RegulationErrors`, column ``j``)."""
 
-    def __init__(self, errors: RegulationErrors, j: int):
-        self.errors, self.j = errors, j
-        self.name = f"x{j + 1} regulation error"
-
-    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
-        """``errors(K, plants)[:, j]``."""
-        return self.errors(K, plants)[:, self.j]
-
-    def __repr__(self) -> str:
-        return f"RegulationError(j={self.j})"
+    def column_name(self, j: int) -> str:
+        """``"x{j+1} regulation error"``."""
+        return f"x{j + 1} regulation error"
 
 
 class GenericRLQRProblem(TuningProblem):
@@ -280,21 +263,17 @@ class GenericRLQRProblem(TuningProblem):
         self.initial_states = np.eye(n) if initial_states is None else as_matrix(
             initial_states, "initial_states", cols=n, cols_what="the number of states")
         self.horizon = check_int(horizon, "horizon", 1)
-        if aggregate not in ("mean", "max"):
-            raise ValueError(f"aggregate must be 'mean' or 'max', got {aggregate!r}")
-        if backend not in BACKENDS:
-            raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}")
-        self.aggregate, self.backend = aggregate, backend
         # true plants per scenario: F_s (S, n, n), G_s (S, n, m)
         F_s = F_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EF_true)
         G_s = G_GENERIC + self.deltas[:, None, None] * (H_GENERIC @ self.EG_true)
         scenarios = [rc.Plant(F, G, dt=1.0) for F, G in zip(F_s, G_s, strict=True)]
+        self.errors = RegulationErrors(scenarios, self.initial_states, self.horizon, aggregate, backend)
+        self.aggregate, self.backend = self.errors.aggregate, self.errors.backend     # checked there
         family = RLQRFamily(rc.Plant(F_GENERIC, G_GENERIC, dt=1.0), H=H_GENERIC.copy(), Q=Q, R=R, alpha=alpha,
                             max_iter=max_iter, fallback="recursion")
         self.rlqr_family = family
         self.plant, self.H, self.Q, self.R = family.plant, family.H, family.Q, family.R
         self.alpha, self.max_iter, self.fallback = family.alpha, family.max_iter, family.fallback
-        self.errors = RegulationErrors(scenarios, self.initial_states, self.horizon, aggregate, backend)
         hv = positive_ref_point(hv_ref_point, "hv_ref_point", n)
         molsp = positive_ref_point(molsp_ref_point, "molsp_ref_point", n)
         super().__init__(family, scenarios, [RegulationError(self.errors, j) for j in range(n)], xl=0.0, xu=200.0,
