@@ -181,7 +181,8 @@ def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
     The optimal Lyapunov matrix ``X`` has roughly the shape of ``P^-1``,
     ``P`` the stabilising Riccati solution of the LQR problem with the
     weight ``[Cz Dzu]'[Cz Dzu]`` (both diagonal blocks regularised by
-    ``LQR_REG`` of their norm). In coordinates where ``P^-1 ~ I`` (then
+    ``LQR_REG`` of their norm; ``P`` lifted to at least ``LQR_SHIFT`` of its
+    largest eigenvalue). In coordinates where ``P^-1 ~ I`` (then
     scaled so that ``||Bw|| = 1`` again) the optimum is usually well
     conditioned: fewer interior-point iterations, rarely
     ``optimal_inaccurate``. ``None`` if the Riccati solve fails.
@@ -200,8 +201,8 @@ def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
         return None
     if not (np.all(np.isfinite(lam)) and lam[-1] > 0):
         return None
-    X = np.linalg.inv(0.5 * (P + P.T) + max(0.0, tol.RECENTRE_REG * lam[-1] - lam[0]) * np.eye(n))
-    moved = recentred(data, X, tol.RECENTRE_REG)  # X > 0 by construction
+    X = np.linalg.inv(0.5 * (P + P.T) + max(0.0, tol.LQR_SHIFT * lam[-1] - lam[0]) * np.eye(n))
+    moved = recentred(data, X, tol.LQR_SHIFT)  # X > 0 by construction
     if moved is None:
         return None
     bw = float(np.linalg.norm(moved[0].Bw, 2))

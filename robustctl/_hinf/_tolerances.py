@@ -23,17 +23,22 @@ Z_RANK = 1e-13
 #: ``LQR_REG * max(1, ||W||)`` added on the diagonal (so that it is solvable).
 LQR_REG = 1e-9
 #: Regularisation, relative to ``lambda_max``, of a Lyapunov matrix before it
-#: defines new coordinates (the LQR coordinates and the recentred centring).
+#: defines new coordinates (the recentred centring).
 RECENTRE_REG = 1e-3
+#: The same for the LQR coordinates of one plant (:func:`._coordinates.lqr_coordinates`):
+#: the inverse LQR solution may be conditioned up to ``1 / LQR_SHIFT``. With a
+#: rank-deficient weight the LQR solution has eigenvalues near ``LQR_REG``;
+#: keeping more of its shape than ``RECENTRE_REG`` would gives the level
+#: minimisation of larger plants fewer interior-point iterations and a level
+#: closer to the Riccati bisection's (``benchmarks/results/hinf.md``).
+LQR_SHIFT = 1e-6
 #: The same for polishing an inaccurate level minimisation (a pure similarity).
 POLISH_REG = 1e-6
 
 # ---------------------------------------------------------------- solves
 #: Solver tolerance of the level minimisation in the LQR coordinates of one
-#: plant (the level then agrees with the Riccati bisection to ~1e-8 relative,
-#: up to 4e-7 when the level of the unit-sized channels is about 1 or less
-#: and X is large, as on the benchmark's n = 20 plant; the first attempt
-#: skips iterative refinement) ...
+#: plant (the level then agrees with the Riccati bisection to 1e-8-1e-7
+#: relative; the first attempt skips iterative refinement) ...
 LEVEL_TOL = 1e-8
 #: ... and otherwise (several vertices, e.g. the truck polytope with an input
 #: bound, are badly conditioned: a looser first solve there ends 1e-3 above
