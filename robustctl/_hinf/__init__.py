@@ -88,10 +88,10 @@ lists them; every tolerance is named in ``robustctl._hinf._tolerances``):
   centring problem is 1; ``[Cz Dzu Dzw]`` replaced by a factor with the same Gram
   matrix when that has fewer rows. A single plant is solved in coordinates
   where the inverse of its LQR Riccati solution (weight
-  ``[Cz Dzu]'[Cz Dzu]``) is ~ I: the optimal ``X`` has roughly that shape,
-  so the optimum is well conditioned (on the benchmark plants with n = 10:
-  13-16 interior-point iterations instead of ~27 ending
-  ``optimal_inaccurate``).
+  ``[Cz Dzu]'[Cz Dzu]``, kept to ``LQR_SHIFT`` of its largest eigenvalue)
+  is ~ I: the optimal ``X`` has roughly that shape, so the optimum is well
+  conditioned (fewer interior-point iterations, rarely
+  ``optimal_inaccurate``; ``benchmarks/results/hinf.md``).
 * Blocks (:mod:`._lmis`): the constant disturbance block ``I`` is
   eliminated by a Schur complement (e.g. the discrete block becomes
   ``[[X - Bw Bw', A X + G Y, -Bw Dzw'], [*, X, (Cz X + Dzu Y)'], [*, *,
@@ -146,9 +146,11 @@ modal or real Schur coordinates of ``F``, or with a dense congruence of the
 second block. Every entry of the smaller blocks depends on every entry of
 ``X``; with that dense coefficient map Clarabel's sparse LDL (faer) was
 slower per iteration than on the full LMI, whose coefficient map stays
-sparse. Coordinates in which the solver's own optimal ``X`` is ``I`` save a
-few iterations only, and scaling the level, Clarabel's step length,
-regularisation, equilibration and presolve settings did not help.
+sparse (``benchmarks/investigations/benchmarks_hinf_sdp_forms.py`` times
+the eliminated form against the full LMI). Coordinates in which the
+solver's own optimal ``X`` is ``I`` save a few iterations only, and scaling
+the level, Clarabel's step length, regularisation, equilibration and
+presolve settings did not help.
 
 References
 ----------
