@@ -31,8 +31,11 @@ checkout at ROOT (e.g. the main branch) against this one, each in a fresh subpro
 ``robustctl`` from its own tree, alternating the two for ``--rounds`` rounds and taking medians (on a
 shared machine the load changes between runs; interleaving spreads it over both).
 
-Usage: python -m benchmarks.bench_hinf [--sizes 4 10 20 50] [--reps 3] [--seeds 5] [--sdp-max-n 50]
-       python -m benchmarks.bench_hinf --before /work/main [--sizes 4 10 20] [--rounds 5] [--reps 3]
+Results are written to ``benchmarks/results/hinf.md`` (``--before``: ``hinf_before_after.md``; ``--out``
+another file) and shown in the documentation as they are.
+
+Usage: python -m benchmarks.bench_hinf [--sizes 4 10 20 50] [--reps 3] [--seeds 5] [--sdp-max-n 50] [--out FILE]
+       python -m benchmarks.bench_hinf --before /work/main [--sizes 4 10 20] [--rounds 5] [--reps 3] [--out FILE]
 """
 
 from __future__ import annotations
@@ -43,8 +46,10 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
+import datetime  # noqa: E402
 import inspect  # noqa: E402
 import json  # noqa: E402
+import platform  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
@@ -186,22 +191,55 @@ def sdp_cpu(root: str, n: int, seed: int, reps: int) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def before_after(before: str, sizes, rounds: int, reps: int) -> None:
+def _header(title: str, command: str) -> list[str]:
+    """The first lines of a result file: what, when, where, with what load, by which command."""
+    return [f"# {title}", "",
+            (f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, {platform.machine()}, Python "
+             f"{platform.python_version()}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start "
+             f"(shared machine). Command: `{command}`."), ""]
+
+
+def _write(lines: list[str], out: Path) -> None:
+    lines = [*lines, "", f"Load average at the end: {os.getloadavg()[0]:.1f}."]
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(lines) + "\n")
+    print(f"written to {out}")
+
+
+def before_after(before: str, sizes, rounds: int, reps: int, out: Path) -> None:
     """The SDP path of ``before`` against this checkout, alternating in fresh subprocesses; medians over rounds."""
-    here = str(Path(__file__).resolve().parents[1])
-    print(f"SDP path (whole hinf call, CPU time per call, median of {reps} per round, median over {rounds} "
-          f"alternating rounds): before = {before}, after = {here}")
-    print(f"{'n':>4} {'before [s]':>11} {'after [s]':>10} {'before/after':>12} {'rounds b/a':>24} "
-          f"{'gamma_opt rel diff':>18} {'iterations b/a':>15}")
+    here = Path(__file__).resolve().parents[1]
+    lines = _header("H-infinity SDP path: another checkout against this one",
+                    f"python -m benchmarks.bench_hinf --before {before} --sizes {' '.join(map(str, sizes))} "
+                    f"--rounds {rounds} --reps {reps}")
+    lines += [(f"The whole `rc.hinf(...)` call (default `synthesis=\"lmi\"`) on the plant `case(n, 0)`: CPU time per "
+               f"call, median of {reps} calls per round, median over {rounds} rounds, the two checkouts alternating, "
+               f"each in a fresh process importing its own tree. Before: `{before}` (commit "
+               f"{_commit(before)}); after: this checkout (commit {_commit(str(here))})."), "",
+              ("| n | before [s] | after [s] | **before / after** | per-round range before / after | "
+               "iterations before / after | `gamma_opt` after / before - 1 |"),
+              "|---|---|---|---|---|---|---|"]
+    print("\n".join(lines), flush=True)
     for n in sizes:
         b, a = [], []
         for _ in range(rounds):
             b.append(sdp_cpu(before, n, 0, reps))
-            a.append(sdp_cpu(here, n, 0, reps))
+            a.append(sdp_cpu(str(here), n, 0, reps))
         tb, ta = np.median([r["cpu"] for r in b]), np.median([r["cpu"] for r in a])
-        spread = "/".join(f"{min(r['cpu'] for r in x):.3f}-{max(r['cpu'] for r in x):.3f}" for x in (b, a))
-        print(f"{n:4d} {tb:11.4f} {ta:10.4f} {tb / ta:12.2f} {spread:>24} "
-              f"{a[0]['gamma_opt'] / b[0]['gamma_opt'] - 1:18.1e} {b[0]['iterations']:>7}/{a[0]['iterations']:<7}")
+        spread = " / ".join(f"{min(r['cpu'] for r in x):.3g}-{max(r['cpu'] for r in x):.3g}" for x in (b, a))
+        lines.append(f"| {n} | {tb:.3g} | {ta:.3g} | **{tb / ta:.2f}** | {spread} | {b[0]['iterations']} / "
+                     f"{a[0]['iterations']} | {a[0]['gamma_opt'] / b[0]['gamma_opt'] - 1:.1e} |")
+        print(lines[-1], flush=True)
+    _write(lines, out)
+
+
+def _commit(root: str) -> str:
+    """The short commit of the checkout at ``root`` (``?`` if git cannot tell)."""
+    try:
+        return subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "?"
 
 
 def main(argv=None) -> None:
@@ -212,9 +250,12 @@ def main(argv=None) -> None:
     ap.add_argument("--sdp-max-n", type=int, default=50, help="largest n for the SDP path (about 90 s at n = 50)")
     ap.add_argument("--before", help="another checkout: time its SDP path against this one's (only that)")
     ap.add_argument("--rounds", type=int, default=5, help="alternating rounds for --before")
+    ap.add_argument("--out", type=Path, help="result file (default benchmarks/results/hinf.md, with --before "
+                                             "benchmarks/results/hinf_before_after.md)")
     args = ap.parse_args(argv)
+    results = Path(__file__).parent / "results"
     if args.before:
-        before_after(args.before, args.sizes, args.rounds, args.reps)
+        before_after(args.before, args.sizes, args.rounds, args.reps, args.out or results / "hinf_before_after.md")
         return
 
     warm = case(3)
@@ -222,9 +263,21 @@ def main(argv=None) -> None:
         hinf(warm[0], Bw=warm[1], Cz=warm[2], Dzu=warm[3], synthesis=synthesis)
     peer_hinf(*warm)
 
-    print(f"{'n':>4} {'seed':>4} {'peer [s]':>9} {'riccati [s]':>11} {'ratio':>6} {'SDP [s]':>8} {'ratio':>7} "
-          f"{'gamma peer':>13} {'rel fast':>9} {'rel SDP':>9} {'norm/gamma':>10}  fast path")
-    summary = []
+    lines = _header("H-infinity state feedback: the riccati fast path and the SDP against an independent peer",
+                    f"python -m benchmarks.bench_hinf --sizes {' '.join(map(str, args.sizes))} --reps {args.reps} "
+                    f"--seeds {args.seeds} --sdp-max-n {args.sdp_max_n}")
+    lines += [(f"Random discrete plants `case(n, seed)` ({args.seeds} per n up to 10, one above; m = 2, q = 2, p = 4, "
+               "F scaled to spectral radius 1.05). Wall-clock times, best of "
+               f"{args.reps} runs (at least 3 for the peer and the fast path; one run above n = 10), BLAS on one "
+               "thread; ratios per plant against the peer timed beside it. **peer**: the game-Riccati bisection "
+               "of this script on python-control's `dare`; **riccati**: `hinf(..., synthesis=\"riccati\")`; "
+               "**SDP**: `hinf(...)` (cvxpy + Clarabel). rel: `gamma_opt` / the peer's - 1. norm / gamma: "
+               "`linfnorm` of the fast path's closed loop over its guaranteed level."), "",
+              ("| n | seed | peer [s] | riccati [s] | riccati / peer | SDP [s] | SDP / peer | gamma (peer) | "
+               "rel riccati | rel SDP | norm / gamma | fast path |"),
+              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    print("\n".join(lines), flush=True)
+    summary = ["", "| n | plants | riccati / peer: median (max) | SDP / peer: median (max) |", "|---|---|---|---|"]
     for n in args.sizes:
         reps, seeds = (args.reps, args.seeds) if n <= 10 else (1, 1)
         r_fast, r_sdp = [], []
@@ -233,30 +286,30 @@ def main(argv=None) -> None:
             (g_peer, _), t_peer = best_time(lambda: peer_hinf(plant, Bw, Cz, Dzu), max(reps, 3))
             fast, t_fast = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, synthesis="riccati"), max(reps, 3))
             r_fast.append(t_fast / t_peer)
+            t_sdp_s = ratio_s = rel_s = "-"
             if n <= args.sdp_max_n:
                 sdp, t_sdp = best_time(lambda: hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu), reps)
                 r_sdp.append(t_sdp / t_peer)
-                sdp_cols = f"{t_sdp:8.3f} {t_sdp / t_peer:7.1f}"
-                rel_sdp = f"{sdp.gamma_opt / g_peer - 1:9.1e}"
-            else:
-                sdp_cols, rel_sdp = f"{'-':>8} {'-':>7}", f"{'-':>9}"
+                t_sdp_s, ratio_s, rel_s = f"{t_sdp:.3g}", f"{t_sdp / t_peer:.3g}", f"{sdp.gamma_opt / g_peer - 1:.1e}"
             norm = cl_norm(plant, fast.K, Bw, Cz, Dzu)
-            print(f"{n:4d} {seed:4d} {t_peer:9.4f} {t_fast:11.4f} {t_fast / t_peer:6.2f} {sdp_cols} "
-                  f"{g_peer:13.8g} {fast.gamma_opt / g_peer - 1:9.1e} {rel_sdp} {norm / fast.gamma:10.6f}  "
-                  f"{fast.info['synthesis']}")
-        line = f"n = {n}: riccati/peer median {np.median(r_fast):.2f} (max {max(r_fast):.2f})"
-        if r_sdp:
-            line += f", SDP/peer median {np.median(r_sdp):.1f} (max {max(r_sdp):.1f})"
-        summary.append(line + f" over {seeds} plant{'s' if seeds > 1 else ''}")
-    print("\n".join(summary))
-
+            cols = [n, seed, f"{t_peer:.3g}", f"{t_fast:.3g}", f"{t_fast / t_peer:.2f}", t_sdp_s, ratio_s,
+                    f"{g_peer:.8g}", f"{fast.gamma_opt / g_peer - 1:.1e}", rel_s, f"{norm / fast.gamma:.6f}",
+                    fast.info["synthesis"]]
+            lines.append(f"| {' | '.join(map(str, cols))} |")
+            print(lines[-1], flush=True)
+        sdp_sum = f"{np.median(r_sdp):.3g} ({max(r_sdp):.3g})" if r_sdp else "-"
+        summary.append(f"| {n} | {seeds} | **{np.median(r_fast):.2f}** ({max(r_fast):.2f}) | **{sdp_sum}** |")
+    lines += summary
     ctrl, t_truck = truck_case(args.reps)
-    print(f"truck (n=4, m=1, 4 payload vertices, |alpha| <= 0.45 rad): {t_truck:.3f} s, "
-          f"gamma = {ctrl.gamma:.6g}, guaranteed max |alpha| = {ctrl.info['u_bound'][0]:.4f} rad")
     un = units(args.reps)
-    print(f"truck, authors' weights (R = 33535, Bw = ones), unscaled vs z / sqrt(r) by hand: time {un['t_raw']:.3f} s "
-          f"vs {un['t_hand']:.3f} s (ratio {un['t_raw'] / un['t_hand']:.2f}); gamma_opt {un['gamma_raw']:.10g} vs "
-          f"{un['gamma_hand']:.10g}, peer bisection (unscaled) {un['gamma_ric']:.10g}")
+    lines += ["", (f"Truck (n = 4, m = 1, 4 payload vertices, steering bound 0.45 rad), SDP path: {t_truck:.3f} s, "
+                   f"gamma = {ctrl.gamma:.6g}, guaranteed max |alpha| = {ctrl.info['u_bound'][0]:.4f} rad."), "",
+              (f"Truck with the authors' weights (R = 33535, Bw = ones), unscaled against z / sqrt(r) by hand: time "
+               f"{un['t_raw']:.3f} s against {un['t_hand']:.3f} s (ratio {un['t_raw'] / un['t_hand']:.2f}); "
+               f"gamma_opt {un['gamma_raw']:.10g} against {un['gamma_hand']:.10g}, peer bisection (unscaled) "
+               f"{un['gamma_ric']:.10g}.")]
+    print("\n".join(lines[-len(summary) - 4:]), flush=True)
+    _write(lines, args.out or results / "hinf.md")
 
 
 if __name__ == "__main__":
