@@ -46,7 +46,7 @@ __all__ = ["LMI", "SolveReport", "solve_sdp", "check_solver", "SDP_SOLVERS", "ce
 # Clarabel's defaults (equilibration, faer's LDL on its default threads,
 # chordal decomposition unless the caller asks for whole blocks with
 # ``decompose=False``): other values measured no better on the H-infinity
-# level minimisation (benchmarks/results/hinf.md).
+# level minimisation (measured in the documentation, Validation: Benchmarks).
 SOLVER_TOL = 1e-10
 _CLARABEL = dict(tol_gap_abs=SOLVER_TOL, tol_gap_rel=SOLVER_TOL, tol_feas=SOLVER_TOL,
                  tol_infeas_abs=1e-10, tol_infeas_rel=1e-10, tol_ktratio=1e-8,

@@ -91,7 +91,7 @@ lists them; every tolerance is named in ``robustctl._hinf._tolerances``):
   ``[Cz Dzu]'[Cz Dzu]``, kept to ``LQR_SHIFT`` of its largest eigenvalue)
   is ~ I: the optimal ``X`` has roughly that shape, so the optimum is well
   conditioned (fewer interior-point iterations, rarely
-  ``optimal_inaccurate``; ``benchmarks/results/hinf.md``).
+  ``optimal_inaccurate``; measured in the documentation, Validation: Benchmarks).
 * Blocks (:mod:`._lmis`): the constant disturbance block ``I`` is
   eliminated by a Schur complement (e.g. the discrete block becomes
   ``[[X - Bw Bw', A X + G Y, -Bw Dzw'], [*, X, (Cz X + Dzu Y)'], [*, *,

@@ -30,7 +30,7 @@ RECENTRE_REG = 1e-3
 #: rank-deficient weight the LQR solution has eigenvalues near ``LQR_REG``;
 #: keeping more of its shape than ``RECENTRE_REG`` would gives the level
 #: minimisation of larger plants fewer interior-point iterations and a level
-#: closer to the Riccati bisection's (``benchmarks/results/hinf.md``).
+#: closer to the Riccati bisection's (measured in the documentation, Validation: Benchmarks).
 LQR_SHIFT = 1e-6
 #: The same for polishing an inaccurate level minimisation (a pure similarity).
 POLISH_REG = 1e-6
