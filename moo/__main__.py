@@ -280,7 +280,6 @@ def _cmd_run(args) -> int:
     return 0
 
 
-
 def _os_reason(exc: OSError) -> str:
     """``strerror`` of a disk error (``No space left on device``), else its first line."""
     if exc.strerror:
