@@ -46,8 +46,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import contextlib  # noqa: E402
-import datetime  # noqa: E402
-import platform  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 import timeit  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -56,6 +55,7 @@ import control  # noqa: E402
 import numpy as np  # noqa: E402
 
 import robustctl as rc  # noqa: E402
+from benchmarks._report import header, write  # noqa: E402
 from robustctl import _hinfnorm  # noqa: E402
 
 
@@ -221,10 +221,8 @@ def main(argv=None) -> int:
 
     warm = case(3, 0, True)
     rc.robust_stability((warm[0], warm[1]), warm[2])  # fill caches
-    load = os.getloadavg()[0]
-    lines = [(f"# bench_analysis ({datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, "
-              f"{platform.processor() or platform.machine()}, Python {platform.python_version()}, "
-              f"{os.cpu_count()} cores, load average {load:.1f} at start: shared machine, CPU times)"), "",
+    command = "python -m benchmarks.bench_analysis " + " ".join(sys.argv[1:] if argv is None else argv)
+    lines = [*header("bench_analysis: robust analysis against linfnorm (CPU times)", command.strip()),
              ("`robust_stability` of one loop with its certificate (H-infinity norm, bounded-real Riccati "
               "certificate verified by eigenvalues) against python-control's `linfnorm` of the same loop "
               "`E (zI - A)^-1 H`; p = 2, l = 3, m = 2, margin 2. CPU times, the two timed alternately: best of "
@@ -264,10 +262,7 @@ def main(argv=None) -> int:
               f"| robust (norm-bounded) | {rb['t_rob']:.3f} | {rb['gamma_rob']:.5g} | {rb['worst_rob']:.5g} |",
               f"| **ratio** robust / polytopic | **{rb['t_rob'] / rb['t_poly']:.2f}** | | |"]
     print("\n".join(lines[-7:]), flush=True)
-    lines += ["", f"Load average at the end: {os.getloadavg()[0]:.1f}."]
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text("\n".join(lines) + "\n")
-    print(f"written to {args.out}")
+    write(lines, args.out)
     return 0
 
 

@@ -46,10 +46,8 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import datetime  # noqa: E402
 import inspect  # noqa: E402
 import json  # noqa: E402
-import platform  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
@@ -59,6 +57,7 @@ from pathlib import Path  # noqa: E402
 import control  # noqa: E402
 import numpy as np  # noqa: E402
 
+from benchmarks._report import header, write  # noqa: E402
 from robustctl import (  # noqa: E402
     Plant,
     hinf,
@@ -191,25 +190,10 @@ def sdp_cpu(root: str, n: int, seed: int, reps: int) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _header(title: str, command: str) -> list[str]:
-    """The first lines of a result file: what, when, where, with what load, by which command."""
-    return [f"# {title}", "",
-            (f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, {platform.machine()}, Python "
-             f"{platform.python_version()}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start "
-             f"(shared machine). Command: `{command}`."), ""]
-
-
-def _write(lines: list[str], out: Path) -> None:
-    lines = [*lines, "", f"Load average at the end: {os.getloadavg()[0]:.1f}."]
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text("\n".join(lines) + "\n")
-    print(f"written to {out}")
-
-
 def before_after(before: str, sizes, rounds: int, reps: int, out: Path) -> None:
     """The SDP path of ``before`` against this checkout, alternating in fresh subprocesses; medians over rounds."""
     here = Path(__file__).resolve().parents[1]
-    lines = _header("H-infinity SDP path: another checkout against this one",
+    lines = header("H-infinity SDP path: another checkout against this one",
                     f"python -m benchmarks.bench_hinf --before {before} --sizes {' '.join(map(str, sizes))} "
                     f"--rounds {rounds} --reps {reps}")
     lines += [(f"The whole `rc.hinf(...)` call (default `synthesis=\"lmi\"`) on the plant `case(n, 0)`: CPU time per "
@@ -230,7 +214,7 @@ def before_after(before: str, sizes, rounds: int, reps: int, out: Path) -> None:
         lines.append(f"| {n} | {tb:.3g} | {ta:.3g} | **{tb / ta:.2f}** | {spread} | {b[0]['iterations']} / "
                      f"{a[0]['iterations']} | {a[0]['gamma_opt'] / b[0]['gamma_opt'] - 1:.1e} |")
         print(lines[-1], flush=True)
-    _write(lines, out)
+    write(lines, out)
 
 
 def _commit(root: str) -> str:
@@ -263,7 +247,7 @@ def main(argv=None) -> None:
         hinf(warm[0], Bw=warm[1], Cz=warm[2], Dzu=warm[3], synthesis=synthesis)
     peer_hinf(*warm)
 
-    lines = _header("H-infinity state feedback: the riccati fast path and the SDP against an independent peer",
+    lines = header("H-infinity state feedback: the riccati fast path and the SDP against an independent peer",
                     f"python -m benchmarks.bench_hinf --sizes {' '.join(map(str, args.sizes))} --reps {args.reps} "
                     f"--seeds {args.seeds} --sdp-max-n {args.sdp_max_n}")
     lines += [(f"Random discrete plants `case(n, seed)` ({args.seeds} per n up to 10, one above; m = 2, q = 2, p = 4, "
@@ -309,7 +293,7 @@ def main(argv=None) -> None:
                f"gamma_opt {un['gamma_raw']:.10g} against {un['gamma_hand']:.10g}, peer bisection (unscaled) "
                f"{un['gamma_ric']:.10g}.")]
     print("\n".join(lines[-len(summary) - 4:]), flush=True)
-    _write(lines, args.out or results / "hinf.md")
+    write(lines, args.out or results / "hinf.md")
 
 
 if __name__ == "__main__":
