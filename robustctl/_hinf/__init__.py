@@ -144,10 +144,11 @@ respect to the middle ``X`` block with ``Z >= Y X^-1 Y'`` lifted as
 ``[[Z, Y], [Y', X]] >= 0`` (blocks ``n + p`` and ``n + m``); either in the
 modal or real Schur coordinates of ``F``, or with a dense congruence of the
 second block. Every entry of the smaller blocks depends on every entry of
-``X``; with that dense coefficient map Clarabel's sparse LDL (faer) was
-slower per iteration than on the full LMI, whose coefficient map stays
-sparse (``benchmarks/investigations/benchmarks_hinf_sdp_forms.py`` times
-the eliminated form against the full LMI). Coordinates in which the
+``X``; with that dense coefficient map Clarabel's sparse LDL (faer) loses
+to the full LMI, whose coefficient map stays sparse, as the plant grows:
+``benchmarks/investigations/benchmarks_hinf_sdp_forms.py`` times the
+eliminated form, faster than the full LMI on mid-sized plants and slower
+on large ones; it would also need its own gain recovery. Coordinates in which the
 solver's own optimal ``X`` is ``I`` save a few iterations only, and scaling
 the level, Clarabel's step length, regularisation, equilibration and
 presolve settings did not help.
