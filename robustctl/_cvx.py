@@ -43,11 +43,21 @@ __all__ = ["LMI", "SolveReport", "solve_sdp", "check_solver", "SDP_SOLVERS", "ce
 # Clarabel settings (cvxpy passes them through). Tight on purpose: the
 # H-infinity level must agree to 1e-5 relative with an independent Riccati
 # computation, and the problems are small. The other settings are
-# Clarabel's defaults (equilibration, faer's LDL on its default threads,
-# chordal decomposition unless the caller asks for whole blocks with
-# ``decompose=False``): other values measured no better on the H-infinity
-# level minimisation (measured in the documentation, Validation: Benchmarks).
+# Clarabel's defaults (equilibration, faer's LDL, chordal decomposition
+# unless the caller asks for whole blocks with ``decompose=False``): other
+# values measured no better on the H-infinity level minimisation (measured in
+# the documentation, Validation: Benchmarks), except the number of threads
+# (SINGLE_THREAD_PSD).
 SOLVER_TOL = 1e-10
+#: Problems whose PSD blocks have at most this many free entries in total
+#: (``sum k (k + 1) / 2``) are solved by Clarabel on one thread (its
+#: ``max_threads``); larger ones on its default threads. On small
+#: problems the thread pool's synchronisation costs more than the parallel
+#: factorisation saves (a quarter of the process's time in the kernel's
+#: scheduler at n = 20), and the experiment runner's processes already use
+#: every core; the H-infinity level minimisation of n = 50 states (5460
+#: entries) is faster in wall-clock time on two threads.
+SINGLE_THREAD_PSD = 2500
 _CLARABEL = dict(tol_gap_abs=SOLVER_TOL, tol_gap_rel=SOLVER_TOL, tol_feas=SOLVER_TOL,
                  tol_infeas_abs=1e-10, tol_infeas_rel=1e-10, tol_ktratio=1e-8,
                  reduced_tol_gap_abs=1e-7, reduced_tol_gap_rel=1e-7, reduced_tol_feas=1e-7,
@@ -135,12 +145,12 @@ def _evaluate(lmis: Sequence[LMI], who: str) -> tuple[dict[str, float], dict[str
     return cert, scales
 
 
-def _settings(solver: str, tol: float, refine: bool = True, decompose: bool = True) -> dict:
+def _settings(solver: str, tol: float, refine: bool = True, decompose: bool = True, psd_size: int = 0) -> dict:
     if solver != "CLARABEL":
         return {}
     out = dict(_CLARABEL)
     out.update(tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol, iterative_refinement_enable=refine,
-               chordal_decomposition_enable=decompose)
+               chordal_decomposition_enable=decompose, max_threads=1 if psd_size <= SINGLE_THREAD_PSD else 0)
     return out
 
 
@@ -225,12 +235,13 @@ def solve_sdp(objective, lmis: Sequence[LMI], constraints: Sequence = (), *, sol
     schedule = [(True, tol)] if solver != "CLARABEL" else \
         ([(False, tol)] if fast else []) + [(True, tol), (True, 1e2 * tol), (True, 1e4 * tol)]
     failure, solve_time, iterations = None, 0.0, 0
+    psd_size = sum(lmi.M.shape[0] * (lmi.M.shape[0] + 1) // 2 for lmi in lmis)
     for refine, attempt_tol in schedule:
         try:
             with warnings.catch_warnings():
                 # cvxpy warns on 'optimal_inaccurate'; the status is checked below instead.
                 warnings.simplefilter("ignore", UserWarning)
-                prob.solve(solver=solver, **_settings(solver, attempt_tol, refine, decompose))
+                prob.solve(solver=solver, **_settings(solver, attempt_tol, refine, decompose, psd_size))
         except cp.error.SolverError as exc:
             failure = f"{solver} failed ({exc})"
         except BaseException as exc:  # a Rust panic inside Clarabel surfaces as pyo3's PanicException

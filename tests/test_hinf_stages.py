@@ -467,3 +467,96 @@ def test_closed_loop_check_of_the_pole_regions():
     with pytest.raises(ConvergenceError, match=r"a closed-loop pole of plant lies outside Disk\(center=0.0"):
         _synthesis.check_closed_loop(K, [msd(1.0)], (Disk(0.0, 0.5),))
     _synthesis.check_closed_loop(K, [msd(1.0)], (Disk(0.0, 1.0),))
+
+
+# ------------------------------------------------------------ projected blocks (Y eliminated)
+def _projected_optimum(problem):
+    """The level minimisation over the projected blocks in the LQR coordinates (what ``minimise_level`` runs)."""
+    lqr = _coordinates.lqr_coordinates(balanced_of(problem), problem.discrete)
+    assert _level.projected_form(problem, lqr.n)
+    return lqr, _level.solve_level(problem, lqr, preconditioned=True)
+
+
+def test_projected_blocks_hold_at_every_point_of_the_full_block(discrete):
+    """Necessity (projection lemma): a strictly feasible ``(X, K X)`` of the full block makes both projections
+    positive at the same ``X`` and level."""
+    from robustctl import _cvx
+
+    problem, opt = discrete
+    gain = _gains.optimum_certified(problem, opt, 1e-3).gain
+    z_scale = 1.0 / (gain.data.level_scale * opt.gamma_opt * (1 + 1e-3))
+    cert = _cvx.certificate(_lmis.projected_blocks(gain.data, gain.point.X, 1.0, z_scale))
+    assert set(cert) == {"hinf_projected[0]", "hinf_phi[0]"} and min(cert.values()) > 0
+
+
+@pytest.mark.parametrize("seed,n,m,q,cross", [(1, 4, 2, 2, False), (2, 6, 2, 3, False), (4, 5, 2, 2, True)])
+def test_projected_level_and_gain_match_the_riccati_bisection_and_linfnorm(seed, n, m, q, cross):
+    """The projected optimum is the Riccati bisection's level; the recovered gain holds (1 + backoff / 2) of it."""
+    plant, Bw, Cz, Dzu, Dzw = random_case(seed, n, m, q, discrete=True, cross=cross)
+    problem = problem_of(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw)
+    lqr, found = _projected_optimum(problem)
+    assert set(found.report.certificate) == {"hinf_projected[0]", "hinf_phi[0]"}
+    gamma_opt = np.sqrt(found.level_sq) / lqr.level_scale
+    ref = hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, rtol=1e-9)
+    assert gamma_opt == pytest.approx(ref.gamma, rel=RTOL)
+    K = lqr.to_original(found.point.gain(), found.point.X)[0]
+    assert cl_norm(plant, K, Bw, Cz, Dzu, Dzw) <= gamma_opt * (1 + 0.5 * problem.backoff) * (1 + RTOL)
+
+
+def test_projected_gain_of_a_singular_phi_is_the_limit_of_the_least_squares_gains(discrete):
+    """``X - Bw Bw'`` singular: the floored weight gives the gain that the vanishing regularisation converges to."""
+    _, opt = discrete
+    data, X = opt.data, opt.point.X
+    Bw = data.Bw
+    lam, U = np.linalg.eigh(X - Bw @ Bw.T)
+    Xs = Bw @ Bw.T + (U * np.r_[0.0, lam[1:]]) @ U.T            # Phi singular along U[:, 0]
+    level_sq = (data.level_scale * opt.gamma_opt) ** 2 * 1.1
+    K = _lmis.projected_gain(data, Xs, level_sq)
+    Abar, Bbar = np.vstack([data.F[0], data.Cz]), np.vstack([data.G[0], data.Dzu])
+    v = np.r_[U[:, 0], np.zeros(data.p)]
+    assert abs(v @ (Abar + Bbar @ K)).max() < 1e-4 * np.abs(Abar).max()   # the singular direction is respected
+    def weighted(eps):
+        W = np.linalg.inv(_lmis._phi(np.vstack([Bw, data.Dzw]), Xs, level_sq) + eps * np.eye(data.n + data.p))
+        return -np.linalg.solve(Bbar.T @ W @ Bbar, Bbar.T @ W @ Abar)
+    assert np.allclose(K, weighted(1e-9), rtol=0, atol=1e-3 * np.abs(K).max())
+    assert _lmis.projected_gain(data, np.full_like(X, np.nan), level_sq) is None
+    assert _lmis.projected_gain(data, -np.eye(data.n) - Bw @ Bw.T, -1.0) is None
+
+
+@pytest.mark.parametrize("failure", ["solver", "gain"])
+def test_projected_failure_leaves_the_level_to_the_full_block(discrete, monkeypatch, failure):
+    problem, _ = discrete
+    if failure == "solver":
+        real = _level._cvx.solve_sdp
+
+        def projected_fails(objective, lmis, *a, **k):
+            if lmis[0].name == "hinf_projected[0]":
+                raise ConvergenceError("injected")
+            return real(objective, lmis, *a, **k)
+
+        monkeypatch.setattr(_level._cvx, "solve_sdp", projected_fails)
+    else:
+        monkeypatch.setattr(_level, "projected_gain", lambda *a: None)
+    opt = optimum_of(problem)
+    assert list(opt.report.certificate) == ["hinf[0]"] and opt.preconditioned
+    plant = problem.plants[0]
+    assert opt.gamma_opt == pytest.approx(hinf_riccati(plant, Bw=problem.Bw, Cz=problem.Cz, Dzu=problem.Dzu).gamma,
+                                          rel=RTOL)
+
+
+def test_projected_form_is_the_plain_discrete_problem_with_a_backoff_only(discrete, polytope):
+    problem, _ = discrete
+    n = problem.plants[0].n
+    assert _level.projected_form(problem, n)
+    assert not _level.projected_form(problem, tol.PROJECTED_MAX_N + 1)
+    assert not _level.projected_form(dataclasses.replace(problem, backoff=0.0), n)
+    assert not _level.projected_form(dataclasses.replace(problem, u_max=np.ones(2), w_energy=1.0), n)
+    assert not _level.projected_form(polytope[0], 2)
+    cont, Bw, Cz, Dzu, _ = random_case(3, 4, 2, 2, discrete=False)
+    assert not _level.projected_form(problem_of(cont, Bw=Bw, Cz=Cz, Dzu=Dzu), n)
+    # end to end: the full block where the projected form does not apply, with the same level
+    full = hinf(problem.plants[0], Bw=problem.Bw, Cz=problem.Cz, Dzu=problem.Dzu, backoff=0.0)
+    projected = hinf(problem.plants[0], Bw=problem.Bw, Cz=problem.Cz, Dzu=problem.Dzu)
+    assert list(full.info["solves"][0]["certificate"]) == ["hinf[0]"]
+    assert list(projected.info["solves"][0]["certificate"]) == ["hinf_projected[0]", "hinf_phi[0]"]
+    assert projected.gamma_opt == pytest.approx(full.gamma_opt, rel=1e-6)

@@ -95,7 +95,17 @@ lists them; every tolerance is named in ``robustctl._hinf._tolerances``):
 * Blocks (:mod:`._lmis`): the constant disturbance block ``I`` is
   eliminated by a Schur complement (e.g. the discrete block becomes
   ``[[X - Bw Bw', A X + G Y, -Bw Dzw'], [*, X, (Cz X + Dzu Y)'], [*, *,
-  gamma^2 I - Dzw Dzw']] >= 0``): same set, ``q`` rows smaller.
+  gamma^2 I - Dzw Dzw']] >= 0``): same set, ``q`` rows smaller. For the
+  plain discrete problem (one plant, no input bound, pole region or
+  uncertainty, a backoff) up to ``PROJECTED_MAX_N`` states the level is
+  minimised with ``Y`` eliminated as well (projection lemma, Gahinet &
+  Apkarian 1994; :func:`._lmis.projected_blocks`): with ``Abar = [F; Cz]``,
+  ``Bbar = [G; Dzu]``, ``Phi = diag(X, gamma^2 I) - [Bw; Dzw][Bw; Dzw]'``
+  and ``N`` a basis of the null space of ``Bbar'``, the blocks
+  ``N'(Phi - Abar X Abar')N >= 0`` and ``Phi >= 0`` (orders ``n + p - m``
+  and ``n + p``), and the gain is the weighted least-squares one,
+  ``K = -(Bbar' Phi^-1 Bbar)^-1 Bbar' Phi^-1 Abar``
+  (:func:`._lmis.projected_gain`), certified like every other gain.
 * Level (:mod:`._level`): ``gamma_opt`` minimises ``gamma^2`` (non-strict
   LMIs: the infimum), in the LQR coordinates of one plant at tolerance
   1e-8, first without Clarabel's iterative refinement (see
@@ -133,25 +143,25 @@ lists them; every tolerance is named in ``robustctl._hinf._tolerances``):
   per iteration on the benchmark plants). Polytopes keep the decomposition.
 
 Where the time goes: nearly all of it is Clarabel's interior-point
-iterations on the dense ``(2 n + p)(2 n + p + 1) / 2`` front of the KKT
-system (cvxpy's compilation and Clarabel's setup are a small part from
-n = 20 on); there is no second solve in the default path of one discrete
-plant. Formulations tried for the level minimisation and not kept, all
-exact: eliminating ``Y`` (elimination lemma, Gahinet & Apkarian 1994)
-leaves ``N'(Phi(X) - Abar X Abar')N >= 0`` and ``X >= Bw Bw'`` (blocks
-``n + p - m`` and ``n`` instead of ``2 n + p``); the Schur complement with
+iterations, each a sparse LDL factorisation of a KKT system whose PSD part
+is dense (``k (k + 1) / 2`` rows for a block of order ``k``); cvxpy's
+compilation and Clarabel's setup are a small part from n = 20 on, and there
+is no second solve in the default path of one discrete plant. The projected
+blocks have about half the rows of the full one; their coefficient map is
+dense (every entry depends on every entry of ``X``), so beyond about 40
+states the full block, whose map stays sparse, factors faster. Small
+problems run Clarabel on one thread (:data:`robustctl._cvx.SINGLE_THREAD_PSD`).
+Formulations tried and not kept, all exact: the Schur complement with
 respect to the middle ``X`` block with ``Z >= Y X^-1 Y'`` lifted as
-``[[Z, Y], [Y', X]] >= 0`` (blocks ``n + p`` and ``n + m``); either in the
-modal or real Schur coordinates of ``F``, or with a dense congruence of the
-second block. Every entry of the smaller blocks depends on every entry of
-``X``; with that dense coefficient map Clarabel's sparse LDL (faer) loses
-to the full LMI, whose coefficient map stays sparse, as the plant grows:
-``benchmarks/investigations/benchmarks_hinf_sdp_forms.py`` times the
-eliminated form, faster than the full LMI on mid-sized plants and slower
-on large ones; it would also need its own gain recovery. Coordinates in which the
-solver's own optimal ``X`` is ``I`` save a few iterations only, and scaling
-the level, Clarabel's step length, regularisation, equilibration and
-presolve settings did not help.
+``[[Z, Y], [Y', X]] >= 0`` (blocks ``n + p`` and ``n + m``), in the modal or
+real Schur coordinates of ``F``, or with a dense congruence of the second
+block; ``Phi >= 0`` split into ``X >= Bw Bw'`` and ``gamma^2 >= 0`` when
+``Dzw = 0`` (smaller, but Clarabel's ordering then factors it more slowly).
+``benchmarks/investigations/benchmarks_hinf_sdp_forms.py`` times the full
+and the projected blocks. Coordinates in which the solver's own optimal
+``X`` is ``I`` save a few iterations only, and scaling the level,
+Clarabel's step length, regularisation, equilibration and presolve settings
+did not help.
 
 References
 ----------

@@ -5,8 +5,9 @@ feasible points. :func:`minimise_level` tries, in order:
 
 1. the preferred coordinates (the LQR ones of a single plant, at
    ``LEVEL_TOL`` with a first attempt without iterative refinement and
-   without Clarabel's chordal decomposition; otherwise the balanced ones
-   at ``LEVEL_TOL_GENERAL``);
+   without Clarabel's chordal decomposition, over the projected blocks
+   where :func:`projected_form` says so and the full block if that fails;
+   otherwise the balanced ones at ``LEVEL_TOL_GENERAL``);
 2. if that solver fails (``ConvergenceError``) in the LQR coordinates: the
    balanced ones;
 3. if the extended (slack-variable) problem still fails: the standard one
@@ -29,10 +30,10 @@ from .. import _cvx
 from ..errors import ConvergenceError, InfeasibleError
 from . import _tolerances as tol
 from ._coordinates import Coordinates, recentred
-from ._lmis import Point, blocks, variables
+from ._lmis import Point, blocks, projected_blocks, projected_gain, variables
 from ._problem import Problem
 
-__all__ = ["Optimum", "Solved", "minimise_level", "solve_level"]
+__all__ = ["Optimum", "Solved", "minimise_level", "solve_level", "projected_form"]
 
 
 class Solved(NamedTuple):
@@ -85,6 +86,10 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
     import cvxpy as cp
 
     extended = problem.extended if extended is None else extended
+    if preconditioned and not extended and projected_form(problem, data.n):
+        found = _solve_projected(problem, data, z_scale)
+        if found is not None:
+            return found
     V = variables(data.n, data.m, len(data.F), extended, uncertain=problem.uncertainty is not None)
     level_sq = cp.Variable(name="level_sq")
     rep = _cvx.solve_sdp(cp.Minimize(level_sq),
@@ -93,6 +98,42 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
                          infeasible_msg=f"no H-infinity state feedback: {problem.infeasibility()}",
                          fast=preconditioned, decompose=not preconditioned)
     return Solved(V.values(), float(_cvx.value(level_sq)), rep)
+
+
+def projected_form(problem: Problem, n: int) -> bool:
+    """Whether the level of ``problem`` is minimised over the projected blocks (:func:`._lmis.projected_blocks`).
+
+    The plain discrete problem (one plant, standard LMI, no input bound,
+    pole region or uncertainty) with a backoff, up to ``PROJECTED_MAX_N``
+    states: there the two smaller blocks solve faster than the full one.
+    """
+    return problem.discrete and not problem.beyond_plain() and problem.backoff > 0 and n <= tol.PROJECTED_MAX_N
+
+
+def _solve_projected(problem: Problem, data: Coordinates, z_scale: float) -> Solved | None:
+    """The level over the projected blocks, with ``Y = K X`` from :func:`._lmis.projected_gain`; ``None`` on failure.
+
+    The gain is that of ``Phi`` at the level ``(1 + backoff / 2) gamma_opt``
+    (``eta`` times ``(1 + backoff / 2)^2``: ``Phi`` is then positive definite
+    even where the optimum makes it singular), like the saddle point of the
+    Riccati path. A failure (solver, certificate or ``Phi``) leaves the
+    decision to the full block.
+    """
+    import cvxpy as cp
+
+    X, level_sq = cp.Variable((data.n, data.n), symmetric=True, name="X"), cp.Variable(name="level_sq")
+    try:
+        rep = _cvx.solve_sdp(cp.Minimize(level_sq), projected_blocks(data, X, level_sq, z_scale),
+                             solver=problem.solver, tol=tol.LEVEL_TOL, fast=True, decompose=False,
+                             infeasible_msg=f"no H-infinity state feedback: {problem.infeasibility()}")
+    except (ConvergenceError, InfeasibleError):
+        return None
+    X_opt, eta = _cvx.value(X), float(_cvx.value(level_sq))
+    X_opt = 0.5 * (X_opt + X_opt.T)
+    K = projected_gain(data, X_opt, eta * (1.0 + 0.5 * problem.backoff) ** 2, z_scale)
+    if K is None:
+        return None
+    return Solved(Point(X=X_opt, Y=K @ X_opt), eta, rep)
 
 
 def minimise_level(problem: Problem, balanced: Coordinates, lqr: Coordinates | None) -> Optimum:

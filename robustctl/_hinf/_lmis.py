@@ -12,14 +12,15 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import scipy.linalg
 
 from .. import _cvx
 from ..regions import region_lmi
 from . import _tolerances as tol
 from ._coordinates import Coordinates
 
-__all__ = ["Point", "variables", "blocks", "hinf_blocks", "lyapunov_blocks", "input_bound_blocks",
-           "region_blocks", "is_strict"]
+__all__ = ["Point", "variables", "blocks", "hinf_blocks", "projected_blocks", "projected_gain", "lyapunov_blocks",
+           "input_bound_blocks", "region_blocks", "is_strict"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,6 +130,77 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
                            [-CX - BD.T, level_sq * Ip - DD]])
         out.append(_cvx.LMI(f"hinf[{i}]", M, margin))
     return out
+
+
+def projected_blocks(data: Coordinates, X, level_sq, z_scale: float = 1.0) -> list[_cvx.LMI]:
+    r"""The discrete H-infinity block of one plant with ``Y`` eliminated (projection lemma): two smaller blocks.
+
+    With ``Abar = [F; Cz]``, ``Bbar = [G; Dzu]``, ``Wbar = [Bw; Dzw]``,
+    ``eta = level_sq`` and ``Phi(X, eta) = diag(X, eta I) - Wbar Wbar'``, the
+    block of :func:`hinf_blocks` is (rows reordered) ``[[Phi, Abar X + Bbar
+    Y], [*, X]] >= 0``. ``Y`` enters only through ``Bbar Y [0 I]``, so by the
+    projection lemma (Gahinet & Apkarian 1994) some ``Y`` satisfies it
+    exactly when both of its projections do, onto the null space of
+    ``[Bbar' 0]`` and of ``[0 I]``:
+
+    * ``hinf_projected[0]``: ``N'(Phi - Abar X Abar')N >= 0`` (order ``n + p - m``,
+      after a Schur complement on ``X``), ``N`` an orthonormal basis of the
+      null space of ``Bbar'``;
+    * ``hinf_phi[0]``: ``Phi >= 0`` (order ``n + p``).
+
+    Instead of one block of order ``2 n + p`` and ``m n`` variables fewer; the
+    gain is recovered by :func:`projected_gain`. ``X`` (a cvxpy variable or
+    an array) and ``level_sq`` are in ``data``'s coordinates, with ``z``
+    multiplied by ``z_scale`` as in :func:`hinf_blocks`.
+    """
+    Abar, Bbar, Wbar = _stacked(data, z_scale)
+    N = scipy.linalg.null_space(Bbar.T)
+    NA, NW = N.T @ Abar, N.T @ Wbar
+    Nx, Nz = N[:data.n], N[data.n:]
+    projected = Nx.T @ X @ Nx + level_sq * (Nz.T @ Nz) - NA @ X @ NA.T - NW @ NW.T
+    return [_cvx.LMI("hinf_projected[0]", projected), _cvx.LMI("hinf_phi[0]", _phi(Wbar, X, level_sq))]
+
+
+def projected_gain(data: Coordinates, X: np.ndarray, level_sq: float, z_scale: float = 1.0) -> np.ndarray | None:
+    r"""The gain of a point ``(X, eta)`` of :func:`projected_blocks`: ``K = -(Bbar' Phi^-1 Bbar)^+ Bbar' Phi^-1 Abar``.
+
+    With ``Y = K X`` and ``Phi > 0`` the block of :func:`hinf_blocks` is, by
+    Schur complements, ``X^-1 - (Abar + Bbar K)' Phi^-1 (Abar + Bbar K) >= 0``.
+    The weighted least-squares ``K`` minimises ``(Abar + Bbar K)' Phi^-1 (Abar
+    + Bbar K)`` in the positive semidefinite order (it is ``Abar' (Phi^-1 -
+    Phi^-1 Bbar (Bbar' Phi^-1 Bbar)^+ Bbar' Phi^-1) Abar`` there), so it
+    satisfies the block whenever any gain does.
+
+    At an optimum ``Phi`` can be singular (``X - Bw Bw'`` is, on some
+    plants): a direction ``v`` with ``Phi v = 0`` forces ``v'(Abar + Bbar K)
+    = 0``. ``Phi`` is therefore lifted to at least ``PHI_FLOOR`` of its
+    largest eigenvalue first, and the weighted least squares keeps that
+    constraint up to the floor. ``None`` if ``Phi`` is not finite or not
+    positive anywhere.
+    """
+    Abar, Bbar, Wbar = _stacked(data, z_scale)
+    phi = _phi(Wbar, 0.5 * (X + X.T), level_sq)
+    if not np.all(np.isfinite(phi)):
+        return None
+    lam = np.linalg.eigvalsh(phi)
+    if not lam[-1] > 0:
+        return None
+    L = np.linalg.cholesky(phi + max(0.0, tol.PHI_FLOOR * lam[-1] - lam[0]) * np.eye(phi.shape[0]))
+    LA, LB = scipy.linalg.solve_triangular(L, Abar, lower=True), scipy.linalg.solve_triangular(L, Bbar, lower=True)
+    return -np.linalg.lstsq(LB, LA, rcond=None)[0]
+
+
+def _stacked(data: Coordinates, z_scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``Abar = [F; Cz]``, ``Bbar = [G; Dzu]``, ``Wbar = [Bw; Dzw]`` of the nominal plant, ``z`` times ``z_scale``."""
+    return (np.vstack([data.F[0], z_scale * data.Cz]), np.vstack([data.G[0], z_scale * data.Dzu]),
+            np.vstack([data.Bw, z_scale * data.Dzw]))
+
+
+def _phi(Wbar: np.ndarray, X, level_sq):
+    """``Phi(X, eta) = diag(X, eta I) - Wbar Wbar'`` for a variable or an array ``X`` (as one matrix)."""
+    n = X.shape[0]
+    WW = Wbar @ Wbar.T
+    return _bmat([[X - WW[:n, :n], -WW[:n, n:]], [-WW[n:, :n], level_sq * np.eye(WW.shape[0] - n) - WW[n:, n:]]])
 
 
 def _robust_block(data: Coordinates, eps, X, Y, AX, CX, W, BB, BD, discrete: bool):

@@ -52,6 +52,16 @@ class Problem:
     def polytopic(self) -> bool:
         return len(self.plants) > 1
 
+    def beyond_plain(self) -> list[str]:
+        """The arguments that make this more than the plain problem, in the order of ``hinf``'s signature.
+
+        The plain problem: one plant, free level, standard LMI, no input bound, pole region or uncertainty.
+        """
+        return [name for name, on in (("vertices", self.polytopic), ("gamma", self.gamma is not None),
+                                      ("u_max", self.u_max is not None), ("extended", self.extended),
+                                      ("poles", bool(self.regions)), ("uncertainty", self.uncertainty is not None))
+                if on]
+
     def infeasibility(self) -> str:
         """Plain-English statement of what no gain satisfies (for InfeasibleError messages)."""
         if not self.polytopic:

@@ -91,9 +91,7 @@ def riccati_synthesis(problem: Problem, data: Coordinates, lqr: Coordinates | No
 
 def check_plain(problem: Problem) -> None:
     """ValueError naming the argument that ``synthesis="riccati"`` does not support."""
-    given = [name for name, on in (("vertices", problem.polytopic), ("u_max", problem.u_max is not None),
-                                   ("poles", bool(problem.regions)), ("uncertainty", problem.uncertainty is not None),
-                                   ("gamma", problem.gamma is not None), ("extended", problem.extended)) if on]
+    given = problem.beyond_plain()
     if given:
         raise ValueError(f"synthesis='riccati' is the plain problem only (one plant, free level, no input bound, "
                          f"pole region or uncertainty, standard LMI); drop {', '.join(given)} or use "

@@ -44,6 +44,14 @@ LEVEL_TOL = 1e-8
 #: bound, are badly conditioned: a looser first solve there ends 1e-3 above
 #: the level that the tighter one and its polish reach).
 LEVEL_TOL_GENERAL = 1e-10
+#: Largest number of states whose level is minimised over the projected
+#: blocks (:func:`._level.projected_form`): beyond it the full block solves
+#: faster (measured in the documentation, Validation: Benchmarks).
+PROJECTED_MAX_N = 40
+#: The gain of a projected-blocks optimum (:func:`._lmis.projected_gain`)
+#: weighs with ``Phi`` lifted to at least ``PHI_FLOOR`` of its largest
+#: eigenvalue (above the solver's accuracy ``LEVEL_TOL``).
+PHI_FLOOR = 1e-6
 #: Solver tolerance of the centring and fixed-level problems (their optimum
 #: need not be exact: only their certificate matters).
 CENTRE_TOL = 1e-7
