@@ -26,7 +26,7 @@ scaled by hand (:func:`units`: the synthesis scales them inside, so both are
 the same problem for the solver). Robust against polytopic H-infinity on the
 truck is in ``bench_analysis.py``.
 
-``--before ROOT`` times only the SDP path (the whole ``hinf`` call, CPU time of the process) of the
+``--before ROOT`` times only the SDP path (the whole ``hinf`` call, CPU time of the process and wall-clock time) of the
 checkout at ROOT (e.g. the main branch) against this one, each in a fresh subprocess that imports
 ``robustctl`` from its own tree, alternating the two for ``--rounds`` rounds and taking medians (on a
 shared machine the load changes between runs; interleaving spreads it over both).
@@ -160,8 +160,8 @@ def cl_norm(plant, K, Bw, Cz, Dzu) -> float:
 
 
 # The SDP path of one checkout, timed in a subprocess (``robustctl`` imported from ROOT via PYTHONPATH):
-# the plants of ``case`` (its source, inserted below) rebuilt from the same seeds; prints the median CPU time
-# per call and gamma_opt.
+# the plants of ``case`` (its source, inserted below) rebuilt from the same seeds; prints the median CPU and
+# wall-clock times per call and gamma_opt.
 _TIMER = """
 import json, sys, time
 import numpy as np
@@ -172,17 +172,19 @@ n, seed, reps = (int(a) for a in sys.argv[1:4])
 w = case(3, 0)
 hinf(w[0], Bw=w[1], Cz=w[2], Dzu=w[3])
 plant, Bw, Cz, Dzu = case(n, seed)
-cpu = []
+cpu, wall = [], []
 for _ in range(reps):
-    t0 = time.process_time()
+    t0, w0 = time.process_time(), time.perf_counter()
     ctrl = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
     cpu.append(time.process_time() - t0)
-print(json.dumps({{"cpu": float(np.median(cpu)), "gamma_opt": ctrl.gamma_opt, "iterations": ctrl.info["iterations"]}}))
+    wall.append(time.perf_counter() - w0)
+print(json.dumps({{"cpu": float(np.median(cpu)), "wall": float(np.median(wall)), "gamma_opt": ctrl.gamma_opt,
+                  "iterations": ctrl.info["iterations"]}}))
 """
 
 
 def sdp_cpu(root: str, n: int, seed: int, reps: int) -> dict:
-    """The median CPU time of ``reps`` SDP-path calls of the checkout at ``root`` (a fresh subprocess)."""
+    """The median CPU and wall-clock times of ``reps`` SDP-path calls of the checkout at ``root`` (a fresh subprocess)."""
     env = dict(os.environ, PYTHONPATH=str(Path(root).resolve()))
     code = _TIMER.format(case=inspect.getsource(case))
     out = subprocess.run([sys.executable, "-c", code, str(n), str(seed), str(reps)], env=env, cwd=root,
@@ -197,12 +199,13 @@ def before_after(before: str, sizes, rounds: int, reps: int, out: Path) -> None:
                     f"python -m benchmarks.bench_hinf --before {before} --sizes {' '.join(map(str, sizes))} "
                     f"--rounds {rounds} --reps {reps}")
     lines += [(f"The whole `rc.hinf(...)` call (default `synthesis=\"lmi\"`) on the plant `case(n, 0)`: CPU time per "
-               f"call, median of {reps} calls per round, median over {rounds} rounds, the two checkouts alternating, "
-               f"each in a fresh process importing its own tree. Before: `{before}` (commit "
-               f"{_commit(before)}); after: this checkout (commit {_commit(str(here))})."), "",
+               f"call (of the process, all threads), median of {reps} calls per round, median over {rounds} rounds, "
+               "the two checkouts alternating, each in a fresh process importing its own tree; the same for the "
+               f"wall-clock time. Before: `{before}` (commit {_commit(before)}); after: this checkout (commit "
+               f"{_commit(str(here))})."), "",
               ("| n | before [s] | after [s] | **before / after** | per-round range before / after | "
-               "iterations before / after | `gamma_opt` after / before - 1 |"),
-              "|---|---|---|---|---|---|---|"]
+               "wall: before / after [s] (ratio) | iterations before / after | `gamma_opt` after / before - 1 |"),
+              "|---|---|---|---|---|---|---|---|"]
     print("\n".join(lines), flush=True)
     for n in sizes:
         b, a = [], []
@@ -210,9 +213,11 @@ def before_after(before: str, sizes, rounds: int, reps: int, out: Path) -> None:
             b.append(sdp_cpu(before, n, 0, reps))
             a.append(sdp_cpu(str(here), n, 0, reps))
         tb, ta = np.median([r["cpu"] for r in b]), np.median([r["cpu"] for r in a])
+        wb, wa = np.median([r["wall"] for r in b]), np.median([r["wall"] for r in a])
         spread = " / ".join(f"{min(r['cpu'] for r in x):.3g}-{max(r['cpu'] for r in x):.3g}" for x in (b, a))
-        lines.append(f"| {n} | {tb:.3g} | {ta:.3g} | **{tb / ta:.2f}** | {spread} | {b[0]['iterations']} / "
-                     f"{a[0]['iterations']} | {a[0]['gamma_opt'] / b[0]['gamma_opt'] - 1:.1e} |")
+        lines.append(f"| {n} | {tb:.3g} | {ta:.3g} | **{tb / ta:.2f}** | {spread} | {wb:.3g} / {wa:.3g} "
+                     f"({wb / wa:.2f}) | {b[0]['iterations']} / {a[0]['iterations']} | "
+                     f"{a[0]['gamma_opt'] / b[0]['gamma_opt'] - 1:.1e} |")
         print(lines[-1], flush=True)
     write(lines, out)
 

@@ -113,11 +113,12 @@ def projected_form(problem: Problem, n: int) -> bool:
 def _solve_projected(problem: Problem, data: Coordinates, z_scale: float) -> Solved | None:
     """The level over the projected blocks, with ``Y = K X`` from :func:`._lmis.projected_gain`; ``None`` on failure.
 
-    The gain is that of ``Phi`` at the level ``(1 + backoff / 2) gamma_opt``
-    (``eta`` times ``(1 + backoff / 2)^2``: ``Phi`` is then positive definite
-    even where the optimum makes it singular), like the saddle point of the
-    Riccati path. A failure (solver, certificate or ``Phi``) leaves the
-    decision to the full block.
+    The gain is the weighted least-squares one at the optimum ``(X, eta)``
+    itself (``Phi`` floored where the optimum makes it singular): on the
+    plants tried it is the gain ``Y X^-1`` of the full block's optimum to
+    the accuracy of the solve, and like that one it is certified at the
+    backed-off level by :func:`._gains.optimum_certified`. A failure
+    (solver, certificate or ``Phi``) leaves the decision to the full block.
     """
     import cvxpy as cp
 
@@ -130,7 +131,7 @@ def _solve_projected(problem: Problem, data: Coordinates, z_scale: float) -> Sol
         return None
     X_opt, eta = _cvx.value(X), float(_cvx.value(level_sq))
     X_opt = 0.5 * (X_opt + X_opt.T)
-    K = projected_gain(data, X_opt, eta * (1.0 + 0.5 * problem.backoff) ** 2, z_scale)
+    K = projected_gain(data, X_opt, eta, z_scale)
     if K is None:
         return None
     return Solved(Point(X=X_opt, Y=K @ X_opt), eta, rep)

@@ -50,8 +50,12 @@ LEVEL_TOL_GENERAL = 1e-10
 PROJECTED_MAX_N = 40
 #: The gain of a projected-blocks optimum (:func:`._lmis.projected_gain`)
 #: weighs with ``Phi`` lifted to at least ``PHI_FLOOR`` of its largest
-#: eigenvalue (above the solver's accuracy ``LEVEL_TOL``).
-PHI_FLOOR = 1e-6
+#: eigenvalue: at the optimum ``Phi`` can be singular, and eigenvalues below
+#: the accuracy of the level minimisation (``LEVEL_TOL``) are rounding noise
+#: of either sign (as for ``OPTIMUM_X_FLOOR``). A larger floor moves the gain
+#: away from the optimum's (1e-6: the truck's closed-loop norm 1.1e-4 above
+#: ``gamma_opt`` instead of 1e-6).
+PHI_FLOOR = 1e-8
 #: Solver tolerance of the centring and fixed-level problems (their optimum
 #: need not be exact: only their certificate matters).
 CENTRE_TOL = 1e-7
