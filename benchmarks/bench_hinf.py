@@ -184,7 +184,7 @@ print(json.dumps({{"cpu": float(np.median(cpu)), "wall": float(np.median(wall)),
 
 
 def sdp_cpu(root: str, n: int, seed: int, reps: int) -> dict:
-    """The median CPU and wall-clock times of ``reps`` SDP-path calls of the checkout at ``root`` (a fresh subprocess)."""
+    """Median CPU and wall-clock times of ``reps`` SDP-path calls of the checkout at ``root`` (a fresh subprocess)."""
     env = dict(os.environ, PYTHONPATH=str(Path(root).resolve()))
     code = _TIMER.format(case=inspect.getsource(case))
     out = subprocess.run([sys.executable, "-c", code, str(n), str(seed), str(reps)], env=env, cwd=root,
