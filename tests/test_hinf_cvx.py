@@ -77,6 +77,26 @@ def test_whole_block_factorisation_gives_the_same_optimum(monkeypatch, decompose
     assert seen and set(seen) == {decompose}
 
 
+@pytest.mark.parametrize("threshold,threads", [(_cvx.SINGLE_THREAD_PSD, 1), (20, 0)])
+def test_small_problems_run_clarabel_on_one_thread(monkeypatch, threshold, threads):
+    """Blocks of 6 + 15 = 21 free entries: one thread up to the threshold, Clarabel's default above; same optimum."""
+    seen = []
+    real = cp.Problem.solve
+
+    def spy(self, *a, **k):
+        seen.append(k.get("max_threads"))
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(cp.Problem, "solve", spy)
+    monkeypatch.setattr(_cvx, "SINGLE_THREAD_PSD", threshold)
+    X, t = cp.Variable((5, 5), symmetric=True), cp.Variable()
+    lmis = [_cvx.LMI("X-I", X - np.eye(5)), _cvx.LMI("upper", cp.bmat([[t * np.eye(2), np.ones((2, 1))],
+                                                                         [np.ones((1, 2)), np.ones((1, 1))]]))]
+    rep = _cvx.solve_sdp(cp.Minimize(cp.trace(X) + t), lmis)
+    assert set(seen) == {threads}
+    assert rep.value == pytest.approx(5.0 + 2.0, rel=1e-7)   # X = I; [[t I, 1], [1', 1]] >= 0 iff t >= 2
+
+
 def test_infeasible_lmi_raises_with_the_callers_message():
     X = cp.Variable((2, 2), symmetric=True)
     with pytest.raises(InfeasibleError, match="no X for the test"):
