@@ -2,7 +2,7 @@ r"""The H-infinity level SDP of one discrete plant: the standard LMI against its
 
 Usage::
 
-    python -m benchmarks.investigations.benchmarks_hinf_sdp_forms [--sizes 20 30 50] [--reps 3]
+    python -m benchmarks.investigations.benchmarks_hinf_sdp_forms [--sizes 20 30 40 50] [--reps 3]
         [--shift 1e-6] [--one-rep-from 50] [--out benchmarks/results/hinf_sdp_forms.md]
 
 (quick look: ``--sizes 4 --reps 1 --out /tmp/forms.md``)
@@ -10,7 +10,11 @@ Usage::
 ``rc.hinf`` (``synthesis="lmi"``) minimises ``eta = gamma^2`` subject to the
 discrete bounded-real LMI in one cvxpy/Clarabel solve. This asks whether a
 smaller SDP, the one in which the projection (elimination) lemma removes
-``Y = K X``, solves faster. Both forms are posed here, on the same data:
+``Y = K X``, solves faster, and up to which size. (The library's level
+minimisation of one plant uses the eliminated form,
+``robustctl._hinf._lmis.projected_blocks``, up to the size where this
+measures it faster.) Both forms are posed here, on the same data, written
+out independently of the library:
 
 ``standard`` (variables ``X`` symmetric, ``Y``, ``eta``; one PSD block of order ``2n + p``)::
 
@@ -52,12 +56,15 @@ positive definite at n = 50.) ``eta`` is the level of these scaled data.
 
 Solves: Clarabel through cvxpy with ``tol_gap_abs = tol_gap_rel = tol_feas
 = 1e-8``, ``chordal_decomposition_enable=False``,
-``iterative_refinement_enable=False`` (*tuned*), and at the first size
-also with Clarabel's defaults; both forms also with CVXOPT when it is
+``iterative_refinement_enable=False``, ``max_threads=1`` (*tuned*; the
+library runs Clarabel on one thread when the PSD blocks have at most 2500
+free entries, the full LMI up to n = 30 and the eliminated form up to
+n = 40, and on its default threads above), the same on Clarabel's
+default threads (``max_threads=0``), and at the first size also with
+Clarabel's defaults; both forms also with CVXOPT when it is
 importable (it is not a dependency), with its defaults (``abstol = 1e-7,
 reltol = 1e-6, feastol = 1e-7``; at 1e-8 it stops short of its tolerances
-on some of these plants). Clarabel's own threads are left at their
-default, as in the library. Each timing is the whole ``problem.solve`` call
+on some of these plants). Each timing is the whole ``problem.solve`` call
 (cvxpy's compilation included) on a freshly built problem: CPU time of the
 process (``time.process_time``, all threads) and wall-clock time, the best
 of ``--reps`` runs (one run from ``--one-rep-from`` states on), the forms
@@ -95,7 +102,7 @@ import scipy.linalg  # noqa: E402
 from benchmarks.bench_hinf import case, peer_hinf  # noqa: E402
 
 TUNED = dict(tol_gap_abs=1e-8, tol_gap_rel=1e-8, tol_feas=1e-8, chordal_decomposition_enable=False,
-             iterative_refinement_enable=False)
+             iterative_refinement_enable=False, max_threads=1)
 FORMS = ("standard", "eliminated")
 BACKOFF = 1e-3
 
@@ -279,6 +286,9 @@ def summary(found: dict[int, dict], with_cvxopt: bool) -> str:
     return (
         "Clarabel tuned, CPU time of the standard form over that of the eliminated form: "
         + each(lambda f: f"{ratio(f['std'], f['elim'])} ({f['std']:.3g} s against {f['elim']:.3g} s)") + ". "
+        "Wall-clock time on one thread against Clarabel's default threads, standard form; eliminated form: "
+        + each(lambda f: "; ".join(f"{f['wall'][form]:.3g} s against {f['threads'][form]:.3g} s" for form in FORMS))
+        + ". "
         "Total svec dimension of the PSD blocks, standard against eliminated: "
         + each(lambda f: f"{f['svec']['standard']} against {f['svec']['eliminated']}") + "; "
         "nonzeros of the constraint matrix: "
@@ -297,7 +307,7 @@ def summary(found: dict[int, dict], with_cvxopt: bool) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[20, 30, 50], help="numbers of states n")
+    ap.add_argument("--sizes", type=int, nargs="+", default=[20, 30, 40, 50], help="numbers of states n")
     ap.add_argument("--reps", type=int, default=3, help="timed runs per form (best taken)")
     ap.add_argument("--shift", type=float, default=1e-6,
                     help="lift of the Riccati solution's smallest eigenvalue, relative to its largest (library: 1e-6)")
@@ -322,8 +332,9 @@ def main(argv: list[str] | None = None) -> int:
               f"coordinates described in the script's docstring (shift {args.shift:g}); `eta = gamma^2` of the scaled "
               "data. "
               "*Clarabel tuned*: `tol_gap_abs = tol_gap_rel = tol_feas = 1e-8`, chordal decomposition and "
-              "iterative refinement off; *defaults*: the solver's defaults. Time: the whole `problem.solve` "
-              "call (cvxpy's compilation included), CPU time of the process with the wall-clock time in "
+              "iterative refinement off, one thread; *default threads*: the same on Clarabel's default threads; "
+              "*defaults*: the solver's defaults. Time: the whole `problem.solve` call (cvxpy's compilation "
+              "included), CPU time of the process with the wall-clock time in "
               f"brackets, best of {args.reps} run(s) (one run from n = {args.one_rep_from} on), the forms "
               "alternating. Solver wall: the solve time the solver reports to cvxpy (best run). "
               "PSD blocks: order (svec dimension). nnz(A): nonzeros of the constraint matrix passed to the "
@@ -343,7 +354,8 @@ def main(argv: list[str] | None = None) -> int:
         nnz = {form: nnz_a(BUILD[form](d)[0]) for form in FORMS}
         svec = {form: sum(k * (k + 1) // 2 for k in sizes(d, form)[0]) for form in FORMS}
         reps = args.reps if n < args.one_rep_from else 1
-        settings = [("Clarabel tuned", "CLARABEL", TUNED)]
+        settings = [("Clarabel tuned", "CLARABEL", TUNED),
+                    ("Clarabel tuned, default threads", "CLARABEL", {**TUNED, "max_threads": 0})]
         if i == 0:
             settings.append(("Clarabel defaults", "CLARABEL", {}))
         for label, solver, options in settings:
@@ -355,7 +367,10 @@ def main(argv: list[str] | None = None) -> int:
             if label == "Clarabel tuned":
                 reference, check = runs["standard"], gain_check(d, runs["eliminated"])
                 found[n] = dict(std=reference.cpu, elim=runs["eliminated"].cpu, check=check, nnz=nnz, svec=svec,
-                                error={form: (runs[form].eta - eta_peer) / eta_peer for form in FORMS})
+                                error={form: (runs[form].eta - eta_peer) / eta_peer for form in FORMS},
+                                wall={form: runs[form].wall for form in FORMS})
+            elif label == "Clarabel tuned, default threads":
+                found[n]["threads"] = {form: runs[form].wall for form in FORMS}
             for form in FORMS:
                 lines.append(row(d, form, label, runs[form], reference, check if form == "eliminated" else None,
                                  nnz[form], eta_peer))

@@ -170,8 +170,11 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         (the value used), ``poles`` (the regions), ``uncertainty`` and, with
         one, ``multipliers`` (the S-procedure multipliers). Each entry of
         ``solves`` has the solver's ``status``, ``value``, ``tol``,
-        ``solve_time``, ``iterations`` and ``certificate``; centring solves
-        also name their ``centring`` variant. ``synthesis`` (``"lmi"`` or
+        ``solve_time``, ``iterations`` and ``certificate`` (of the blocks
+        that solve imposed: ``hinf_projected[0]`` and ``hinf_phi[0]`` when
+        the level of the plain discrete problem was minimised with ``Y``
+        eliminated, see :mod:`robustctl._hinf`); centring solves also name
+        their ``centring`` variant. ``synthesis`` (``"lmi"`` or
         ``"riccati"``: the path that returned the gain) and, with
         ``synthesis="riccati"``, ``riccati`` (bisection ``iterations`` and
         the bracket ``gamma_low``) and ``fallback`` (why the SDP was solved,
