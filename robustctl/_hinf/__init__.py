@@ -150,7 +150,7 @@ is no second solve in the default path of one discrete plant. The projected
 blocks have about half the rows of the full one; their coefficient map is
 dense (every entry depends on every entry of ``X``), so beyond about 40
 states the full block, whose map stays sparse, factors faster. Small
-problems run Clarabel on one thread (:data:`robustctl._cvx.SINGLE_THREAD_PSD`).
+problems run Clarabel on one thread (``robustctl._cvx.SINGLE_THREAD_PSD``).
 Formulations tried and not kept, all exact: the Schur complement with
 respect to the middle ``X`` block with ``Z >= Y X^-1 Y'`` lifted as
 ``[[Z, Y], [Y', X]] >= 0`` (blocks ``n + p`` and ``n + m``), in the modal or
