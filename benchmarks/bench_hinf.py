@@ -183,7 +183,7 @@ print(json.dumps({{"cpu": float(np.median(cpu)), "wall": float(np.median(wall)),
 """
 
 
-def sdp_cpu(root: str, n: int, seed: int, reps: int) -> dict:
+def sdp_times(root: str, n: int, seed: int, reps: int) -> dict:
     """Median CPU and wall-clock times of ``reps`` SDP-path calls of the checkout at ``root`` (a fresh subprocess)."""
     env = dict(os.environ, PYTHONPATH=str(Path(root).resolve()))
     code = _TIMER.format(case=inspect.getsource(case))
@@ -210,8 +210,8 @@ def before_after(before: str, sizes, rounds: int, reps: int, out: Path) -> None:
     for n in sizes:
         b, a = [], []
         for _ in range(rounds):
-            b.append(sdp_cpu(before, n, 0, reps))
-            a.append(sdp_cpu(str(here), n, 0, reps))
+            b.append(sdp_times(before, n, 0, reps))
+            a.append(sdp_times(str(here), n, 0, reps))
         tb, ta = np.median([r["cpu"] for r in b]), np.median([r["cpu"] for r in a])
         wb, wa = np.median([r["wall"] for r in b]), np.median([r["wall"] for r in a])
         spread = " / ".join(f"{min(r['cpu'] for r in x):.3g}-{max(r['cpu'] for r in x):.3g}" for x in (b, a))

@@ -46,8 +46,22 @@ def test_fast_attempt_agrees_with_the_refined_solve():
     assert values[1] == pytest.approx(exact, rel=1e-7)
 
 
+@pytest.fixture
+def solve_settings(monkeypatch):
+    """The keyword arguments of every ``cvxpy.Problem.solve`` call of the test, in order (the solve still runs)."""
+    seen: list[dict] = []
+    real = cp.Problem.solve
+
+    def spy(self, *args, **kwargs):
+        seen.append(kwargs)
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(cp.Problem, "solve", spy)
+    return seen
+
+
 @pytest.mark.parametrize("decompose", [True, False])
-def test_whole_block_factorisation_gives_the_same_optimum(monkeypatch, decompose):
+def test_whole_block_factorisation_gives_the_same_optimum(solve_settings, decompose):
     """decompose=False (no chordal decomposition in Clarabel) reaches the solver and the exact optimum.
 
     ``[[X - I, A X, 0], [X A', X, 0], [0, 0, t - 1]] >= 0`` (cliques ``2 n`` and 1) and ``X <= t I``: the
@@ -59,14 +73,6 @@ def test_whole_block_factorisation_gives_the_same_optimum(monkeypatch, decompose
     rng = np.random.default_rng(4)
     A = rng.normal(size=(5, 5))
     A *= 0.9 / np.max(np.abs(np.linalg.eigvals(A)))
-    seen = []
-    real = cp.Problem.solve
-
-    def spy(self, *args, **kwargs):
-        seen.append(kwargs.get("chordal_decomposition_enable"))
-        return real(self, *args, **kwargs)
-
-    monkeypatch.setattr(cp.Problem, "solve", spy)
     X, t = cp.Variable((5, 5), symmetric=True), cp.Variable()
     Z = np.zeros((5, 1))
     block = cp.bmat([[X - np.eye(5), A @ X, Z], [X @ A.T, X, Z], [Z.T, Z.T, cp.reshape(t - 1.0, (1, 1), order="F")]])
@@ -74,26 +80,18 @@ def test_whole_block_factorisation_gives_the_same_optimum(monkeypatch, decompose
                          tol=1e-9, decompose=decompose)
     exact = np.linalg.eigvalsh(scipy.linalg.solve_discrete_lyapunov(A, np.eye(5))).max()
     assert exact > 1.0 and rep.value == pytest.approx(exact, rel=1e-7)
-    assert seen and set(seen) == {decompose}
+    assert solve_settings and {k["chordal_decomposition_enable"] for k in solve_settings} == {decompose}
 
 
 @pytest.mark.parametrize("threshold,threads", [(_cvx.SINGLE_THREAD_PSD, 1), (20, 0)])
-def test_small_problems_run_clarabel_on_one_thread(monkeypatch, threshold, threads):
+def test_small_problems_run_clarabel_on_one_thread(monkeypatch, solve_settings, threshold, threads):
     """Blocks of 6 + 15 = 21 free entries: one thread up to the threshold, Clarabel's default above; same optimum."""
-    seen = []
-    real = cp.Problem.solve
-
-    def spy(self, *a, **k):
-        seen.append(k.get("max_threads"))
-        return real(self, *a, **k)
-
-    monkeypatch.setattr(cp.Problem, "solve", spy)
     monkeypatch.setattr(_cvx, "SINGLE_THREAD_PSD", threshold)
     X, t = cp.Variable((5, 5), symmetric=True), cp.Variable()
     lmis = [_cvx.LMI("X-I", X - np.eye(5)), _cvx.LMI("upper", cp.bmat([[t * np.eye(2), np.ones((2, 1))],
                                                                          [np.ones((1, 2)), np.ones((1, 1))]]))]
     rep = _cvx.solve_sdp(cp.Minimize(cp.trace(X) + t), lmis)
-    assert set(seen) == {threads}
+    assert solve_settings and {k["max_threads"] for k in solve_settings} == {threads}
     assert rep.value == pytest.approx(5.0 + 2.0, rel=1e-7)   # X = I; [[t I, 1], [1', 1]] >= 0 iff t >= 2
 
 

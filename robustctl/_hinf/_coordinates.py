@@ -16,7 +16,9 @@ factors, only the solver's path (iterations, accuracy) changes.
   factor with the same Gram matrix when that has fewer rows.
 * :func:`lqr_coordinates`: coordinates in which the inverse of the LQR
   Riccati solution of the nominal vertex is ~ I.
-* :func:`recentred`: coordinates in which a given Lyapunov matrix is ~ I.
+* :func:`recentred`: coordinates in which a given Lyapunov matrix is ~ I;
+* :func:`lifted`: the eigenvalue floor that both of the last two, and the
+  gain of the projected blocks, put under a matrix before factoring it.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import scipy.linalg
 
 from . import _tolerances as tol
 
-__all__ = ["Coordinates", "channel_scales", "normalised", "lqr_coordinates", "recentred"]
+__all__ = ["Coordinates", "channel_scales", "normalised", "lqr_coordinates", "recentred", "lifted"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -195,14 +197,12 @@ def lqr_coordinates(data: Coordinates, discrete: bool) -> Coordinates | None:
     are = scipy.linalg.solve_discrete_are if discrete else scipy.linalg.solve_continuous_are
     try:
         with np.errstate(all="ignore"):
-            P = are(F, G, Q, R, s=S)
-        lam = np.linalg.eigvalsh(0.5 * (P + P.T))
+            P = lifted(are(F, G, Q, R, s=S), tol.LQR_SHIFT)
     except (ValueError, np.linalg.LinAlgError):
         return None
-    if not (np.all(np.isfinite(lam)) and lam[-1] > 0):
+    if P is None:
         return None
-    X = np.linalg.inv(0.5 * (P + P.T) + max(0.0, tol.LQR_SHIFT * lam[-1] - lam[0]) * np.eye(n))
-    moved = recentred(data, X, tol.LQR_SHIFT)  # X > 0 by construction
+    moved = recentred(data, np.linalg.inv(P), tol.LQR_SHIFT)  # P^-1 > 0 by construction
     if moved is None:
         return None
     bw = float(np.linalg.norm(moved[0].Bw, 2))
@@ -220,13 +220,27 @@ def recentred(data: Coordinates, X: np.ndarray, reg: float) -> tuple[Coordinates
     ``X``. Returns the new coordinates and ``lambda_max`` of ``X`` in them
     (<= 1), or ``None`` if ``X`` is unusable (not finite, or ``lambda_max <= 0``).
     """
+    X_lifted = lifted(X, reg)
+    if X_lifted is None:
+        return None
+    R = np.linalg.cholesky(X_lifted)
     X = 0.5 * (X + X.T)
-    if not np.all(np.isfinite(X)):
-        return None
-    lam = np.linalg.eigvalsh(X)
-    if not lam[-1] > 0:
-        return None
-    # smallest eigenvalue of the shifted matrix >= reg lambda_max > 0: the Cholesky factor exists
-    R = np.linalg.cholesky(X + max(0.0, reg * lam[-1] - lam[0]) * np.eye(data.n))
     Xh = np.linalg.solve(R, np.linalg.solve(R, X).T)
     return data.to(data.T @ R), float(np.linalg.eigvalsh(0.5 * (Xh + Xh.T))[-1])
+
+
+def lifted(M: np.ndarray, floor: float) -> np.ndarray | None:
+    """``M`` symmetrised and shifted, ``M + s I``, so that its smallest eigenvalue is at least ``floor lambda_max(M)``.
+
+    The shift ``s = max(0, floor lambda_max - lambda_min)`` is zero when ``M``
+    already meets the floor. With ``0 < floor`` the result is positive
+    definite (its Cholesky factor exists). ``None`` if ``M`` is not finite or
+    ``lambda_max(M) <= 0`` (nothing to take the shape from).
+    """
+    M = 0.5 * (M + M.T)
+    if not np.all(np.isfinite(M)):
+        return None
+    lam = np.linalg.eigvalsh(M)
+    if not lam[-1] > 0:
+        return None
+    return M + max(0.0, floor * lam[-1] - lam[0]) * np.eye(M.shape[0])

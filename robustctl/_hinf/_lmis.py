@@ -17,7 +17,7 @@ import scipy.linalg
 from .. import _cvx
 from ..regions import region_lmi
 from . import _tolerances as tol
-from ._coordinates import Coordinates
+from ._coordinates import Coordinates, lifted
 
 __all__ = ["Point", "variables", "blocks", "hinf_blocks", "projected_blocks", "projected_gain", "lyapunov_blocks",
            "input_bound_blocks", "region_blocks", "is_strict"]
@@ -179,13 +179,10 @@ def projected_gain(data: Coordinates, X: np.ndarray, level_sq: float, z_scale: f
     positive anywhere.
     """
     Abar, Bbar, Wbar = _stacked(data, z_scale)
-    phi = _phi(Wbar, 0.5 * (X + X.T), level_sq)
-    if not np.all(np.isfinite(phi)):
+    phi = lifted(_phi(Wbar, X, level_sq), tol.PHI_FLOOR)
+    if phi is None:
         return None
-    lam = np.linalg.eigvalsh(phi)
-    if not lam[-1] > 0:
-        return None
-    L = np.linalg.cholesky(phi + max(0.0, tol.PHI_FLOOR * lam[-1] - lam[0]) * np.eye(phi.shape[0]))
+    L = np.linalg.cholesky(phi)
     LA, LB = scipy.linalg.solve_triangular(L, Abar, lower=True), scipy.linalg.solve_triangular(L, Bbar, lower=True)
     return -np.linalg.lstsq(LB, LA, rcond=None)[0]
 
