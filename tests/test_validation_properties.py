@@ -13,9 +13,9 @@ from hypothesis import strategies as st
 
 import robustctl as rc
 from robustctl import rlqr_step, rlqr_step_block
-from robustctl.hinf_riccati import hinf_riccati
-from robustctl.lqr import dare
-from robustctl.stability import unstabilizable_modes
+from robustctl.synthesis.hinf_riccati import hinf_riccati
+from robustctl.synthesis.lqr import dare
+from robustctl.systems.stability import unstabilizable_modes
 
 dims = st.integers(1, 4)
 SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
