@@ -350,7 +350,7 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None, D=None):
         flip = sig[:, 1] > sig[:, 0]
         Ah, Bh, Ch, Dh = _cayley(A, B, C, flip, D)
     elif D is not None:
-        # where sigma_max(G(inf)) > sigma_max(G(0)), the level set runs on G(1/s) (feedthrough G(0)), for the same reason
+        # where sigma_max(G(inf)) > sigma_max(G(0)), the level set runs on G(1/s) (feedthrough G(0)), for that reason
         flip = sig[:, -1] > sig[:, 0]
         Ah, Bh, Ch, Dh = _invert(A, B, C, D, flip)
     else:
