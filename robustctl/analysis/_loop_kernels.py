@@ -361,7 +361,7 @@ def _grid(lam, discrete: bool, extra):
 
 
 def _golden(value, theta, k, f, t, rows):
-    """Golden-section search of ``value`` on ``[theta[k - 1], theta[k + 1]]`` (per row), from ``(f, t)``: ``(best, at)``."""
+    """Golden-section search of ``value`` on ``[theta[k - 1], theta[k + 1]]`` per row from ``(f, t)``."""
     r = np.arange(theta.shape[0])
     lo = theta[r, np.maximum(k - 1, 0)]
     hi = theta[r, np.minimum(k + 1, theta.shape[1] - 1)]
