@@ -34,6 +34,8 @@ continuous one by the bilinear transform ``z = (1 + s) / (1 - s)``
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 
 from . import _hinfnorm
@@ -68,13 +70,26 @@ def sensitivity(A, B, C, D):
     return A - B @ Ei @ C, B @ Ei, -(Ei @ C), Ei, posed
 
 
+def solve(M, rhs):
+    """``np.linalg.solve`` on stacks, with NaN for the singular systems instead of an error for all."""
+    try:
+        return np.linalg.solve(M, rhs)
+    except np.linalg.LinAlgError:
+        rhs = np.broadcast_to(rhs, (*M.shape[:-1], rhs.shape[-1]))
+        out = np.full(rhs.shape, np.nan, dtype=np.result_type(M, rhs))
+        for i in np.ndindex(M.shape[:-2]):
+            with contextlib.suppress(np.linalg.LinAlgError):
+                out[i] = np.linalg.solve(M[i], rhs[i])
+        return out
+
+
 def response(A, B, C, D, points):
-    """``D + C (pI - A)^-1 B`` at complex ``points`` (K, r): (K, r, l, p)."""
+    """``D + C (pI - A)^-1 B`` at complex ``points`` (K, r): (K, r, l, p); NaN at a pole."""
     n = A.shape[-1]
     if n == 0:
         return np.broadcast_to(D[:, None], (*points.shape, *D.shape[1:])).astype(complex)
     M = points[:, :, None, None] * np.eye(n) - A[:, None]
-    X = np.linalg.solve(M, np.broadcast_to(B[:, None], (*points.shape, *B.shape[1:])).astype(complex))
+    X = solve(M, np.broadcast_to(B[:, None], (*points.shape, *B.shape[1:])).astype(complex))
     return D[:, None] + C[:, None] @ X
 
 
@@ -88,18 +103,21 @@ def _axis_zeros(A2, b2, c2, d2):
     M[:, :N, N:] = b2
     M[:, N:, :N] = c2
     M[:, N, N] = d2
+    X = np.full((K, N + 1, N), np.nan)
+    sigma = np.zeros(K)
+    todo = np.arange(K)
     for shift in (_SHIFT, -1.37 * _SHIFT, 2.71 * _SHIFT):      # a shift on a zero makes the matrix singular
-        sigma = shift * scale
-        Ms = M.copy()
-        Ms[:, np.arange(N), np.arange(N)] -= sigma[:, None]
-        try:
-            X = np.linalg.solve(Ms, np.broadcast_to(np.eye(N + 1, N), (K, N + 1, N)))
+        sigma[todo] = shift * scale[todo]
+        Ms = M[todo]
+        Ms[:, np.arange(N), np.arange(N)] -= sigma[todo, None]
+        X[todo] = solve(Ms, np.eye(N + 1, N))
+        todo = todo[~np.isfinite(X[todo]).all(axis=(1, 2))]
+        if not todo.size:
             break
-        except np.linalg.LinAlgError:
-            continue
-    else:   # pragma: no cover - three shifts on zeros of one row
-        return np.full((K, N), np.nan)
-    mu = _hinfnorm.eigvals(X[:, :N, :])
+    fine = np.isfinite(X).all(axis=(1, 2))    # a row singular for every shift: Phi = 0 (l = 0), no crossing
+    mu = np.zeros((K, N), dtype=complex)
+    if fine.any():
+        mu[fine] = _hinfnorm.eigvals(X[fine, :N, :])
     with np.errstate(divide="ignore", invalid="ignore"):
         lam = sigma[:, None] + 1.0 / mu
     mag = np.abs(lam)
@@ -117,14 +135,14 @@ def _newton(A, b, c, d, w, real_part: bool):
     step = np.zeros_like(W)
     for _ in range(_NEWTON):
         M = 1j * W[:, :, None, None] * I - A[:, None]
-        X = np.linalg.solve(M, np.broadcast_to(b[:, None], (*W.shape, n, 1)).astype(complex))
-        Y = np.linalg.solve(M, X)
+        X = solve(M, np.broadcast_to(b[:, None], (*W.shape, n, 1)).astype(complex))
+        Y = solve(M, X)
         S = (d[:, None] + c[:, None] @ X)[..., 0, 0]
         dS = (-1j * (c[:, None] @ Y))[..., 0, 0]                     # dS/dw
         f, fp = (S.real - 0.5, dS.real) if real_part else (S.imag, dS.imag)
         with np.errstate(divide="ignore", invalid="ignore"):
             step = np.where(fp != 0.0, f / fp, np.inf)
-        valid &= np.isfinite(step)
+        valid &= np.isfinite(step)   # NaN at a pole of S
         W = np.where(valid, np.abs(W - step), 0.0)                   # f is even or odd in w
     S = response(A, b, c, d, 1j * W)[..., 0, 0]
     f = S.real - 0.5 if real_part else S.imag
