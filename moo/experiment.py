@@ -84,11 +84,10 @@ from pathlib import Path
 
 import numpy as np
 
-from moo._imports import build_problem, check_algorithm_name, check_problem_name
-from moo._validation import check_int
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
-from moo.executors import POOL_RESTARTS, _RestartingPool, open_executor
+from moo.executors import POOL_RESTARTS, RestartingPool, open_executor
+from moo.factories import build_problem, check_algorithm_name, check_problem_name
 from moo.store import (
     FAILED_SUFFIX,
     CorruptRecordError,
@@ -105,6 +104,7 @@ from moo.store import (
     write_json_atomic,
     write_settings,
 )
+from moo.validation import check_int
 
 __all__ = ["RunSpec", "ExperimentReport", "PreparedExperiment", "RunFailedError", "plan", "run_seeds",
            "prepare", "run_experiment", "load_records", "write_json_atomic", "problem_dir"]
@@ -203,7 +203,7 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
     ----------
     problem : str
         A name of :data:`moo.problems.PROBLEMS`, or the import path
-        ``package.module:factory`` of a user's problem (:mod:`moo._imports`).
+        ``package.module:factory`` of a user's problem (:mod:`moo.factories`).
     algorithms : str or sequence of str
         ``"all"``, a comma-separated string or a list of registry names or
         import paths of a user's algorithm factories.
@@ -396,7 +396,7 @@ def _run_on(executor: Executor, specs: Sequence[RunSpec], recorder: _Recorder) -
         lost, broken = _submit_and_record(executor, todo, recorder)
         if broken is None:
             return
-        if not isinstance(executor, _RestartingPool):
+        if not isinstance(executor, RestartingPool):
             raise broken
         if not executor.restart():
             raise BrokenProcessPool(f"a pool process died again after {POOL_RESTARTS} restarts of the pool "

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.distance import cdist
 
-from ._validation import as_matrix, check_positive_scalar
+from .validation import as_matrix, check_positive_scalar
 
 __all__ = ["igd", "igd_plus", "spacing", "hypervolume", "pure_diversity", "spread"]
 

@@ -4,7 +4,7 @@
 once (a bad argument raises ``ValueError``/``TypeError`` naming it, before any
 work); :meth:`PreparedRun.run` then runs it. :func:`run` does both. In detail,
 :func:`prepare` builds the problem (:func:`moo.problems.make_problem`, or a
-user's factory ``package.module:factory``, see :mod:`moo._imports`) and the
+user's factory ``package.module:factory``, see :mod:`moo.factories`) and the
 algorithm (:func:`moo.algorithms.make_algorithm`, or a user's factory), wraps it with MO-LSP
 (:func:`moo.molsp.molsp`, reference point ``problem.molsp_ref_point``) if
 asked, runs it with pymoo's ``("n_eval", evals)`` termination and records the
@@ -69,11 +69,11 @@ from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
 from pymoo.core.problem import Problem
 
-from moo._imports import build_algorithm, build_problem, check_algorithm_name, check_problem_name
-from moo._validation import check_int
 from moo.algorithms.operators import POP_SIZE
+from moo.factories import build_algorithm, build_problem, check_algorithm_name, check_problem_name
 from moo.indicators import hypervolume
 from moo.molsp import molsp as add_molsp
+from moo.validation import check_int
 
 __all__ = ["RunResult", "PreparedRun", "prepare", "prepare_on", "run", "check_budget", "setup_name"]
 
@@ -262,7 +262,7 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
     problem : str
         A name of :data:`moo.problems.PROBLEMS`, or the import path
         ``package.module:factory`` of a user's problem factory
-        (:mod:`moo._imports`: called with no argument, or ``n_obj=``).
+        (:mod:`moo.factories`: called with no argument, or ``n_obj=``).
     algorithm : str
         A name of :data:`moo.algorithms.ALGORITHMS`, or the import path of a
         user's algorithm factory, called as ``factory(n_obj=M, pop_size=P)``.

@@ -1,4 +1,4 @@
-"""Tests of theta-DEA (moo.algorithms.theta_dea) and the shared normalisation (moo.algorithms._normalize).
+"""Tests of theta-DEA (moo.algorithms.theta_dea) and the shared normalisation (moo.algorithms.normalization).
 
 Expected values are worked out by hand in the comments (or by brute force /
 closed forms independent of the code under test).
@@ -18,7 +18,7 @@ from pymoo.optimize import minimize
 from pymoo.problems import get_problem
 from pymoo.util.ref_dirs import get_reference_directions
 
-from moo.algorithms._normalize import (
+from moo.algorithms.normalization import (
     HyperplaneNormalization,
     extreme_points,
     front_bounds,

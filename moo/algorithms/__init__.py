@@ -29,14 +29,16 @@ Constructor shape (every entry of :data:`ALGORITHMS`; checked for each by
 * the returned algorithm passes its initial population through its survival
   before the first mating (``advance_after_initial_infill=True``), so the
   first mating sees ranked individuals, and its survival resets its state
-  when a run is set up.
+  when a run is set up (NSGA-II and NSGA-III are pymoo's; the other eight
+  are subclasses of :class:`moo.algorithms.base.MOEA`, which wires a survival
+  and a mating selection into pymoo's genetic algorithm this way).
 """
 
 from __future__ import annotations
 
 from importlib import import_module
 
-from ._base import MIN_POP_SIZE
+from .base import MIN_POP_SIZE
 from .operators import POP_SIZE
 
 __all__ = ["ALGORITHMS", "MIN_POP_SIZE", "POP_SIZE", "make_algorithm"]

@@ -37,7 +37,7 @@ import numpy as np
 import robustctl as rc
 from robustctl.validation import check_plant, check_positive_scalar
 
-from .._validation import as_float_array, as_matrix, check_int
+from ..validation import as_float_array, as_matrix, check_int
 
 __all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains"]
 
@@ -118,7 +118,7 @@ def _input_map(input_map, plant: rc.Plant) -> tuple[np.ndarray | None, rc.Plant]
     return M, rc.Plant(plant.F, plant.G @ M, dt=plant.dt)
 
 
-def _bounds(value, name: str, default: np.ndarray) -> np.ndarray:
+def bound_vector(value, name: str, default: np.ndarray) -> np.ndarray:
     if value is None:
         return default.copy()
     arr = as_float_array(value, name)

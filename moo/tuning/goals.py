@@ -123,14 +123,14 @@ def _gains(K, plants: list[rc.Plant]) -> np.ndarray:
     return Kb
 
 
-def _stacks(plants: list[rc.Plant]) -> tuple[np.ndarray, np.ndarray]:
+def plant_stacks(plants: list[rc.Plant]) -> tuple[np.ndarray, np.ndarray]:
     """``F`` (S, n, n) and ``G`` (S, n, m) of the scenarios."""
     return np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
 
 
 def _closed_loops(K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
     """``A = F_s + G_s K_b`` of every design and scenario, shape (B, S, n, n) (the same product as the problem's)."""
-    F, G = _stacks(plants)
+    F, G = plant_stacks(plants)
     return F[None] + G[None] @ K[:, None]
 
 
@@ -292,7 +292,7 @@ class Response:
         key = tuple(check_scenarios(plants))
         self.check(key)
         n = key[0].n
-        F, G = _stacks(list(key))
+        F, G = plant_stacks(list(key))
         ref = np.zeros((self.steps, n)) if self.reference is None else self.reference
         r0 = ref[..., 0, :]
         sim = LinearSimulator(F, G, ref, x0=self.x0 - r0, u_limit=self.u_limit, bound=self.bound, dt=key[0].dt)

@@ -39,9 +39,9 @@ from pymoo.core.problem import Problem
 import robustctl as rc
 from robustctl.validation import check_positive_scalar
 
-from .._validation import as_float_array, as_matrix, check_int
-from .families import DesignFamily, FamilyGains, _bounds, check_bounds, population
-from .goals import _stacks, check_scenarios
+from ..validation import as_float_array, as_matrix, check_int
+from .families import DesignFamily, FamilyGains, bound_vector, check_bounds, population
+from .goals import check_scenarios, plant_stacks
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
 
@@ -176,14 +176,14 @@ class TuningProblem(Problem):
             if callable(check):
                 check(self.scenarios)
         n_var = int(family.n_var)
-        lo = _bounds(family.xl if xl is None else xl, "xl", np.zeros(n_var))
-        hi = _bounds(family.xu if xu is None else xu, "xu", np.zeros(n_var))
+        lo = bound_vector(family.xl if xl is None else xl, "xl", np.zeros(n_var))
+        hi = bound_vector(family.xu if xu is None else xu, "xu", np.zeros(n_var))
         check_bounds(lo, hi)
         self.penalty = check_positive_scalar(penalty, "penalty")
         n_obj = len(self.objectives)
         self.hv_ref_point = _ref_point(hv_ref_point, "hv_ref_point", np.full(n_obj, self.penalty))
         self.molsp_ref_point = _ref_point(molsp_ref_point, "molsp_ref_point", self.hv_ref_point)
-        self._F_s, self._G_s = _stacks(self.scenarios)
+        self._F_s, self._G_s = plant_stacks(self.scenarios)
         self.last_flags = np.zeros(0, dtype=object)
         super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=len(self.constraints), xl=lo, xu=hi, vtype=float)
 
@@ -228,7 +228,7 @@ class TuningProblem(Problem):
         if scenarios is None:
             F_s, G_s = self._F_s, self._G_s
         else:
-            F_s, G_s = _stacks(check_scenarios(scenarios, "scenarios"))
+            F_s, G_s = plant_stacks(check_scenarios(scenarios, "scenarios"))
         return F_s[None] + G_s[None] @ K[:, None]
 
     def closed_loop_radius(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:

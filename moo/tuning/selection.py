@@ -41,7 +41,7 @@ import numpy as np
 
 import robustctl as rc
 
-from .._validation import as_float_array, check_int
+from ..validation import as_float_array, check_int
 
 __all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "scenario_errors", "draw_errors",
            "check_weights", "default_weights"]

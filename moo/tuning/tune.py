@@ -17,9 +17,9 @@ import numpy as np
 
 import robustctl as rc
 
-from .._validation import check_int
 from ..algorithms.operators import POP_SIZE
 from ..runner import RunResult, prepare_on
+from ..validation import check_int
 from .problem import TuningProblem
 from .selection import Selection, select
 
