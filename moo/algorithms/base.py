@@ -237,6 +237,8 @@ class MOEA(GeneticAlgorithm):
     >>> from pymoo.optimize import minimize
     >>> from moo.problems import make_problem
     >>> alg = MOEA(RankAndCrowding(), RandomSelection(), pop_size=20)
+    >>> type(alg.mating.crossover).__name__, type(alg.mating.mutation).__name__   # the paper's operators
+    ('SBX', 'PaperPM')
     >>> res = minimize(make_problem("zdt1"), alg, ("n_gen", 5), seed=1)
     >>> res.F.shape[1], alg.advance_after_initial_infill
     (2, True)
