@@ -573,9 +573,9 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
     """Run the grid of :func:`~moo.experiment.plan` into ``out``, skipping runs already recorded.
 
     Every cell (algorithm, variant) runs ``runs`` times with the seeds of
-    :func:`run_seeds`; each run is written as ``out/<algorithm>/<variant>/seed_<s>.json``
-    as soon as it ends, so a grid interrupted and started again runs only
-    what is missing.
+    :func:`run_seeds`; each run is written as
+    ``out/<problem>/<algorithm>[+molsp]/seed_<s>.json`` as soon as it ends, so
+    a grid interrupted and started again runs only what is missing.
 
     Parameters
     ----------

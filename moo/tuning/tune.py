@@ -88,8 +88,11 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
     >>> prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios,
     ...                             [response.error(), response.peak_input()])
     >>> sel = tuning.select_front(prob, [[0.0, 0.0, 0.0], [0.0, 0.0, -2.0]], n_sims=20, seed=0)
-    >>> sel.controller.method, sel.index in (0, 1), int(sel.counts.sum())
-    ('lqr', True, 20)
+    >>> sel.controller.method, int(sel.counts.sum())
+    ('lqr', 20)
+    >>> R = [1.0, 0.01][sel.index]                  # the chosen row's weight
+    >>> np.allclose(sel.K, rc.lqr(plant, Q=np.eye(2), R=[[R]]).K)
+    True
     """
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"problem must be a moo.tuning.TuningProblem, got {type(problem).__name__}")
@@ -265,8 +268,9 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
     Raises
     ------
     TypeError
-        ``problem`` not a :class:`TuningProblem`.
-    ValueError, TypeError
+        ``problem`` not a :class:`TuningProblem`, or a run argument of the
+        wrong type (the message names it).
+    ValueError
         A bad run argument (the message names it): an unknown algorithm, a
         budget below the population size, a negative seed, ...
 
