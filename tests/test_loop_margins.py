@@ -336,6 +336,87 @@ def test_continuous_lqr_guaranteed_margins():
     assert m.gain_range[1] == np.inf and m.gain_range[0] == pytest.approx(0.5, rel=1e-9)
 
 
+def _observer_controller(discrete: bool):
+    """A plant with one measured output and an observer-based controller built with python-control alone:
+    xh+ = F xh + G u + Lk (y - C xh), u = -K_pc xh, i.e. u = K(z) y with Ac = F - G K_pc - Lk C, Bc = Lk,
+    Cc = -K_pc, Dc = 0 (our sign: no minus in u = K(z) y)."""
+    F = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-0.5, -1.0, -1.2]])
+    G, C = np.array([[0.0], [0.0], [1.0]]), np.array([[1.0, 0.0, 0.0]])
+    if discrete:
+        sysd = control.c2d(control.ss(F, G, C, 0), 0.1)
+        F, G = sysd.A, sysd.B
+        K_pc = control.dlqr(F, G, np.eye(3), np.eye(1))[0]
+        Lk = control.dlqr(F.T, C.T, np.eye(3), np.eye(1))[0].T
+    else:
+        K_pc = control.lqr(F, G, np.eye(3), np.eye(1))[0]
+        Lk = control.lqr(F.T, C.T, np.eye(3), np.eye(1))[0].T
+    dt = 0.1 if discrete else None
+    plant = rc.Plant(F, G, dt, C=C)
+    ctrl = rc.Controller.dynamic(F - G @ K_pc - Lk @ C, Lk, -K_pc, np.zeros((1, 1)), "observer", plant)
+    P = control.ss(F, G, C, 0, 0 if dt is None else dt)
+    Kss = control.ss(F - G @ K_pc - Lk @ C, Lk, -K_pc, 0, 0 if dt is None else dt)
+    return plant, ctrl, P, Kss
+
+
+@pytest.mark.parametrize("discrete", [False, True])
+@pytest.mark.parametrize("at", ["input", "output"])
+def test_output_feedback_loop_by_hand(discrete, at):
+    """u = K(z) y: L = -K(z) P(z) at the input and -P(z) K(z) at the output, built by python-control's series."""
+    plant, ctrl, P, Kss = _observer_controller(discrete)
+    L = -(Kss * P) if at == "input" else -(P * Kss)
+    ours = rc.loop_margins(ctrl, at=at)
+    assert ours.stable
+    assert np.all(np.abs(control.poles(control.feedback(P, Kss, sign=1))) < 1) if discrete \
+        else np.all(control.poles(control.feedback(P, Kss, sign=1)).real < 0)
+    gm, pm, sm, wg, wp, _ = control.stability_margins(L)
+    if not (discrete and ours.gain_margin_freq == pytest.approx(np.pi / 0.1)):
+        np.testing.assert_allclose([ours.gain_margin, ours.gain_margin_freq], [gm, wg], rtol=1e-7)
+    np.testing.assert_allclose([ours.phase_margin, ours.phase_margin_freq], [pm, wp], rtol=1e-7)
+    if np.isfinite(ours.alpha_freq):
+        assert pc_disk_margin(L, ours.alpha_freq) == pytest.approx(ours.alpha, rel=1e-8)
+    assert pc_disk_margin(L, grid(L)) >= ours.alpha * (1 - 1e-10)
+    assert ours.S_peak == pytest.approx(control.linfnorm(control.feedback(control.ss([], [], [], 1.0), L))[0],
+                                        rel=1e-7)
+    # the sign trap: K(z) used as python-control's negative-feedback controller is another loop
+    assert rc.loop_margins(Kss * P).alpha != pytest.approx(ours.alpha, rel=1e-3)
+
+
+def test_static_output_feedback_mimo():
+    """u = Dc y on a plant with two measured outputs (static output feedback), at the input and at the output."""
+    rng = np.random.default_rng(11)
+    F = np.diag([0.9, 0.5, -0.3, 0.7]) + 0.05 * rng.standard_normal((4, 4))
+    G, C = rng.standard_normal((4, 2)), rng.standard_normal((2, 4))
+    plant = rc.Plant(F, G, 0.05, C=C, D=0.1 * rng.standard_normal((2, 2)))
+    Dc = -0.02 * rng.standard_normal((2, 2))
+    ctrl = rc.Controller.dynamic([], [], [], Dc, "static", plant)
+    P = control.ss(F, G, C, plant.D, 0.05)
+    for at, L in (("input", -(control.ss([], [], [], Dc, 0.05) * P)), ("output", -(P * Dc))):
+        ours = rc.loop_margins(ctrl, at=at)
+        assert ours.stable
+        if HAS_SLYCOT:
+            assert pc_disk_margin(L, ours.alpha_freq) == pytest.approx(ours.alpha, rel=1e-8)
+        for i in range(2):
+            li = control.feedback(L, np.diag([0.0 if j == i else 1.0 for j in range(2)]))[i, i]
+            assert pc_disk_margin(li, ours.alpha_loops_freq[i]) == pytest.approx(ours.alpha_loops[i], rel=1e-8)
+            with warnings.catch_warnings():     # its 'frd' fallback: still within 1e-7 here
+                warnings.simplefilter("ignore")
+                pm, _, _, wp = control.stability_margins(li)[1:5]
+            np.testing.assert_allclose([ours.phase_margin[i], ours.phase_margin_freq[i]], [pm, wp], rtol=1e-7)
+
+
+def test_controller_batch_equals_single_controllers():
+    plant, ctrl, _, _ = _observer_controller(True)
+    scale = np.array([1.0, 0.7, 1.3, 25.0])[:, None, None]
+    batch = rc.ControllerBatch(plant, np.repeat(ctrl.Ac[None], 4, axis=0), np.repeat(ctrl.Bc[None], 4, axis=0),
+                               scale * ctrl.Cc, np.zeros((4, 1, 1)))
+    many = rc.loop_margins(batch, at="output")
+    assert many.alpha.shape == (4,) and many.reason[3] == "unstable"
+    for b in range(4):
+        one = rc.loop_margins(batch[b], at="output")
+        for key in ("alpha", "gain_margin", "phase_margin", "S_peak", "T_peak"):
+            np.testing.assert_allclose(getattr(many, key)[b], getattr(one, key), rtol=1e-9)
+
+
 # ---------------------------------------------------------------- stacks
 @pytest.mark.parametrize(("discrete", "at"), [(True, "input"), (False, "input"), (True, "output")])
 def test_stack_equals_single_calls(discrete, at):

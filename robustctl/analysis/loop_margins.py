@@ -16,14 +16,14 @@ of the nominal loop's frequency response.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from .._validation import as_float_array, check_choice, check_real
-from ..systems.controller import Controller
-from ..systems.plant import Plant
+from ..systems.controller import Controller, ControllerBatch
+from ..systems.interconnect import loop_transfer
 from ..systems.stability import stability_of_eigenvalues
 from . import _hinfnorm
 from . import _loop_kernels as kern
@@ -235,17 +235,30 @@ def _from_lti(L) -> tuple[tuple[np.ndarray, ...], float | None]:
     return (A[None], B[None], C[None], D[None]), dt
 
 
-def _from_gains(plant: Plant, K: np.ndarray, at: str) -> tuple[np.ndarray, ...]:
-    r"""Loop transfers (stacks) of the state feedbacks ``u = K x``, broken at the input or at the (state) output.
+def _from_controller(ctrl, at: str) -> tuple[tuple[np.ndarray, ...], float | None, bool]:
+    """``((A, B, C, D) stacks, dt, single)`` of the loop transfers of a controller, a batch or ``(plant, K)``.
 
-    At the input ``L = -K (zI - F)^-1 G``: ``(F, G, -K, 0)``; at the output
-    (``y = x``) ``L = -(zI - F)^-1 G K``: ``(F, G K, -I, 0)``.
+    :func:`robustctl.systems.interconnect.loop_transfer`: at the input
+    ``L = -K(z) P(z)``, at the output ``L = -P(z) K(z)``; a state feedback
+    ``u = K x`` reads the state (``C = I``, ``D = 0``).
     """
-    B, n, m = K.shape[0], plant.n, plant.m
-    F = np.broadcast_to(plant.F, (B, n, n))
-    if at == "input":
-        return F, np.broadcast_to(plant.G, (B, n, m)), -K, np.zeros((B, m, m))
-    return F, plant.G @ K, np.broadcast_to(-np.eye(n), (B, n, n)), np.zeros((B, n, n))
+    if isinstance(ctrl, (Controller, ControllerBatch)):
+        batch = ctrl.as_batch() if isinstance(ctrl, Controller) else ctrl
+        plant, (Ac, Bc, Cc, Dc) = batch.plant, (batch.Ac, batch.Bc, batch.Cc, batch.Dc)
+        single = isinstance(ctrl, Controller)
+    else:
+        try:
+            plant, K = _loop(ctrl, batch=True)
+        except TypeError:
+            raise TypeError("ctrl must be a robustctl.Controller, a ControllerBatch, a (Plant, K) pair or a "
+                            f"python-control system (the loop transfer L), got {type(ctrl).__name__}") from None
+        single = K.ndim == 2
+        Dc = K[None] if single else K
+        B, m, n = Dc.shape
+        plant = replace(plant, C=None, D=None) if plant.has_outputs else plant   # u = K x reads the state
+        Ac, Bc, Cc = np.zeros((B, 0, 0)), np.zeros((B, 0, n)), np.zeros((B, m, 0))
+    C, D = plant.output_matrices()
+    return loop_transfer(plant.F, plant.G, C, D, Ac, Bc, Cc, Dc, at), plant.dt, single
 
 
 # ---------------------------------------------------------------- the analysis
@@ -330,18 +343,20 @@ def loop_margins(ctrl, at: str | None = None, skew: float = 0.0) -> LoopMargins:
 
     Parameters
     ----------
-    ctrl : Controller, (Plant, K) pair, or python-control system
-        The loop: a :class:`~robustctl.Controller` (its plant and gain), a
-        pair ``(plant, K)`` with one gain ``K`` (m, n) or a stack (B, m, n)
+    ctrl : Controller, ControllerBatch, (Plant, K) pair, or python-control system
+        The loop: a :class:`~robustctl.Controller` with its plant (state
+        feedback ``u = K x`` or dynamic output feedback ``u = K(z) y``), a
+        :class:`~robustctl.ControllerBatch` (a stack), a pair ``(plant, K)``
+        of state feedbacks with one gain ``K`` (m, n) or a stack (B, m, n)
         (as :func:`~robustctl.robust_stability` takes it), or a loop
         transfer ``L`` (python-control ``StateSpace`` or ``TransferFunction``,
         square, in python-control's negative-feedback convention: the loop
         is closed by ``u = -y``; continuous if ``L.dt`` is 0 or None).
     at : {"input", "output"}, optional
         Where a controller's loop is broken (default ``"input"``): at the
-        plant input (m loops) or at its measured output (the state for a
-        state feedback: n loops). Not for a loop transfer ``L``, which is
-        analysed as it is.
+        plant input (m loops) or at its measured output (p loops; the state
+        for a state feedback: n loops). Not for a loop transfer ``L``, which
+        is analysed as it is.
     skew : float, default 0
         The skew :math:`\sigma` of the disk margin: 0 balanced (gain
         increase and decrease alike), 1 based on ``S`` (the distance of the
@@ -370,18 +385,20 @@ def loop_margins(ctrl, at: str | None = None, skew: float = 0.0) -> LoopMargins:
 
     Notes
     -----
-    **Sign convention.** Our controllers use :math:`u = K x` (no minus
-    sign). Broken at the plant input, the signal that returns to the break
-    is :math:`K (zI - F)^{-1} G v`; in the negative-feedback convention of
-    python-control (and of every margin formula) the loop transfer is
-    therefore
+    **Sign convention.** Our controllers use :math:`u = K x` and
+    :math:`u = K(z) y` (no minus sign). Broken at the plant input, the
+    signal that returns to the break is :math:`K(z) P(z) v` (:math:`P: u \to y`);
+    in the negative-feedback convention of python-control (and of every
+    margin formula) the loop transfer is therefore
 
     .. math::
-        L(z) = -K (zI - F)^{-1} G \quad \text{(input)}, \qquad
-        L(z) = -(zI - F)^{-1} G K \quad \text{(output, } y = x\text{)}.
+        L(z) = -K(z) P(z) \quad \text{(input)}, \qquad
+        L(z) = -P(z) K(z) \quad \text{(output)},
 
-    A python-control gain ``K_pc`` (``u = -K_pc x``) gives the same loop
-    with ``L = K_pc (zI - F)^{-1} G``. Then :math:`S = (I + L)^{-1}` and
+    for a state feedback :math:`L(z) = -K (zI - F)^{-1} G` at the input (and
+    :math:`-(zI - F)^{-1} G K` at the state). A python-control gain
+    ``K_pc`` (``u = -K_pc x``) gives the same loop with
+    ``L = K_pc (zI - F)^{-1} G``. Then :math:`S = (I + L)^{-1}` and
     :math:`T = L (I + L)^{-1} = I - S`.
 
     **Disk margin** [1]_. The loop stays stable when each loop's gain is
@@ -446,21 +463,16 @@ def loop_margins(ctrl, at: str | None = None, skew: float = 0.0) -> LoopMargins:
     >>> bool(abs(pm - m.phase_margin) < 1e-8)
     True
     """
-    if hasattr(ctrl, "ninputs") and hasattr(ctrl, "noutputs") and not isinstance(ctrl, (Controller, tuple)):
+    import control
+
+    if isinstance(ctrl, (control.StateSpace, control.TransferFunction)):
         if at is not None:
             raise TypeError("at applies to a controller; a loop transfer L is analysed as it is (leave at unset)")
         (A, B, C, D), dt = _from_lti(ctrl)
         single, where = True, "loop"
     else:
         where = "input" if at is None else check_choice(at, "at", ("input", "output"))
-        try:
-            plant, K = _loop(ctrl, batch=True)
-        except TypeError:
-            raise TypeError("ctrl must be a robustctl.Controller, a (Plant, K) pair or a python-control system "
-                            f"(the loop transfer L), got {type(ctrl).__name__}") from None
-        single = K.ndim == 2
-        A, B, C, D = _from_gains(plant, K[None] if single else K, where)
-        dt = plant.dt
+        (A, B, C, D), dt, single = _from_controller(ctrl, where)
     s = check_real(skew, "skew")
     out = _analyse(A, B, C, D, discrete=dt is not None, skew=s)
     if dt is not None:
