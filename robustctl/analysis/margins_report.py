@@ -101,7 +101,7 @@ class MarginsReport:
         return m if isinstance(m, str) else f"{m.margin:.3g}{' (certified)' if m.certified else ''}"
 
     def loop_cells(self, controller: str) -> tuple[str, ...]:
-        """The loop-margin entries of one controller as text (:data:`_LOOP_COLUMNS`; the worst loop of several).
+        """The loop-margin entries of one controller as text (the columns of :meth:`loops_to_markdown`; worst loop).
 
         The disk margin is the simultaneous one; the gain margin of several
         loops is the one closest to 1 (in ``|log|``), the phase margin the
