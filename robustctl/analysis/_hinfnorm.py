@@ -34,12 +34,18 @@ and keeps the norm and the storage function. Where ``sigma_max(G(-1))``
 exceeds ``sigma_max(G(1))`` the loop ``(-A, B, -C)`` (the same norm,
 ``z -> -z``) is transformed instead, so that ``Dc`` is the smaller of the
 two and ``R = gamma^2 I - Dc'Dc`` stays far from singular near the peak.
-For the Riccati equation: the stabilising solution of
+A feedthrough ``D`` (:func:`hinf_norm` takes one) enters ``M(gamma)`` as
+above; in continuous time the level set starts from ``sigma_max(D)`` (the
+gain at ``w = inf``) too, and where that exceeds ``sigma_max(G(0))`` it runs
+on ``G(1/s)``, realised by ``(A^-1, A^-1 B, -C A^-1, D - C A^-1 B)`` (the
+same singular values at ``w`` and ``1 / w``, feedthrough ``G(0)``), for the
+same reason as the flip. For the Riccati equation: the stabilising solution of
 the continuous bounded-real Riccati equation of ``(Ac, Bc, Cc, Dc)`` is the
 stabilising solution ``P`` of the discrete one,
 ``P = A'PA + C'C + A'PB (gamma^2 I - B'PB)^-1 B'PA``. ``A + I`` is
-invertible for a Schur-stable ``A``. The singular values themselves are
-always evaluated on the original realisation (at ``z = exp(j theta)``).
+invertible for a Schur-stable ``A``. The singular values of a discrete
+loop are evaluated on its original realisation (at ``z = exp(j theta)``),
+those of an inverted continuous one on ``G(1/s)``.
 
 Riccati: the stabilising solution at a level ``gamma > ||G||_inf`` is
 ``P = X2 X1^-1`` from the ``n`` eigenvectors ``[X1; X2]`` of ``M(gamma)``

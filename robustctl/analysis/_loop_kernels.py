@@ -411,13 +411,14 @@ def mu_peak(A, B, C, D, *, discrete: bool, lam, extra):
     evaluated at its peak frequency and refined there if larger (a peak the
     sweep stepped over), for up to ``_CHECKS`` rounds.
 
-    Returns ``(peak, freq, certified)``, (K,) each: ``freq`` is ``w``
-    (``inf`` allowed) or ``theta`` if ``discrete``; ``certified`` where the
-    constant scaling confirms the peak to ``1e-6`` (no frequency has a
-    larger bound). Continuous loops are swept on the unit circle after the
-    bilinear map :func:`_bilinear` (``w = ws tan(theta / 2)``, ``ws`` the
-    geometric mean of the smallest and largest pole moduli), which
-    includes ``w = inf``.
+    Returns ``(peak, freq)``, (K,) each: ``freq`` is ``w`` (``inf``
+    allowed) or ``theta`` if ``discrete``. Where the constant scaling
+    confirms the peak (to ``1e-6``), no frequency has a larger bound; where
+    it does not, the scaling varies with frequency and no larger bound was
+    found at the frequency it points to. Continuous loops are swept on the
+    unit circle after the bilinear map :func:`_bilinear` (``w = ws tan(theta
+    / 2)``, ``ws`` the geometric mean of the smallest and largest pole
+    moduli), which includes ``w = inf``.
     """
     K = A.shape[0]
     theta, ws = _grid(lam, discrete, extra)
@@ -431,14 +432,12 @@ def mu_peak(A, B, C, D, *, discrete: bool, lam, extra):
     rows = np.arange(K)
     k = np.argmax(mu, axis=1)
     best, at = _golden(value, theta, k, mu[rows, k], theta[rows, k], rows)
-    certified = np.zeros(K, dtype=bool)
     todo = rows
     for _ in range(_CHECKS):
         e = np.exp(value(at[todo, None], todo)[1][:, 0])
         norm, where, _ = _hinfnorm.hinf_norm(A[todo], B[todo] / e[:, None, :], e[:, :, None] * C[todo],
                                              discrete=True, D=e[:, :, None] * D[todo] / e[:, None, :])
         ok = norm <= best[todo] * (1.0 + 1e-6)
-        certified[todo[ok]] = True
         todo, where = todo[~ok], where[~ok]
         if not todo.size:
             break
@@ -450,6 +449,6 @@ def mu_peak(A, B, C, D, *, discrete: bool, lam, extra):
         if not todo.size:
             break
     if discrete:
-        return best, at, certified
+        return best, at
     with np.errstate(over="ignore"):
-        return best, np.where(at >= np.pi, np.inf, ws * np.tan(0.5 * at)), certified
+        return best, np.where(at >= np.pi, np.inf, ws * np.tan(0.5 * at))

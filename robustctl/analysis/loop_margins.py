@@ -335,7 +335,7 @@ def _analyse(A, B, C, D, *, discrete: bool, skew: float) -> dict[str, np.ndarray
             out["alpha"][idx], out["alpha_freq"][idx] = out["alpha_loops"][idx, 0], out["alpha_loops_freq"][idx, 0]
         else:
             extra = np.concatenate([out["alpha_loops_freq"][idx], out["S_peak_freq"][idx, None]], axis=1)
-            mu, w, _ = kern.mu_peak(a, b, c, d + shift * np.eye(m), discrete=discrete, lam=poles, extra=extra)
+            mu, w = kern.mu_peak(a, b, c, d + shift * np.eye(m), discrete=discrete, lam=poles, extra=extra)
             with np.errstate(divide="ignore"):
                 out["alpha"][idx] = 1.0 / mu
             out["alpha_freq"][idx] = w
