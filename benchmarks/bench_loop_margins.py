@@ -119,7 +119,7 @@ def row(n: int, m: int, B: int, discrete: bool, reps: int) -> str:
                 nyquist += bool(np.min(np.abs(poles + 1.0)) < 1e-9)
                 ours, ref = ours[[1, 3]], ref[[1, 3]]
             both = np.isfinite(ours) & np.isfinite(ref)
-            d = np.max(np.abs(ours - ref)[both] / np.maximum(np.abs(ref[both]), 1e-300), initial=0.0)
+            d = np.max(np.abs(ours[both] - ref[both]) / np.maximum(np.abs(ref[both]), 1e-300), initial=0.0)
             same = np.array_equal(np.isfinite(ours), np.isfinite(ref)) and d <= 1e-6
             agree += same
             diff = max(diff, d) if same else diff
