@@ -378,11 +378,10 @@ def _grid(lam, discrete: bool, extra):
     return theta, ws
 
 
-def _golden(value, theta, k, f, t, rows):
-    """Golden-section search of ``value`` on ``[theta[k - 1], theta[k + 1]]`` per row from ``(f, t)``."""
-    r = np.arange(theta.shape[0])
-    lo = theta[r, np.maximum(k - 1, 0)]
-    hi = theta[r, np.minimum(k + 1, theta.shape[1] - 1)]
+def _golden(value, theta, f, t, rows):
+    """Golden-section search of ``value`` between the grid points ``theta`` next to ``t`` (per row), from ``(f, t)``."""
+    lo = np.where(theta < t[:, None], theta, 0.0).max(axis=1)
+    hi = np.where(theta > t[:, None], theta, np.pi).min(axis=1)
     g = 0.5 * (np.sqrt(5.0) - 1.0)
     a, b = hi - g * (hi - lo), lo + g * (hi - lo)
     fa, fb = value(a[:, None], rows)[0][:, 0], value(b[:, None], rows)[0][:, 0]
@@ -413,7 +412,7 @@ def mu_peak(A, B, C, D, *, discrete: bool, lam, extra):
 
     Returns ``(peak, freq)``, (K,) each: ``freq`` is ``w`` (``inf``
     allowed) or ``theta`` if ``discrete``. Where the constant scaling
-    confirms the peak (to ``1e-6``), no frequency has a larger bound; where
+    confirms the peak (to ``1e-9``), no frequency has a larger bound; where
     it does not, the scaling varies with frequency and no larger bound was
     found at the frequency it points to. Continuous loops are swept on the
     unit circle after the bilinear map :func:`_bilinear` (``w = ws tan(theta
@@ -431,18 +430,17 @@ def mu_peak(A, B, C, D, *, discrete: bool, lam, extra):
     mu = value(theta)[0]
     rows = np.arange(K)
     k = np.argmax(mu, axis=1)
-    best, at = _golden(value, theta, k, mu[rows, k], theta[rows, k], rows)
+    best, at = _golden(value, theta, mu[rows, k], theta[rows, k], rows)
     todo = rows
     for _ in range(_CHECKS):
         e = np.exp(value(at[todo, None], todo)[1][:, 0])
         norm, where, _ = _hinfnorm.hinf_norm(A[todo], B[todo] / e[:, None, :], e[:, :, None] * C[todo],
                                              discrete=True, D=e[:, :, None] * D[todo] / e[:, None, :])
-        ok = norm <= best[todo] * (1.0 + 1e-6)
+        ok = norm <= best[todo] * (1.0 + 1e-9)
         todo, where = todo[~ok], where[~ok]
         if not todo.size:
             break
-        k = np.argmin(np.abs(theta[todo] - where[:, None]), axis=1)
-        f, t = _golden(value, theta[todo], k, value(where[:, None], todo)[0][:, 0], where, todo)
+        f, t = _golden(value, theta[todo], value(where[:, None], todo)[0][:, 0], where, todo)
         up = f > best[todo]
         best[todo[up]], at[todo[up]] = f[up], t[up]
         todo = todo[up]          # no larger bound found: the constant scaling is only conservative there
