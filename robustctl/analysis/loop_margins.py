@@ -119,9 +119,10 @@ class LoopMargins:
         The disk margin: the loop stays stable for every simultaneous,
         independent variation of the m loops by factors in the disk of
         :func:`disk_ranges`, :math:`1 / \sup_\omega \mu(S + \frac{\sigma - 1}{2} I)`.
-        Exact for one loop; for several, a lower bound (``alpha_exact``
-        False): ``mu`` is replaced by its D-scaled upper bound on a sweep
-        refined at its peak. 0 where the nominal loop is unstable.
+        Exact for one loop (to the level sets' ``2e-10`` relative); for
+        several, a lower bound (``alpha_exact`` False): ``mu`` is replaced by
+        its D-scaled upper bound on a sweep refined at its peak. 0 where the
+        nominal loop is unstable.
     alpha_freq : float or (B,) ndarray
         The frequency of the peak.
     alpha_loops, alpha_loops_freq : float or ndarray
