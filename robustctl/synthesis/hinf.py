@@ -215,6 +215,8 @@ from ._hinf import tolerances as tol
 from ._hinf.coordinates import channel_scales, lqr_coordinates, normalised
 from ._hinf.gains import Gain, gain_at_level, gain_near_optimum
 from ._hinf.level import minimise_level
+from ._hinf.output_problem import channel, dynamic_controller, output_problem, refuse, wants_output
+from ._hinf.output_synthesis import synthesise
 from ._hinf.problem import Problem, validate, vertex_name
 from ._hinf.riccati_path import RiccatiPath, check_plain, riccati_synthesis
 
@@ -223,13 +225,13 @@ __all__ = ["hinf", "HinfController", "check_closed_loop", "guaranteed_input_boun
 
 @dataclass(frozen=True, eq=False, repr=False)
 class HinfController(Controller):
-    """An H-infinity state feedback ``u = K x`` with its guaranteed level.
+    """An H-infinity controller, state feedback ``u = K x`` or output feedback ``u = K(z) y``, with its level.
 
     Attributes
     ----------
     gamma : float
-        Level guaranteed by the returned gain: ``||T_zw||_inf < gamma`` for
-        the plant (and every plant of the hull of ``vertices``). Equals
+        Level guaranteed by the returned controller: ``||T_zw||_inf < gamma``
+        for the plant (and every plant of the hull of ``vertices``). Equals
         ``(1 + backoff) * gamma_opt``, or the requested ``gamma``.
     gamma_opt : float or None
         The optimal level of the LMI problem (``None`` when ``gamma`` was fixed);
@@ -247,18 +249,24 @@ class HinfController(Controller):
 
 
 def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: ArrayLike | None = None,
-         vertices: Sequence[Plant] | None = None, gamma: float | None = None, u_max: ArrayLike | None = None,
-         w_energy: float | None = None, backoff: float = 1e-3, extended: bool = False,
-         poles: Region | Sequence[Region] | None = None, uncertainty: NormBounded | None = None,
-         solver: str = "CLARABEL", synthesis: str = "lmi") -> HinfController:
-    r"""H-infinity state feedback ``u = K x`` by LMI optimisation.
+         Dyw: ArrayLike | None = None, vertices: Sequence[Plant] | None = None, gamma: float | None = None,
+         u_max: ArrayLike | None = None, w_energy: float | None = None, backoff: float = 1e-3,
+         extended: bool = False, poles: Region | Sequence[Region] | None = None,
+         uncertainty: NormBounded | None = None, solver: str = "CLARABEL", synthesis: str = "lmi",
+         feedback: str | None = None) -> HinfController:
+    r"""H-infinity synthesis by LMI optimisation: state feedback ``u = K x`` or output feedback ``u = K(z) y``.
 
-    Finds ``K`` minimising ``gamma`` such that ``||T_zw||_inf < gamma`` for
+    Finds the controller minimising ``gamma`` such that ``||T_zw||_inf < gamma`` for
 
     ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u`` (discrete plant) or
     ``x' = F x + Bw w + G u`` (continuous plant, ``plant.dt is None``; ``F``,
-    ``G`` are then ``A``, ``B``). The LMIs and the stages of the
-    synthesis are given in the docstring of its module, ``robustctl.synthesis.hinf``.
+    ``G`` are then ``A``, ``B``). When the plant declares measured outputs
+    (``Plant(..., C=..., D=...)``), ``y = C x + D u + Dyw w`` and the result
+    is a full-order dynamic controller ``xc+ = Ac xc + Bc y``,
+    ``u = Cc xc + Dc y`` (``ctrl.K`` is None); otherwise, or with
+    ``feedback="state"``, the state feedback ``u = K x``. The LMIs and the
+    stages of both syntheses are given in the docstring of its module,
+    ``robustctl.synthesis.hinf``.
 
     Parameters
     ----------
@@ -273,9 +281,15 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         the optimum may need an unbounded gain (the backoff then matters).
     Dzw : (p, q) array_like, optional
         Feedthrough from ``w`` to ``z`` (default zero).
+    Dyw : (plant.p, q) array_like, optional
+        Output feedback: the feedthrough from ``w`` to the measured outputs
+        (measurement noise; default zero). ``Dyw`` without full row rank (no
+        noise on some output) makes the problem *singular*: the LMIs still
+        solve it, the optimum then being an infimum (see ``backoff``).
     vertices : list of Plant, optional
         Further plants (same ``n``, ``m``, ``dt``). The bound then holds for
-        every plant in the convex hull of ``[plant] + vertices``.
+        every plant in the convex hull of ``[plant] + vertices``. State
+        feedback only.
     gamma : float, optional
         Fixed level: solve the feasibility problem at this ``gamma`` (no
         minimisation). Raises :class:`~robustctl.errors.InfeasibleError`
@@ -285,7 +299,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         disturbance with ``sum_k |w_k|^2 <= w_energy`` (continuous time:
         ``int |w|^2 dt <= w_energy``). Uses the reachable-set ellipsoid of
         the same Lyapunov matrix, so ``gamma_opt`` is then the best level
-        *subject to* the bound.
+        *subject to* the bound. State feedback only.
     w_energy : float, optional
         Disturbance energy for ``u_max`` (default 1). Only valid with ``u_max``.
     backoff : float, default 1e-3
@@ -298,9 +312,14 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         with a positive certificate is found at that level (nearly infeasible
         problems, e.g. a tight ``u_max``), the backoff is raised tenfold, at
         most twice; ``info["backoff"]`` and ``gamma`` report the value used.
+        Output feedback needs ``backoff > 0``: the controller is
+        reconstructed from a well-centred point at that level, where the
+        coupling ``I - X Y`` of the two Lyapunov variables is well
+        conditioned.
     extended : bool, default False
         Use the slack-variable condition of de Oliveira et al. (discrete time
-        only): less conservative with ``vertices``, equal without.
+        only): less conservative with ``vertices``, equal without. State
+        feedback only.
     poles : Region or list of Region, optional
         Pole regions (:mod:`robustctl.systems.regions`: ``Disk``, ``HalfPlane``,
         ``ConicSector``; a list means their intersection): every pole of
@@ -316,6 +335,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         per vertex; see ``robustctl.synthesis.hinf``). The convex counterpart of
         :func:`robustctl.rlqr`. ``H = 0`` or ``[EF EG] = 0`` is the nominal
         design. Pole regions apply to the nominal vertices. Standard LMI only.
+        State feedback only.
     solver : str, default "CLARABEL"
         cvxpy SDP solver. Clarabel is run with explicit tolerances (1e-8 for
         the level of one plant, 1e-10 with vertices, 1e-7 for centring);
@@ -331,11 +351,35 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         strictly positive the SDP is solved instead. ``info["synthesis"]``
         says which path returned the gain (``info["fallback"]`` why the SDP
         was needed). With ``"riccati"`` cvxpy is imported, and ``solver``
-        checked to be installed, only if the SDP runs.
+        checked to be installed, only if the SDP runs. Output feedback: the
+        gamma-iteration on the two Riccati equations of Glover & Doyle (the
+        discrete plant through its Tustin image), the central controller at
+        ``(1 + backoff / 2) gamma_opt`` and its closed loop certified at
+        ``(1 + backoff) gamma_opt``; a singular problem (``Dzu`` without full
+        column rank or ``Dyw`` without full row rank) or any failed check
+        falls back to the LMIs. ``poles`` and a fixed ``gamma`` are then a
+        ValueError.
+    feedback : {None, "state", "output"}, optional
+        ``None``: output feedback when the plant declares outputs, state
+        feedback otherwise. ``"state"`` asks for ``u = K x`` on a plant with
+        outputs (the full state measured); ``"output"`` on a plant without
+        outputs is a ValueError.
 
     Returns
     -------
     HinfController
+        Output feedback: ``Ac``, ``Bc``, ``Cc``, ``Dc`` (``K`` None),
+        ``gamma``, ``gamma_opt`` and ``info`` with ``feedback``
+        (``"output"``), ``synthesis``, ``gain_from`` (``"centred"``: the
+        centring solve at the backed-off level; ``"central"``: the Riccati
+        path), ``certificate`` (of the closed loop: ``stability``, its
+        spectral abscissa or ``1 -`` its spectral radius with the sign that
+        makes it positive, and ``hinf[0]``, the distance of its Hamiltonian's
+        eigenvalues from the imaginary axis relative to the Hamiltonian's
+        norm, see ``robustctl.synthesis.hinf``), ``margin`` (centring
+        margin), ``solves``, ``status``, ``solve_time``, ``iterations``,
+        ``backoff``, ``poles`` and, with ``synthesis="riccati"``,
+        ``riccati`` and ``fallback``. State feedback:
         ``K`` (``u = K x``), ``gamma``, ``gamma_opt`` and ``info`` with
         ``status``, ``solve_time`` (s, summed over solves), ``iterations``,
         ``certificate`` (smallest eigenvalue of each LMI block at the
@@ -392,6 +436,15 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     True
     """
     synthesis = check_choice(synthesis, "synthesis", ("lmi", "riccati"))
+    if wants_output(plant, feedback, Dyw):
+        refuse(vertices=vertices, uncertainty=uncertainty, u_max=u_max, w_energy=w_energy, extended=extended)
+        if synthesis == "riccati" and (poles is not None or gamma is not None):
+            raise ValueError("synthesis='riccati' is the plain problem only (free level, no pole region); drop "
+                             f"{'poles' if poles is not None else 'gamma'} or use synthesis='lmi'")
+        pb = output_problem(plant, "hinf", (channel(plant, Bw, Cz, Dzu, Dzw, Dyw),), gamma=gamma, backoff=backoff,
+                            poles=poles, solver=solver, synthesis=synthesis)
+        res = synthesise(pb)
+        return dynamic_controller(HinfController, "hinf", plant, res, pb, gamma=res.gamma, gamma_opt=res.gamma_opt)
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=gamma, u_max=u_max,
                        w_energy=w_energy, backoff=backoff, extended=extended, solver=solver, poles=poles,
                        uncertainty=uncertainty, defer_solver=synthesis == "riccati")

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from ...stability import is_stable, spectral_abscissa, spectral_radius
+from ...systems.stability import is_stable, spectral_abscissa, spectral_radius
 from .generalised import DynamicGain, Generalised, closed_loop
 
 __all__ = ["hinf_certificate", "h2_norm", "poles_inside", "AXIS_MARGIN"]

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._hinf._coordinates import lifted
+from .coordinates import lifted
 from .generalised import Channel, DynamicGain, Generalised
 
 __all__ = ["Standard", "Frame", "standard", "frame_of_shapes", "SHAPE_FLOOR"]
@@ -119,7 +119,7 @@ class FrameChannel:
 
 @dataclass(frozen=True, eq=False)
 class Frame:
-    """Stage 2: the plant (standard coordinates) as the variables ``X~`` (``x = S x_s``) and ``Y~`` (``x = T x_t``) see it.
+    """Stage 2: the plant (standard coordinates) as ``X~`` (``x = S x_s``) and ``Y~`` (``x = T x_t``) see it.
 
     Derived: ``As = S^-1 A S``, ``B2s = S^-1 B2``, ``C2s = C2 S``; ``At``,
     ``B2t``, ``C2t`` likewise with ``T``; the cross terms ``Ast = S^-1 A T``,

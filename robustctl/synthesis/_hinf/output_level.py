@@ -77,7 +77,7 @@ def minimise(f: Frame, spec: Spec, solver: str) -> Solved:
         objective, value = cp.Minimize(cp.trace(Z)), cp.trace(Z)
     rep = _cvx.solve_sdp(objective, lmis, cons, solver=solver, tol=LEVEL_TOL, fast=True, decompose=False,
                          infeasible_msg=f"no {spec.what}: the LMIs are infeasible")
-    return Solved(V.values(), float(value.value), rep)
+    return Solved(V.values(), float(np.asarray(value.value)), rep)
 
 
 def centre(f: Frame, spec: Spec, solver: str, infeasible_msg: str) -> Solved:
@@ -96,4 +96,4 @@ def centre(f: Frame, spec: Spec, solver: str, infeasible_msg: str) -> Solved:
     lmis, extra = _blocks(f, V, spec, 1.0, Z, t)
     rep = _cvx.solve_sdp(cp.Maximize(t), lmis, cons + extra, solver=solver, tol=CENTRE_TOL, decompose=False,
                          infeasible_msg=infeasible_msg)
-    return Solved(V.values(), float(np.asarray(t.value)), rep)
+    return Solved(V.values(), float(np.asarray(_cvx.value(t))), rep)

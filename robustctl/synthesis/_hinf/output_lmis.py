@@ -42,12 +42,12 @@ from typing import Any
 import numpy as np
 
 from ... import _cvx
-from ...regions import region_lmi
+from ...systems.regions import region_lmi
 from .generalised import DynamicGain
 from .output_coordinates import Frame
 
 __all__ = ["OFPoint", "variables", "products", "lyapunov", "hinf_block", "h2_blocks", "h2_equality",
-           "region_blocks", "controller"]
+           "h2_feedthrough_removed", "region_blocks", "controller"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,6 +147,24 @@ def h2_equality(f: Frame, V: OFPoint, k: int = 0) -> list:
     if f.discrete or not (np.any(c.D12) and np.any(c.D21)):
         return []
     return [c.D11 + c.D12 @ V.Dh @ c.D21 == 0]
+
+
+def h2_feedthrough_removed(f: Frame, V: OFPoint, k: int = 0) -> OFPoint:
+    """Continuous H2: ``Dh`` projected onto ``D12 Dh D21 = 0`` (the solver meets it only to its tolerance).
+
+    ``Dh - D12^+ D12 Dh D21 D21^+`` (the validation asks ``D11 = 0``), and
+    exactly zero when ``D12`` has full column rank and ``D21`` full row rank,
+    so that the closed loop has no feedthrough and a finite H2 norm.
+    """
+    c = f.channels[k]
+    if f.discrete:
+        return V
+    m, p = V.Dh.shape
+    if np.linalg.matrix_rank(c.D12) == m and np.linalg.matrix_rank(c.D21) == p:
+        Dh = np.zeros((m, p))
+    else:
+        Dh = V.Dh - np.linalg.pinv(c.D12) @ c.D12 @ V.Dh @ c.D21 @ np.linalg.pinv(c.D21)
+    return OFPoint(V.X, V.Y, V.Ah, V.Bh, V.Ch, Dh)
 
 
 def region_blocks(regions, f: Frame, V: OFPoint, margin=0.0) -> list[_cvx.LMI]:

@@ -276,8 +276,9 @@ def tustin(plant: Generalised, D22: np.ndarray) -> tuple[Generalised, np.ndarray
 
 
 def tustin_controller_back(K: DynamicGain) -> DynamicGain | None:
-    """The discrete controller whose Tustin image is ``K``: with ``E = (I - Ak)^-1``,
-    ``(E (I + Ak), sqrt(2) E Bk, sqrt(2) Ck E, Dk + Ck E Bk)``; ``None`` if ``Ak`` has an eigenvalue at 1.
+    """The discrete controller whose Tustin image is ``K``; ``None`` if ``Ak`` has an eigenvalue at 1.
+
+    With ``E = (I - Ak)^-1``: ``(E (I + Ak), sqrt(2) E Bk, sqrt(2) Ck E, Dk + Ck E Bk)``.
     """
     Ak, Bk, Ck, Dk = K
     n = Ak.shape[0]

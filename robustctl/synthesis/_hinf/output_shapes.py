@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from ..._hinf._coordinates import lifted
+from .coordinates import lifted
 from .generalised import Channel, DynamicGain, Generalised, closed_loop
 from .output_riccati import bisect_level, is_regular, level_riccati, normalise, tustin
 
@@ -49,8 +49,8 @@ def regularised(plant: Generalised, eps: float, k: int = 0) -> Generalised:
 
 
 def _inverse(M: np.ndarray) -> np.ndarray | None:
-    M = lifted(M, RICCATI_FLOOR)
-    return None if M is None else np.linalg.inv(M)
+    floored = lifted(M, RICCATI_FLOOR)
+    return None if floored is None else np.linalg.inv(floored)
 
 
 def hinf_shapes(plant: Generalised, k: int = 0):
@@ -102,9 +102,10 @@ def h2_shapes(plant: Generalised, k: int = 0):
         else:
             Wc = scipy.linalg.solve_continuous_lyapunov(Acl, -Bcl @ Bcl.T)
         n = plant.n
-        Wc = lifted(Wc, RICCATI_FLOOR)
-        if Wc is None:
+        floored = lifted(Wc, RICCATI_FLOOR)
+        if floored is None:
             return None
+        Wc = floored
         Y0 = np.linalg.inv(Wc)[:n, :n]
     except (ValueError, np.linalg.LinAlgError):
         return None

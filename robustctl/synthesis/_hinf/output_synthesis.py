@@ -26,15 +26,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..._hinf._tolerances import BACKOFF_STEPS
+from ... import _cvx
 from ...errors import ConvergenceError, InfeasibleError
 from .generalised import DynamicGain, Generalised, loop_shift
 from .output_certificate import h2_norm, hinf_certificate, poles_inside
 from .output_coordinates import Frame, Standard, frame_of_shapes, standard
 from .output_level import Solved, Spec, centre, minimise
-from .output_lmis import controller
+from .output_lmis import controller, h2_feedthrough_removed
 from .output_riccati import bisect_level, is_regular, normalise, regular_controller, tustin
 from .output_shapes import h2_shapes, hinf_shapes
+from .tolerances import BACKOFF_STEPS
 
 __all__ = ["OFProblem", "OFResult", "synthesise", "riccati_path", "RICCATI_RTOL", "RICCATI_GAMMA_MAX"]
 
@@ -88,6 +89,7 @@ def synthesise(pb: OFProblem) -> OFResult:
         if isinstance(fast, OFResult):
             return fast
         fallback = fast
+        _cvx.check_solver(pb.solver)    # the SDP is needed after all
     out = _lmi_path(pb, std)
     info = {**out.info, "synthesis": "lmi"}
     if pb.synthesis == "riccati":
@@ -113,10 +115,10 @@ def riccati_path(pb: OFProblem, std: Standard) -> OFResult | str:
     b = pb.backoff
     K = regular_controller(plant, np.zeros((plant.p, plant.m)), hi * (1.0 + 0.5 * b))
     cert = None if K is None else hinf_certificate(plant, K, hi * (1.0 + b))
-    if cert is None:
+    if K is None or cert is None:
         return "the central controller's closed loop is not certified at the backed-off level"
     scale = std.level_scales[0]
-    info = {"synthesis": "riccati", "riccati": {"iterations": its + 1, "gamma_low": lo / scale},
+    info: dict = {"synthesis": "riccati", "riccati": {"iterations": its + 1, "gamma_low": lo / scale},
             "fallback": None, "gain_from": "central", "certificate": cert, "backoff": b, "solves": [],
             "status": "certified", "solve_time": 0.0, "iterations": 0}
     return OFResult(_back(pb, std, K), gamma=hi * (1.0 + b) / scale, gamma_opt=hi / scale, info=info)
@@ -158,6 +160,7 @@ def _setup(pb: OFProblem, std: Standard) -> _Setup:
     chans[k] = chans[k].scaled(1.0, est)
     unit[k] /= est
     if pb.kind == "h2hinf":
+        assert pb.gamma is not None     # the bound of the mixed problem is required
         lvl = pb.gamma * unit[0]           # the H-infinity bound becomes 1
         chans[0] = chans[0].scaled(1.0, lvl)
         unit[0] /= lvl
@@ -231,16 +234,16 @@ def _check(f: Frame, spec: Spec, K: DynamicGain, targets) -> dict | None:
 def _centred(pb: OFProblem, f: Frame, spec: Spec, targets, solves: list, msg: str):
     """``(K, route, certificate, margin)`` of the centring solve at the targets (``K = None`` if uncertified)."""
     level, bound = targets
-    g = f.plant
-    if level is not None:
-        f = f.with_channel(spec.hinf, g.channels[spec.hinf].scaled(1.0, level))
-    if bound is not None:
+    if level is not None and spec.hinf is not None:
+        f = f.with_channel(spec.hinf, f.plant.channels[spec.hinf].scaled(1.0, level))
+    if bound is not None and spec.h2 is not None:
         f = f.with_channel(spec.h2, f.plant.channels[spec.h2].scaled(1.0, bound))
     sol: Solved = centre(f, spec, pb.solver, msg)
     solves.append({**sol.report.as_dict(), "centring": "margin"})
     if not sol.value > MARGIN_MIN:
         return None, "centred", {}, sol.value
-    K = controller(f, sol.point)
+    point = sol.point if spec.h2 is None else h2_feedthrough_removed(f, sol.point, spec.h2)
+    K = controller(f, point)
     cert = _check(f, spec, K, (None if level is None else 1.0, None if bound is None else 1.0))
     return (K if cert is not None else None), "centred", cert or {}, sol.value
 
