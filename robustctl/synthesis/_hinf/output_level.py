@@ -31,12 +31,21 @@ CENTRE_TOL = 1e-7
 
 @dataclass(frozen=True)
 class Spec:
-    """Channel of the H-infinity bound, channel of the H2 bound (``None``: absent) and the pole regions."""
+    """Channel of the H-infinity bound, channel of the H2 bound (``None``: absent) and the pole regions.
+
+    ``shared_w``: both channels have the same disturbance input (``B1``,
+    ``D21``); the H2 Gramian block is then a principal submatrix (discrete)
+    or the Schur complement of the ``w`` block (continuous) of the
+    H-infinity block and is left out: a redundant block becomes singular
+    with the other at the optimum, which the solver measured as failures
+    and false optima on Scherer, Gahinet & Chilali's Example 7.
+    """
 
     hinf: int | None
     h2: int | None
     regions: tuple = ()
     what: str = "an output-feedback controller"
+    shared_w: bool = False
 
 
 class Solved(NamedTuple):
@@ -52,7 +61,8 @@ def _blocks(f: Frame, V: OFPoint, spec: Spec, level_sq, Z, margin) -> tuple[list
     if spec.hinf is not None:
         lmis.append(hinf_block(f, V, level_sq, spec.hinf, margin))
     if spec.h2 is not None:
-        lmis += h2_blocks(f, V, Z, spec.h2, margin)
+        h2 = h2_blocks(f, V, Z, spec.h2, margin)
+        lmis += h2[1:] if spec.shared_w and spec.hinf is not None else h2
         cons += h2_equality(f, V, spec.h2)
     if not f.discrete:
         lmis.append(_cvx.LMI("lyapunov", lyapunov(f, V), margin))

@@ -139,14 +139,27 @@ def h2_blocks(f: Frame, V: OFPoint, Z, k: int = 0, margin=0.0) -> list[_cvx.LMI]
 
 
 def h2_equality(f: Frame, V: OFPoint, k: int = 0) -> list:
-    """Continuous H2: ``D11 + D12 Dh D21 = 0`` (a finite norm), as cvxpy constraints (none where it is void).
+    """Continuous H2: ``D12 Dh D21 = 0`` (a finite norm; the validation asks ``D11 = 0``), as cvxpy constraints.
 
-    A ``D11 != 0`` that no ``Dh`` cancels is refused by the validation.
+    Written as ``Q12' Dh Q21 = 0`` with orthonormal bases ``Q12`` of the row
+    space of ``D12`` and ``Q21`` of the column space of ``D21``: the same
+    set, without the identically zero rows that ``D12 Dh D21 = 0`` has when
+    ``D12`` has more rows than columns (they made Clarabel stop with a
+    numerical error at its first step). None where it is void.
     """
     c = f.channels[k]
-    if f.discrete or not (np.any(c.D12) and np.any(c.D21)):
+    if f.discrete:
         return []
-    return [c.D11 + c.D12 @ V.Dh @ c.D21 == 0]
+    Q12, Q21 = _range_basis(c.D12.T), _range_basis(c.D21)
+    if not (Q12.shape[1] and Q21.shape[1]):
+        return []
+    return [Q12.T @ V.Dh @ Q21 == 0]
+
+
+def _range_basis(M: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of the column space of ``M`` (rank to the SVD's default tolerance)."""
+    U, s, _ = np.linalg.svd(M, full_matrices=False)
+    return U[:, : int(np.sum(s > max(M.shape) * np.finfo(float).eps * (s[0] if s.size else 0.0)))]
 
 
 def h2_feedthrough_removed(f: Frame, V: OFPoint, k: int = 0) -> OFPoint:

@@ -134,9 +134,9 @@ def _back(pb: OFProblem, std: Standard, K: DynamicGain) -> DynamicGain:
 
 @dataclass(frozen=True, eq=False)
 class _Setup:
-    """The frame and, per channel, the factor from the caller's level to the frame's (``level * unit``)."""
+    """The frames to try in order (shaped, then plain) and the factor from a caller's level to the frames'."""
 
-    frame: Frame
+    frames: tuple[Frame, ...]
     unit: tuple[float, ...]
     spec: Spec
 
@@ -146,7 +146,9 @@ def _setup(pb: OFProblem, std: Standard) -> _Setup:
     unit = list(std.level_scales)
     chans = list(plant.channels)
     if pb.kind == "h2hinf":
-        spec = Spec(hinf=0, h2=1, regions=pb.regions, what="mixed H2/H-infinity output feedback")
+        c0, c1 = pb.plant.channels
+        shared = c0.B1.shape == c1.B1.shape and np.array_equal(c0.B1, c1.B1) and np.array_equal(c0.D21, c1.D21)
+        spec = Spec(hinf=0, h2=1, regions=pb.regions, what="mixed H2/H-infinity output feedback", shared_w=shared)
         shapes, k = h2_shapes(plant, 1), 1
     elif pb.kind == "h2":
         spec = Spec(hinf=None, h2=0, regions=pb.regions, what="H2 output feedback")
@@ -164,33 +166,33 @@ def _setup(pb: OFProblem, std: Standard) -> _Setup:
         lvl = pb.gamma * unit[0]           # the H-infinity bound becomes 1
         chans[0] = chans[0].scaled(1.0, lvl)
         unit[0] /= lvl
-    X0, Y0 = (None, None) if shapes is None else shapes[:2]
     g = Generalised(plant.A, plant.B2, plant.C2, tuple(chans), plant.discrete)
-    return _Setup(frame_of_shapes(g, X0, Y0), tuple(unit), spec)
+    plain = frame_of_shapes(g, None, None)
+    frames = (plain,) if shapes is None else (frame_of_shapes(g, *shapes[:2]), plain)
+    return _Setup(frames, tuple(unit), spec)
 
 
 def _lmi_path(pb: OFProblem, std: Standard) -> OFResult:
+    """Stages 4-5 in the first frame where the solver succeeds (the shapes may not suit a problem: then plain)."""
     s = _setup(pb, std)
-    f, spec = s.frame, s.spec
+    spec = s.spec
     solves: list[dict] = []
     if pb.kind == "hinf" and pb.gamma is not None:
         level = pb.gamma * s.unit[0]
-        K, route, cert, margin = _centred(pb, f, spec, (level, None), solves,
+        K, route, cert, margin = _centred(pb, s.frames, spec, (level, None), solves,
                                           f"no controller achieves gamma={pb.gamma:.6g}: the H-infinity "
                                           "output-feedback LMIs are infeasible at this level")
         if K is None:
             raise InfeasibleError(f"no controller achieves gamma={pb.gamma:.6g} (largest strictness margin "
                                   f"{margin:.3g} of the output-feedback LMIs at this level)")
         return OFResult(_back(pb, std, K), gamma=pb.gamma, info=_info(solves, route, cert, None, margin))
-    opt = minimise(f, spec, pb.solver)
-    solves.append(opt.report.as_dict())
-    best = float(np.sqrt(max(opt.value, 0.0)))       # the frame's optimal level (H-infinity) or H2 norm
+    opt, frames = _minimised(pb, s, solves)
+    best = float(np.sqrt(max(opt.value, 0.0)))       # the frames' optimal level (H-infinity) or H2 norm
     failure: Exception | None = None
     for factor in BACKOFF_STEPS:
         b = pb.backoff * factor
-        targets = _targets(pb, best, b)
         try:
-            K, route, cert, margin = _centred(pb, f, spec, targets, solves,
+            K, route, cert, margin = _centred(pb, frames, spec, _targets(pb, best, b), solves,
                                               f"could not find a strictly feasible controller at {b:g} above "
                                               "the optimum; increase backoff")
         except (ConvergenceError, InfeasibleError) as exc:
@@ -201,6 +203,21 @@ def _lmi_path(pb: OFProblem, std: Standard) -> OFResult:
         failure = ConvergenceError(f"the controller of the centred point at {b:g} above the optimum is not "
                                    "certified by its closed loop; increase backoff")
     raise failure or ConvergenceError("no controller strategy applied")
+
+
+def _minimised(pb: OFProblem, s: _Setup, solves: list) -> tuple[Solved, tuple[Frame, ...]]:
+    """The optimum in the first frame that gives one, and the frames from that one on."""
+    failure: Exception | None = None
+    for i, f in enumerate(s.frames):
+        try:
+            opt = minimise(f, s.spec, pb.solver)
+        except (ConvergenceError, InfeasibleError) as exc:   # an InfeasibleError may be a failed certificate
+            failure = exc
+            continue
+        solves.append(opt.report.as_dict())
+        return opt, s.frames[i:]
+    assert failure is not None
+    raise failure
 
 
 def _targets(pb: OFProblem, best: float, b: float) -> tuple[float | None, float | None]:
@@ -231,28 +248,37 @@ def _check(f: Frame, spec: Spec, K: DynamicGain, targets) -> dict | None:
     return cert
 
 
-def _centred(pb: OFProblem, f: Frame, spec: Spec, targets, solves: list, msg: str):
-    """``(K, route, certificate, margin)`` of the centring solve at the targets (``K = None`` if uncertified)."""
+def _centred(pb: OFProblem, frames: tuple[Frame, ...], spec: Spec, targets, solves: list, msg: str):
+    """``(K, route, certificate, margin)`` of the centring solve at the targets (``K = None`` if uncertified).
+
+    The first frame whose solve succeeds; the last failure is raised if none does.
+    """
     level, bound = targets
-    if level is not None and spec.hinf is not None:
-        f = f.with_channel(spec.hinf, f.plant.channels[spec.hinf].scaled(1.0, level))
-    if bound is not None and spec.h2 is not None:
-        f = f.with_channel(spec.h2, f.plant.channels[spec.h2].scaled(1.0, bound))
-    sol: Solved = centre(f, spec, pb.solver, msg)
-    solves.append({**sol.report.as_dict(), "centring": "margin"})
-    if not sol.value > MARGIN_MIN:
-        return None, "centred", {}, sol.value
-    point = sol.point if spec.h2 is None else h2_feedthrough_removed(f, sol.point, spec.h2)
-    K = controller(f, point)
-    cert = _check(f, spec, K, (None if level is None else 1.0, None if bound is None else 1.0))
-    return (K if cert is not None else None), "centred", cert or {}, sol.value
+    failure: Exception | None = None
+    for f in frames:
+        if level is not None and spec.hinf is not None:
+            f = f.with_channel(spec.hinf, f.plant.channels[spec.hinf].scaled(1.0, level))
+        if bound is not None and spec.h2 is not None:
+            f = f.with_channel(spec.h2, f.plant.channels[spec.h2].scaled(1.0, bound))
+        try:
+            sol: Solved = centre(f, spec, pb.solver, msg)
+        except (ConvergenceError, InfeasibleError) as exc:
+            failure = exc
+            continue
+        solves.append({**sol.report.as_dict(), "centring": "margin"})
+        if not sol.value > MARGIN_MIN:
+            return None, "centred", {}, sol.value
+        point = sol.point if spec.h2 is None else h2_feedthrough_removed(f, sol.point, spec.h2)
+        K = controller(f, point)
+        cert = _check(f, spec, K, (None if level is None else 1.0, None if bound is None else 1.0))
+        return (K if cert is not None else None), "centred", cert or {}, sol.value
+    assert failure is not None
+    raise failure
 
 
 def _info(solves: list, route: str, cert: dict, backoff, margin: float) -> dict:
     return {"solves": list(solves), "gain_from": route, "certificate": cert, "backoff": backoff, "margin": margin,
-            "status": solves[-1]["status"] if solves else "certified",
-            "solve_time": float(sum(s["solve_time"] for s in solves)),
-            "iterations": int(sum(s["iterations"] or 0 for s in solves))}
+            "status": solves[-1]["status"] if solves else "certified", **_cvx.totals(solves)}
 
 
 def _result(pb: OFProblem, std: Standard, s: _Setup, K: DynamicGain, best: float, b: float, info: dict) -> OFResult:
