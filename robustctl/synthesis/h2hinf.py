@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 
 from .. import _cvx
 from .._validation import check_positive_scalar, check_real
+from ..errors import ConvergenceError, InfeasibleError
 from ..systems.controller import Controller
 from ..systems.plant import Plant
 from ..systems.regions import Region
@@ -34,6 +35,7 @@ from ._hinf.mixed_state import mixed_state
 from ._hinf.output_problem import channel, dynamic_controller, output_problem, wants_output
 from ._hinf.output_synthesis import synthesise
 from ._hinf.problem import validate
+from .hinf import hinf
 
 __all__ = ["h2hinf", "H2HinfController"]
 
@@ -180,9 +182,15 @@ def h2hinf(plant: Plant, *, gamma: float, Bw: ArrayLike, Cz: ArrayLike, Dzu: Arr
         raise ValueError("Dzw2 must be zero for a continuous-time plant: a feedthrough from white noise w2 to z2 "
                          "makes the H2 norm infinite")
     n = plant.n
-    chans = [Channel(pr.Bw, pr.Cz, pr.Dzw, pr.Dzu, np.zeros((n, pr.Bw.shape[1]))) for pr in (problem, second)]
-    res_sf = mixed_state(plant, *chans, gamma, regions=problem.regions, backoff=problem.backoff,
-                         solver=problem.solver)
+    hinf_ch, h2_ch = (Channel(pr.Bw, pr.Cz, pr.Dzw, pr.Dzu, np.zeros((n, pr.Bw.shape[1]))) for pr in (problem, second))
+    try:
+        res_sf = mixed_state(plant, hinf_ch, h2_ch, gamma, regions=problem.regions, backoff=problem.backoff,
+                             solver=problem.solver)
+    except (ConvergenceError, InfeasibleError):
+        # an empty feasible set often ends in a solver failure: the H-infinity bound alone decides (InfeasibleError
+        # naming gamma when no gain meets it)
+        hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, gamma=gamma, poles=poles, solver=solver, feedback="state")
+        raise
     info = {"feedback": "state", "certificate": res_sf.certificate, "solves": list(res_sf.solves),
             "backoff": res_sf.backoff, "status": res_sf.solves[-1]["status"], "poles": problem.regions,
             **_cvx.totals(res_sf.solves)}

@@ -186,7 +186,12 @@ def _lmi_path(pb: OFProblem, std: Standard) -> OFResult:
             raise InfeasibleError(f"no controller achieves gamma={pb.gamma:.6g} (largest strictness margin "
                                   f"{margin:.3g} of the output-feedback LMIs at this level)")
         return OFResult(_back(pb, std, K), gamma=pb.gamma, info=_info(solves, route, cert, None, margin))
-    opt, frames = _minimised(pb, s, solves)
+    try:
+        opt, frames = _minimised(pb, s, solves)
+    except (ConvergenceError, InfeasibleError):
+        if pb.kind == "h2hinf":
+            _check_bound(pb, s)     # an infeasible bound is a solver failure more often than a certificate
+        raise
     best = float(np.sqrt(max(opt.value, 0.0)))       # the frames' optimal level (H-infinity) or H2 norm
     failure: Exception | None = None
     for factor in BACKOFF_STEPS:
@@ -203,6 +208,21 @@ def _lmi_path(pb: OFProblem, std: Standard) -> OFResult:
         failure = ConvergenceError(f"the controller of the centred point at {b:g} above the optimum is not "
                                    "certified by its closed loop; increase backoff")
     raise failure or ConvergenceError("no controller strategy applied")
+
+
+def _check_bound(pb: OFProblem, s: _Setup) -> None:
+    """InfeasibleError naming ``gamma`` if no controller meets the mixed problem's H-infinity bound alone.
+
+    The largest common margin of the H-infinity blocks at the bound (always
+    feasible, so its sign decides, where the minimisation over an empty set
+    may end in a solver failure instead).
+    """
+    spec = Spec(hinf=0, h2=None, regions=s.spec.regions)
+    msg = f"no controller meets gamma={pb.gamma:.6g}"
+    K, _, _, margin = _centred(pb, s.frames, spec, (1.0, None), [], msg)
+    if K is None:
+        raise InfeasibleError(f"{msg} on the H-infinity channel (largest strictness margin {margin:.3g} of its "
+                              "output-feedback LMIs at this level), so the mixed problem has no solution")
 
 
 def _minimised(pb: OFProblem, s: _Setup, solves: list) -> tuple[Solved, tuple[Frame, ...]]:
@@ -255,7 +275,8 @@ def _centred(pb: OFProblem, frames: tuple[Frame, ...], spec: Spec, targets, solv
     """
     level, bound = targets
     failure: Exception | None = None
-    for f in frames:
+    for frame in frames:
+        f = frame
         if level is not None and spec.hinf is not None:
             f = f.with_channel(spec.hinf, f.plant.channels[spec.hinf].scaled(1.0, level))
         if bound is not None and spec.h2 is not None:
