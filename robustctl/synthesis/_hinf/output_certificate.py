@@ -30,6 +30,7 @@ import scipy.linalg
 
 from ...systems.stability import is_stable, spectral_abscissa, spectral_radius
 from .generalised import DynamicGain, Generalised, closed_loop
+from .output_riccati import bilinear
 
 __all__ = ["hinf_certificate", "h2_norm", "poles_inside", "AXIS_MARGIN"]
 
@@ -51,8 +52,10 @@ def hinf_certificate(plant: Generalised, K: DynamicGain, gamma: float, k: int = 
         return None
     C, D = C / gamma, D / gamma
     if plant.discrete:
-        E = np.linalg.inv(np.eye(A.shape[0]) + A)
-        A, B, C, D = E @ (A - np.eye(A.shape[0])), np.sqrt(2.0) * E @ B, np.sqrt(2.0) * C @ E, D - C @ E @ B
+        image = bilinear(A, B, C, D)       # a stable A has no eigenvalue at -1
+        if image is None:
+            return None
+        A, B, C, D = image
     R = np.eye(D.shape[1]) - D.T @ D
     if D.size and np.linalg.eigvalsh(R)[0] <= 0:
         return None

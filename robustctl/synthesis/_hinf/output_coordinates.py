@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .coordinates import _balance as balance
 from .coordinates import lifted
 from .generalised import Channel, DynamicGain, Generalised
 
@@ -80,28 +81,13 @@ def standard(plant: Generalised) -> Standard:
         chans.append(c.scaled(w, z))
         scales.append(w / z)
     data = Generalised(plant.A, plant.B2, plant.C2, tuple(chans), plant.discrete)
-    d = _balance(data)
+    d = balance(data.A, np.hstack([c.B1 for c in chans]), data.B2, np.vstack([*[c.C1 for c in chans], data.C2]))
     data = data.to(np.diag(d))
     su = 1.0 / np.array([_unit(v) for v in np.linalg.norm(
         np.vstack([data.B2, *[c.D12 for c in data.channels]]), axis=0)])
     sy = 1.0 / np.array([_unit(v) for v in np.linalg.norm(
         np.hstack([data.C2, *[c.D21 for c in data.channels]]), axis=1)])
     return Standard(data.with_io_scaling(su, sy), tuple(scales), su, sy, d)
-
-
-def _balance(plant: Generalised) -> np.ndarray:
-    """Diagonal ``d`` (``x = diag(d) x~``) balancing the plant (SLICOT ``TB01ID``); ones if that fails."""
-    n = plant.n
-    B = np.hstack([*[c.B1 for c in plant.channels], plant.B2])
-    C = np.vstack([*[c.C1 for c in plant.channels], plant.C2])
-    try:
-        from slycot import tb01id
-
-        *_, d = tb01id(n, B.shape[1], C.shape[0], 0.0, plant.A.copy(), B.copy(), C.copy(), job="A")
-        d = np.asarray(d, dtype=float)
-    except (ImportError, RuntimeError, ValueError, ArithmeticError):
-        return np.ones(n)
-    return d if d.shape == (n,) and np.all(np.isfinite(d)) and np.all(d > 0) else np.ones(n)
 
 
 @dataclass(frozen=True, eq=False)

@@ -54,7 +54,7 @@ import scipy.optimize
 from .generalised import Channel, DynamicGain, Generalised, loop_shift
 
 __all__ = ["Normalised", "normalise", "is_regular", "level_riccati", "bisect_level", "central_controller",
-           "tustin", "tustin_controller_back", "regular_controller", "RANK_TOL"]
+           "bilinear", "tustin", "tustin_controller_back", "regular_controller", "RANK_TOL"]
 
 #: ``D12`` (``D21``) counts as rank-deficient when its smallest singular value is below
 #: ``RANK_TOL`` times the norm of the channel (unit-sized in the solver's coordinates).
@@ -310,23 +310,30 @@ def central_controller(norm: Normalised, gamma: float) -> DynamicGain | None:
     return K if K.is_finite() else None
 
 
-def tustin(plant: Generalised, D22: np.ndarray) -> tuple[Generalised, np.ndarray] | None:
-    """The continuous image of a discrete plant under ``s = (z - 1) / (z + 1)``: ``(plant, D22)``.
+def bilinear(A, B, C, D) -> tuple[np.ndarray, ...] | None:
+    """The continuous image of a discrete ``(A, B, C, D)`` under ``s = (z - 1) / (z + 1)``, or ``None``.
 
-    With ``E = (I + A)^-1``: ``A~ = E (A - I)``, ``B~ = sqrt(2) E B``,
-    ``C~ = sqrt(2) C E``, ``D~ = D - C E B`` for the stacked inputs and
-    outputs. ``None`` if ``A`` has an eigenvalue at ``-1`` (to rounding).
+    With ``E = (I + A)^-1``: ``(E (A - I), sqrt(2) E B, sqrt(2) C E, D - C E B)``,
+    the same transfer function at ``z = (1 + s) / (1 - s)`` (the unit circle
+    onto the imaginary axis: every H-infinity norm is kept). ``None`` if
+    ``A`` has an eigenvalue at ``-1`` (to rounding).
     """
-    n = plant.n
-    c = plant.channels[0]
-    Ip = np.eye(n) + plant.A
+    n = A.shape[0]
+    Ip = np.eye(n) + A
     if np.linalg.cond(Ip) > 1e12:
         return None
     E = np.linalg.inv(Ip)
-    B = np.hstack([c.B1, plant.B2])
-    C = np.vstack([c.C1, plant.C2])
-    D = np.block([[c.D11, c.D12], [c.D21, D22]])
-    Ac, Bc, Cc, Dc = E @ (plant.A - np.eye(n)), np.sqrt(2.0) * E @ B, np.sqrt(2.0) * C @ E, D - C @ E @ B
+    return E @ (A - np.eye(n)), np.sqrt(2.0) * E @ B, np.sqrt(2.0) * C @ E, D - C @ E @ B
+
+
+def tustin(plant: Generalised, D22: np.ndarray) -> tuple[Generalised, np.ndarray] | None:
+    """The continuous image (:func:`bilinear`) of a discrete plant: ``(plant, D22)``; ``None`` as there."""
+    c = plant.channels[0]
+    image = bilinear(plant.A, np.hstack([c.B1, plant.B2]), np.vstack([c.C1, plant.C2]),
+                     np.block([[c.D11, c.D12], [c.D21, D22]]))
+    if image is None:
+        return None
+    Ac, Bc, Cc, Dc = image
     nw, nz = c.nw, c.nz
     chan = Channel(Bc[:, :nw], Cc[:nz], Dc[:nz, :nw], Dc[:nz, nw:], Dc[nz:, :nw])
     return Generalised(Ac, Bc[:, nw:], Cc[nz:], (chan,), False), Dc[nz:, nw:]

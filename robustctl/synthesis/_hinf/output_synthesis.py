@@ -6,16 +6,18 @@
    the bisection of :mod:`.output_riccati`, the central controller at
    ``(1 + backoff / 2) gamma_opt`` and its certificate at
    ``(1 + backoff) gamma_opt``; any failure falls through to the LMIs;
-3. the shapes (:mod:`.output_shapes`) and the frame
-   (:func:`.output_coordinates.frame_of_shapes`), ``z`` scaled so that the
-   optimum is near 1;
+3. the shapes (:mod:`.output_shapes`) and the frames
+   (:func:`.output_coordinates.frame_of_shapes`): the shaped one, then the
+   plain one if a solve fails there; ``z`` scaled so that the optimum is
+   near 1;
 4. :func:`.output_level.minimise` - the optimum (or, with a fixed level,
    straight to 5);
-5. the controller, by the first strategy whose closed loop is certified
-   (:mod:`.output_certificate`) at the backed-off level: the optimum's own
-   (``"optimum-certified"``), then a centring solve at that level
-   (``"centred"``), then the same with the backoff raised by
-   ``BACKOFF_STEPS``; ``info["gain_from"]`` names it;
+5. the controller of a centring solve (:func:`.output_level.centre`) at the
+   backed-off level, reconstructed (:func:`.output_lmis.controller`) and
+   accepted only if its closed loop is certified there
+   (:mod:`.output_certificate`); otherwise the backoff is raised by
+   ``BACKOFF_STEPS``. The optimum's own controller is not used: there
+   ``I - X Y`` is nearly singular and the controller huge;
 6. the controller mapped back to the caller's ``u`` and ``y`` and closed
    around ``D22``.
 """
@@ -119,8 +121,8 @@ def riccati_path(pb: OFProblem, std: Standard) -> OFResult | str:
         return "the central controller's closed loop is not certified at the backed-off level"
     scale = std.level_scales[0]
     info: dict = {"synthesis": "riccati", "riccati": {"iterations": its + 1, "gamma_low": lo / scale},
-            "fallback": None, "gain_from": "central", "certificate": cert, "backoff": b, "solves": [],
-            "status": "certified", "solve_time": 0.0, "iterations": 0}
+                  "fallback": None, "gain_from": "central", "certificate": cert, "backoff": b, "solves": [],
+                  "status": "certified", "solve_time": 0.0, "iterations": 0}
     return OFResult(_back(pb, std, K), gamma=hi * (1.0 + b) / scale, gamma_opt=hi / scale, info=info)
 
 
@@ -179,13 +181,13 @@ def _lmi_path(pb: OFProblem, std: Standard) -> OFResult:
     solves: list[dict] = []
     if pb.kind == "hinf" and pb.gamma is not None:
         level = pb.gamma * s.unit[0]
-        K, route, cert, margin = _centred(pb, s.frames, spec, (level, None), solves,
-                                          f"no controller achieves gamma={pb.gamma:.6g}: the H-infinity "
-                                          "output-feedback LMIs are infeasible at this level")
+        K, cert, margin = _centred(pb, s.frames, spec, (level, None), solves,
+                                   f"no controller achieves gamma={pb.gamma:.6g}: the H-infinity output-feedback "
+                                   "LMIs are infeasible at this level")
         if K is None:
             raise InfeasibleError(f"no controller achieves gamma={pb.gamma:.6g} (largest strictness margin "
                                   f"{margin:.3g} of the output-feedback LMIs at this level)")
-        return OFResult(_back(pb, std, K), gamma=pb.gamma, info=_info(solves, route, cert, None, margin))
+        return OFResult(_back(pb, std, K), gamma=pb.gamma, info=_info(solves, cert, None, margin))
     try:
         opt, frames = _minimised(pb, s, solves)
     except (ConvergenceError, InfeasibleError):
@@ -197,14 +199,14 @@ def _lmi_path(pb: OFProblem, std: Standard) -> OFResult:
     for factor in BACKOFF_STEPS:
         b = pb.backoff * factor
         try:
-            K, route, cert, margin = _centred(pb, frames, spec, _targets(pb, best, b), solves,
-                                              f"could not find a strictly feasible controller at {b:g} above "
-                                              "the optimum; increase backoff")
+            K, cert, margin = _centred(pb, frames, spec, _targets(pb, best, b), solves,
+                                       f"could not find a strictly feasible controller at {b:g} above the "
+                                       "optimum; increase backoff")
         except (ConvergenceError, InfeasibleError) as exc:
             failure = exc
             continue
         if K is not None:
-            return _result(pb, std, s, K, best, b, _info(solves, route, cert, b, margin))
+            return _result(pb, std, s, K, best, b, _info(solves, cert, b, margin))
         failure = ConvergenceError(f"the controller of the centred point at {b:g} above the optimum is not "
                                    "certified by its closed loop; increase backoff")
     raise failure or ConvergenceError("no controller strategy applied")
@@ -219,7 +221,7 @@ def _check_bound(pb: OFProblem, s: _Setup) -> None:
     """
     spec = Spec(hinf=0, h2=None, regions=s.spec.regions)
     msg = f"no controller meets gamma={pb.gamma:.6g}"
-    K, _, _, margin = _centred(pb, s.frames, spec, (1.0, None), [], msg)
+    K, _, margin = _centred(pb, s.frames, spec, (1.0, None), [], msg)
     if K is None:
         raise InfeasibleError(f"{msg} on the H-infinity channel (largest strictness margin {margin:.3g} of its "
                               "output-feedback LMIs at this level), so the mixed problem has no solution")
@@ -269,7 +271,7 @@ def _check(f: Frame, spec: Spec, K: DynamicGain, targets) -> dict | None:
 
 
 def _centred(pb: OFProblem, frames: tuple[Frame, ...], spec: Spec, targets, solves: list, msg: str):
-    """``(K, route, certificate, margin)`` of the centring solve at the targets (``K = None`` if uncertified).
+    """``(K, certificate, margin)`` of the centring solve at the targets (``K = None`` if uncertified).
 
     The first frame whose solve succeeds; the last failure is raised if none does.
     """
@@ -288,17 +290,17 @@ def _centred(pb: OFProblem, frames: tuple[Frame, ...], spec: Spec, targets, solv
             continue
         solves.append({**sol.report.as_dict(), "centring": "margin"})
         if not sol.value > MARGIN_MIN:
-            return None, "centred", {}, sol.value
+            return None, {}, sol.value
         point = sol.point if spec.h2 is None else h2_feedthrough_removed(f, sol.point, spec.h2)
         K = controller(f, point)
         cert = _check(f, spec, K, (None if level is None else 1.0, None if bound is None else 1.0))
-        return (K if cert is not None else None), "centred", cert or {}, sol.value
+        return (K if cert is not None else None), cert or {}, sol.value
     assert failure is not None
     raise failure
 
 
-def _info(solves: list, route: str, cert: dict, backoff, margin: float) -> dict:
-    return {"solves": list(solves), "gain_from": route, "certificate": cert, "backoff": backoff, "margin": margin,
+def _info(solves: list, cert: dict, backoff, margin: float) -> dict:
+    return {"solves": list(solves), "gain_from": "centred", "certificate": cert, "backoff": backoff, "margin": margin,
             "status": solves[-1]["status"] if solves else "certified", **_cvx.totals(solves)}
 
 
