@@ -2,7 +2,7 @@
 
 The H-infinity block is :func:`.lmis.hinf_blocks` of the first channel at
 its bound (``z`` scaled so that the bound is 1), the H2 blocks are
-:func:`robustctl.synthesis.h2.h2_blocks` of the second channel; both
+``h2_blocks`` of ``robustctl.synthesis.h2`` for the second channel; both
 channels are in the balanced coordinates of the first
 (:func:`.coordinates.normalised`, the second moved there by
 :meth:`.coordinates.Coordinates.to`), so that one ``X`` and ``Y = K X``

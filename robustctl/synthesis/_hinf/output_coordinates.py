@@ -42,7 +42,7 @@ from .coordinates import _balance as balance
 from .coordinates import lifted
 from .generalised import Channel, DynamicGain, Generalised
 
-__all__ = ["Standard", "Frame", "standard", "frame_of_shapes", "SHAPE_FLOOR"]
+__all__ = ["Standard", "Frame", "FrameChannel", "standard", "frame_of_shapes", "SHAPE_FLOOR"]
 
 #: The shapes ``X0``, ``Y0`` are lifted to at least ``SHAPE_FLOOR`` of their largest eigenvalue before factoring.
 SHAPE_FLOOR = 1e-12
