@@ -208,8 +208,8 @@ def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEF
 def rlqr_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_ALPHA):
     r"""One RLQR step ``P[k+1] -> (L[k], K[k], P[k])`` by the penalty/KKT form.
 
-    The step that :func:`robustctl.rlqr` iterates to its steady state
-    (:mod:`robustctl.synthesis.rlqr` gives the derivation).
+    The step that :func:`robustctl.rlqr` iterates to its steady state (the
+    docstring of the module ``robustctl.synthesis.rlqr`` gives the derivation).
 
     Parameters
     ----------
