@@ -36,7 +36,22 @@ __all__ = ["Region", "Disk", "HalfPlane", "ConicSector", "as_regions", "describe
 
 
 class Region:
-    """Base class: an LMI region given by its characteristic matrices ``L`` (symmetric) and ``M``."""
+    """Base class: an LMI region given by its characteristic matrices ``L`` (symmetric) and ``M``.
+
+    A subclass defines ``L``, ``M`` and :meth:`real_interval`; :meth:`contains`
+    and :func:`region_lmi` follow from them (module docstring).
+
+    See Also
+    --------
+    Disk, HalfPlane, ConicSector : the regions.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.systems.regions import Region
+    >>> isinstance(rc.Disk(0.0, 0.9), Region), bool(rc.Disk(0.0, 0.9).contains(0.5))
+    (True, True)
+    """
 
     @property
     def L(self) -> np.ndarray:  # pragma: no cover - every region defines it
@@ -341,7 +356,30 @@ class ConicSector(Region):
 
 
 def as_regions(poles) -> tuple[Region, ...]:
-    """``poles=`` as a tuple of regions (their intersection): ``None``, one region, or a list of them."""
+    """``poles=`` as a tuple of regions (their intersection): ``None``, one region, or a list of them.
+
+    Parameters
+    ----------
+    poles : None, Region or sequence of Region
+        The ``poles=`` argument of a synthesis.
+
+    Returns
+    -------
+    tuple of Region
+        Empty for None.
+
+    Raises
+    ------
+    TypeError
+        Anything else, or an empty sequence (naming the bad entry).
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.systems.regions import as_regions
+    >>> as_regions(None), as_regions(rc.Disk(0.0, 0.9))
+    ((), (Disk(center=0.0, radius=0.9),))
+    """
     if poles is None:
         return ()
     if isinstance(poles, Region):
@@ -356,15 +394,76 @@ def as_regions(poles) -> tuple[Region, ...]:
 
 
 def describe_regions(regions: Sequence[Region]) -> str:
-    """``Disk(center=0.0, radius=0.9) and HalfPlane(...)``."""
+    """``Disk(center=0.0, radius=0.9) and HalfPlane(...)``: the regions for messages.
+
+    Parameters
+    ----------
+    regions : sequence of Region
+        The regions (their intersection).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.systems.regions import describe_regions
+    >>> describe_regions([rc.Disk(0.0, 0.9), rc.HalfPlane(0.2, "right")])
+    "Disk(center=0.0, radius=0.9) and HalfPlane(boundary=0.2, side='right')"
+    """
     return " and ".join(repr(r) for r in regions)
 
 
 def region_lmi(region: Region, AX, X):
-    """``-M_D(A, X)`` (``>= 0`` means the eigenvalues of ``A`` lie in the region), from ``A X`` and ``X``.
+    r"""``-M_D(A, X)`` (``>= 0`` means the eigenvalues of ``A`` lie in the region), from ``A X`` and ``X``.
 
-    ``AX`` and ``X`` are cvxpy expressions or arrays; the result is a
-    symmetric block of size ``k n`` (``k`` the size of ``L``).
+    Parameters
+    ----------
+    region : Region
+        The region, with ``L`` of size ``k``.
+    AX : (n, n) cvxpy expression or ndarray
+        ``A X`` (in a synthesis ``F X + G Y``).
+    X : (n, n) cvxpy expression or ndarray
+        The Lyapunov matrix, symmetric positive definite.
+
+    Returns
+    -------
+    cvxpy expression
+        The symmetric block ``-M_D(A, X)`` of size ``k n``.
+
+    Notes
+    -----
+    With the Kronecker product [1]_,
+
+    .. math::
+
+        M_D(A, X) = L \otimes X + M \otimes (A X) + M^T \otimes (A X)^T ,
+
+    and ``A`` has its eigenvalues in the region iff ``M_D(A, X) < 0`` for
+    some ``X > 0``.
+
+    References
+    ----------
+    .. [1] M. Chilali, P. Gahinet, "H-infinity design with pole placement
+       constraints: an LMI approach", IEEE Trans. Automatic Control 41(3),
+       358-367, 1996.
+
+    Examples
+    --------
+    ``A`` with eigenvalues 0.5 and -0.3 and ``X = I`` satisfy the disk of
+    radius 0.9: the block is ``[[0.9 I, -A], [-A', 0.9 I]]``, positive
+    definite because ``||A|| < 0.9``.
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.systems.regions import region_lmi
+    >>> A = np.diag([0.5, -0.3])
+    >>> block = region_lmi(rc.Disk(0.0, 0.9), A, np.eye(2))
+    >>> bool(np.allclose(block.value, [[0.9, 0, -0.5, 0], [0, 0.9, 0, 0.3], [-0.5, 0, 0.9, 0], [0, 0.3, 0, 0.9]]))
+    True
+    >>> round(float(np.linalg.eigvalsh(block.value)[0]), 6)
+    0.4
     """
     import cvxpy as cp
 

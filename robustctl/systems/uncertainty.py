@@ -385,6 +385,18 @@ def check_norm_bounded(value, plant: Plant, name: str = "uncertainty") -> NormBo
         ``value`` is not a :class:`~robustctl.NormBounded` (message naming ``name``).
     ValueError
         Its sizes do not match ``plant``'s.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.systems.uncertainty import check_norm_bounded
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> check_norm_bounded(rc.NormBounded([[0.0], [0.1]], [[0.0, 0.0]], [[0.3]]), plant)
+    NormBounded(n=2, m=1, p=1, l=1)
+    >>> check_norm_bounded(rc.NormBounded([[0.1]], [[0.0]], [[0.3]]), plant)
+    Traceback (most recent call last):
+    ...
+    ValueError: uncertainty is for n=1 states and m=1 inputs, plant has n=2, m=1
     """
     if not isinstance(value, NormBounded):
         raise TypeError(f"{name} must be a robustctl.NormBounded, got {type(value).__name__}")
