@@ -24,9 +24,6 @@ PENDING = {
     "robustctl.HinfController": "robustctl/synthesis/hinf.py is being documented on another branch",
     "robustctl.H2Controller": "robustctl/synthesis/h2.py is being documented on another branch",
     "robustctl.MarginsReport": "robustctl/analysis/margins_report.py is being documented on another branch",
-    "robustctl.validation.check_plant": "robustctl/systems/plant.py's argument checks are not in numpydoc form yet",
-    "robustctl.validation.check_plants": "robustctl/systems/plant.py's argument checks are not in numpydoc form yet",
-    "robustctl.validation.check_vertices": "robustctl/systems/plant.py's argument checks are not in numpydoc form yet",
 }
 
 
