@@ -25,6 +25,30 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     ``design(method, plant, ...)`` is ``robustctl.<method>(plant, ...)``: the
     remaining arguments are those of the named function, which documents them.
 
+    Parameters
+    ----------
+    method : str
+        The design method (case-insensitive), one of the table in the Notes.
+    plant : Plant
+        The plant.
+    *args, **kwargs
+        The arguments of the named function after ``plant``.
+
+    Returns
+    -------
+    Controller
+        What the named function returns (a subclass of
+        :class:`~robustctl.Controller` with the method's levels).
+
+    Raises
+    ------
+    ValueError
+        ``method`` names no design; the named function's own errors.
+    TypeError
+        ``plant`` is not a :class:`~robustctl.Plant`.
+
+    Notes
+    -----
     ==========  =====================================================  ===========================
     method      function                                               controller
     ==========  =====================================================  ===========================
@@ -39,6 +63,11 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     (``ctrl.Ac``, ``Bc``, ``Cc``, ``Dc``) when the plant declares measured
     outputs (``Plant(..., C=...)``), a state feedback otherwise or with
     ``feedback="state"``.
+
+    Examples
+    --------
+    ``design`` calls the named function with the same arguments; an unknown
+    method is named in the error:
 
     >>> import numpy as np
     >>> from robustctl import design, lqr

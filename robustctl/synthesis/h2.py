@@ -76,8 +76,22 @@ __all__ = ["h2", "H2Controller"]
 class H2Controller(Controller):
     """An H2 controller, state feedback ``u = K x`` or output feedback ``u = K(z) y``, with its guaranteed cost.
 
-    Attributes
+    What :func:`robustctl.h2` returns; the constructor is that of
+    :class:`~robustctl.Controller` with the two bounds.
+
+    Parameters
     ----------
+    K : (m, n) array_like or None
+        State-feedback gain ``u = K x``; None for an output feedback.
+    method : str
+        Name of the design method.
+    plant : Plant
+        The plant it was designed for.
+    info : Mapping, optional
+        Diagnostics of the design (see the design function), stored read-only.
+    Ac, Bc, Cc, Dc : array_like, optional
+        Output feedback ``xc+ = Ac xc + Bc y``, ``u = Cc xc + Dc y`` (as in
+        :class:`~robustctl.Controller`).
     h2_bound : float
         ``||T_zw||_2 <= h2_bound`` for the plant (and every plant of the hull
         of ``vertices``): ``(1 + backoff) h2_opt``.
@@ -85,6 +99,24 @@ class H2Controller(Controller):
         The optimal value of the LMI problem (for one plant without pole
         regions: the H2-optimal cost, the LQR's for state feedback and the
         LQG controller's for output feedback).
+
+    See Also
+    --------
+    robustctl.h2
+
+    Examples
+    --------
+    The H2-optimal state feedback of a scalar plant is the LQR, whose cost
+    ``sqrt(P)`` comes from the scalar Riccati equation
+    ``P = 1 + 1.44 P - 1.44 P^2 / (1 + P)``, i.e. ``P^2 - 1.44 P - 1 = 0``,
+    of ``x+ = 1.2 x + u + w`` with unit weights:
+
+    >>> import numpy as np, robustctl as rc
+    >>> plant = rc.Plant([[1.2]], [[1.0]], 0.1)
+    >>> ctrl = rc.h2(plant, Bw=[[1.0]], Cz=[[1.0], [0.0]], Dzu=[[0.0], [1.0]])
+    >>> P = 0.72 + np.sqrt(0.72**2 + 1)     # the positive root
+    >>> isinstance(ctrl, rc.H2Controller), bool(abs(ctrl.h2_opt / np.sqrt(P) - 1) < 1e-5)
+    (True, True)
     """
 
     h2_bound: float = float("nan")

@@ -44,8 +44,22 @@ __all__ = ["h2hinf", "H2HinfController"]
 class H2HinfController(Controller):
     """A mixed H2/H-infinity controller, state feedback ``u = K x`` or output feedback ``u = K(z) y``.
 
-    Attributes
+    What :func:`robustctl.h2hinf` returns; the constructor is that of
+    :class:`~robustctl.Controller` with the bound and the two H2 values.
+
+    Parameters
     ----------
+    K : (m, n) array_like or None
+        State-feedback gain ``u = K x``; None for an output feedback.
+    method : str
+        Name of the design method.
+    plant : Plant
+        The plant it was designed for.
+    info : Mapping, optional
+        Diagnostics of the design (see the design function), stored read-only.
+    Ac, Bc, Cc, Dc : array_like, optional
+        Output feedback ``xc+ = Ac xc + Bc y``, ``u = Cc xc + Dc y`` (as in
+        :class:`~robustctl.Controller`).
     gamma : float
         The H-infinity bound met: ``||T_zw||_inf < gamma``.
     h2_bound : float
@@ -54,6 +68,24 @@ class H2HinfController(Controller):
         The optimal value of the mixed LMI problem: an *upper bound* of the
         smallest H2 norm of any controller meeting the H-infinity bound (one
         Lyapunov matrix for both).
+
+    See Also
+    --------
+    robustctl.h2hinf
+
+    Examples
+    --------
+    The H-infinity optimum of a scalar plant with ``z = (x, u)``, then the
+    mixed design at twice it: the H2 bound lies above the unconstrained H2
+    optimum (the LQR cost):
+
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.2]], [[1.0]], 0.1)
+    >>> ch = dict(Bw=[[1.0]], Cz=[[1.0], [0.0]], Dzu=[[0.0], [1.0]])
+    >>> g = rc.hinf(plant, **ch).gamma_opt
+    >>> ctrl = rc.h2hinf(plant, gamma=2 * g, **ch, Cz2=ch["Cz"], Dzu2=ch["Dzu"])
+    >>> isinstance(ctrl, rc.H2HinfController), bool(ctrl.h2_opt >= rc.h2(plant, **ch).h2_opt * (1 - 1e-6))
+    (True, True)
     """
 
     gamma: float = float("nan")
