@@ -39,8 +39,11 @@ same optimal level, and a continuous controller maps back to a discrete one
 with the same closed-loop norm (the image has a ``D11`` and a ``D22`` even
 when the discrete plant has none: both are handled).
 
-:func:`bisect_level` is the gamma-iteration (geometric bisection on the four
-conditions); :func:`central_controller` the controller at a level above it.
+:func:`bisect_level` is the gamma-iteration (bisection until both Riccati
+solutions exist, then Brent's method on the coupling margin);
+:func:`central_controller` the controller at a level above the optimum;
+:func:`regular_controller` that controller in the caller's ``u``, ``y``
+and ``D22`` (through the Tustin image for a discrete plant).
 """
 
 from __future__ import annotations
