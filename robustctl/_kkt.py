@@ -1,0 +1,204 @@
+"""The regularised least-squares (KKT) kernel shared by the robust regulator and the robust filter.
+
+One step of the robust LQR (:func:`robustctl.rlqr`) and of the robust filter
+are each the solution of a regularised least-squares problem, written as one
+symmetric indefinite (KKT) linear system per design; a population of designs
+is a stack of such systems. This module holds what both solve them with:
+:func:`solve`, a stacked solve in which a numerically singular system spoils
+only its own design, :func:`sym`, the symmetric part of a stack, and
+:func:`weighted_lsq`, the KKT form of a weighted least-squares problem whose
+weight may be infinite on some rows (hard constraints, the ``mu -> inf``
+limit of the penalty method). Their steady states are fixed points of a
+Riccati recursion: :func:`doubling` (the structure-preserving doubling
+algorithm), :func:`stein` (Smith's iteration, for Newton's method),
+:func:`relchange` and :func:`healthy` serve both.
+
+References
+----------
+A. H. Sayed, "A framework for state-space estimation with uncertain models",
+IEEE TAC 46(7), 2001.
+E. K.-W. Chu, H.-Y. Fan and W.-W. Lin, "A structure-preserving doubling
+algorithm for continuous-time algebraic Riccati equations", Linear Algebra
+Appl. 396, 2005 (and its discrete-time form).
+"""
+
+from __future__ import annotations
+
+import contextlib
+
+import numpy as np
+
+from ._validation import as_float_array
+
+__all__ = ["solve", "sym", "weighted_lsq", "doubling", "stein", "relchange", "healthy", "check_penalty",
+           "DIVERGED", "DEFAULT_ALPHA", "MU_MIN"]
+
+#: Default margin of ``lambda = (1 + alpha) mu ||H'H||`` (Sayed's approximation of the optimal ``lambda``).
+DEFAULT_ALPHA = 0.1
+#: Smallest accepted penalty ``mu`` (``1/mu`` enters products with ``P``).
+MU_MIN = 1e-100
+#: ``|P|`` beyond this: a recursion is diverging.
+DIVERGED = 1e250
+#: Smith iteration for a Stein equation: stop when the increment is below this, relative to the largest entry.
+STEIN_TOL = 1e-17
+STEIN_MAX_SQUARINGS = 60
+_TINY = np.finfo(float).tiny
+
+
+def sym(P: np.ndarray) -> np.ndarray:
+    """The symmetric part ``(P + P') / 2`` of every matrix of a stack ``(..., n, n)``."""
+    return 0.5 * (P + P.swapaxes(-1, -2))
+
+
+def solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Stacked solve ``A[i] x[i] = b[i]``; a numerically singular system gives NaN for that design only.
+
+    (``np.linalg.solve`` fails the whole stack if one matrix is singular, e.g.
+    ``R + G' Pt G`` with two identical input columns and ``Pt ~ mu ~ 1e20``.)
+    """
+    try:
+        return np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        out = np.full(b.shape, np.nan)
+        for i in range(A.shape[0]):  # rare fallback, only when some system is singular
+            with contextlib.suppress(np.linalg.LinAlgError):
+                out[i] = np.linalg.solve(A[i], b[i])
+        return out
+
+
+def weighted_lsq(Winv: np.ndarray, A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    r"""Weighted least squares in KKT form, for a stack: the minimiser and its covariance.
+
+    .. math::
+
+        \hat z = \arg\min_z \|A z - b\|^2_{W^{-1}_{inv}}, \qquad
+        \begin{bmatrix} W_{inv} & A \\ A' & 0 \end{bmatrix}
+        \begin{bmatrix} r & \cdot \\ \hat z & \Pi \end{bmatrix} =
+        \begin{bmatrix} b & 0 \\ 0 & -I \end{bmatrix},
+
+    so that ``Pi = (A' Winv^-1 A)^-1``. ``Winv`` (the inverse weight: a
+    covariance) may be singular: its zero rows are constraints met exactly
+    (the ``mu -> inf`` limit of a penalty). Solvable when those rows of ``A``
+    have full row rank and ``A`` has full column rank.
+
+    Parameters
+    ----------
+    Winv : (B, r, r) symmetric positive semidefinite
+    A : (B, r, N)
+    b : (B, r, c)
+
+    Returns
+    -------
+    z : (B, N, c)
+    Pi : (B, N, N)
+        NaN for a design whose KKT matrix is singular.
+    """
+    B, r, N = A.shape
+    kkt = np.zeros((B, r + N, r + N))
+    kkt[:, :r, :r] = Winv
+    kkt[:, :r, r:] = A
+    kkt[:, r:, :r] = A.swapaxes(1, 2)
+    rhs = np.zeros((B, r + N, b.shape[2] + N))
+    rhs[:, :r, :b.shape[2]] = b
+    rhs[:, r:, b.shape[2]:] = -np.eye(N)
+    sol = solve(kkt, rhs)[:, r:]
+    return sol[..., :b.shape[2]], sym(sol[..., b.shape[2]:])
+
+
+def _fro(X: np.ndarray) -> np.ndarray:
+    """Batched Frobenius norm (``np.linalg.norm(X, axis=(1, 2))`` without its Python overhead)."""
+    return np.sqrt(np.add.reduce(X * X, axis=(1, 2)))
+
+
+def relchange(new: np.ndarray, old: np.ndarray) -> np.ndarray:
+    """``||new - old||_F / ||new||_F`` per matrix of a stack (NaN stays NaN)."""
+    return _fro(new - old) / np.maximum(_fro(new), _TINY)
+
+
+def healthy(P: np.ndarray, bound: float = DIVERGED) -> np.ndarray:
+    """Per matrix of a stack: every entry finite and below ``bound`` in magnitude."""
+    return np.abs(P).max(axis=(1, 2)) < bound
+
+
+def doubling(A: np.ndarray, G: np.ndarray, H: np.ndarray, tol: float, max_steps: int,
+             active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Stabilising solution of ``X = H + A' X (I + G X)^-1 A`` by doubling, for a stack.
+
+    The structure-preserving doubling algorithm (Chu, Fan & Lin 2005): with
+    ``W = I + G_k H_k``,
+
+    .. math::
+
+        A_{k+1} = A_k W^{-1} A_k, \quad G_{k+1} = G_k + A_k W^{-1} G_k A_k', \quad
+        H_{k+1} = H_k + A_k' H_k W^{-1} A_k,
+
+    ``H_k`` is the ``2^k``-step iterate of the Riccati recursion from ``H``
+    and converges quadratically to the stabilising solution (``G``, ``H``
+    symmetric positive semidefinite). A design stops when ``H`` changes by
+    less than ``tol`` (relative Frobenius norm) or stops being
+    :func:`healthy`. ``active`` (bool (B,)) selects the designs to iterate.
+
+    Returns
+    -------
+    H : (B, n, n)
+        The last iterate of each design.
+    steps : (B,) int
+    settled : (B,) bool
+        The design met ``tol`` (False: it blew up or was still moving after ``max_steps``).
+    """
+    A, G, H = A.copy(), G.copy(), H.copy()
+    B, n = H.shape[:2]
+    active = np.ones(B, dtype=bool) if active is None else active.copy()
+    steps = np.zeros(B, dtype=int)
+    settled = np.zeros(B, dtype=bool)
+    eye = np.eye(n)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for _ in range(max_steps):
+            if not active.any():
+                break
+            idx = slice(None) if active.all() else np.flatnonzero(active)  # no copies while all run
+            a, g, h = A[idx], G[idx], H[idx]
+            sol = solve(eye + g @ h, np.concatenate([a, g], axis=2))       # W^-1 [A, G]
+            wa, wg = sol[..., :n], sol[..., n:]
+            h_new = sym(h + a.swapaxes(1, 2) @ h @ wa)
+            ok = healthy(h_new)
+            change = np.where(ok, relchange(h_new, h), np.inf)
+            A[idx], G[idx], H[idx] = a @ wa, sym(g + a @ wg @ a.swapaxes(1, 2)), h_new
+            steps[idx] += 1
+            settled[idx] |= change < tol
+            active[idx] &= (change >= tol) & ok
+    return H, steps, settled
+
+
+def stein(A: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """Solve ``X = A' X A + C`` for a stack (``rho(A) < 1``) by Smith's doubling iteration."""
+    X, Ak = C.copy(), A.copy()
+    for _ in range(STEIN_MAX_SQUARINGS):
+        inc = Ak.swapaxes(1, 2) @ X @ Ak
+        X = X + inc
+        Ak = Ak @ Ak
+        if np.all(np.abs(inc) <= STEIN_TOL * np.abs(X).max(axis=(1, 2), keepdims=True)):
+            break
+    return sym(X)
+
+
+def check_penalty(mu, name: str = "mu", *, batch: bool = False, what: str = "this design") -> np.ndarray:
+    """Penalties in ``[MU_MIN, inf]`` as a 1-D array: a scalar, or (``batch``) a scalar or a 1-D array.
+
+    ``mu`` is required (``None`` is a ``TypeError``); NaN, ``mu <= 0`` and
+    ``mu < MU_MIN`` are ``ValueError``; ``np.inf`` is the penalty method's limit.
+    """
+    if mu is None:
+        raise TypeError(f"{name} is required: a positive number (np.inf allowed)")
+    arr = as_float_array(mu, name)
+    if np.any(np.isnan(arr)):
+        raise ValueError(f"{name} must not be NaN")
+    if np.any(arr <= 0):
+        raise ValueError(f"{name} must be > 0 (np.inf allowed), got min {arr.min():g}")
+    if np.any(arr < MU_MIN):
+        raise ValueError(f"{name} must be >= {MU_MIN:g} (or np.inf), got min {arr.min():g}")
+    if not batch and arr.shape != ():
+        raise TypeError(f"{name} must be a scalar for {what}, got shape {arr.shape}")
+    if arr.ndim > 1:
+        raise ValueError(f"{name} must be a scalar or a 1-D array of shape (B,), got shape {arr.shape}")
+    return np.atleast_1d(arr)
