@@ -28,6 +28,7 @@ import contextlib
 
 import numpy as np
 
+from ._simkernel import _jit as jit
 from ._validation import as_float_array
 
 __all__ = ["solve", "sym", "weighted_lsq", "doubling", "stein", "relchange", "healthy", "check_penalty",
@@ -120,9 +121,126 @@ def healthy(P: np.ndarray, bound: float = DIVERGED) -> np.ndarray:
     return np.abs(P).max(axis=(1, 2)) < bound
 
 
+@jit
+def _lu_solve(A, b):
+    """Solve ``A x = b`` in place (``A`` (k, k) becomes its LU factors, ``b`` (k, c) the solution).
+
+    Partial pivoting; returns False (``b`` then unspecified) when a pivot is exactly zero.
+    """
+    k, c = b.shape
+    for j in range(k):
+        p, big = j, abs(A[j, j])
+        for i in range(j + 1, k):
+            if abs(A[i, j]) > big:
+                p, big = i, abs(A[i, j])
+        if A[p, j] == 0.0:
+            return False
+        if p != j:
+            for q in range(k):
+                A[j, q], A[p, q] = A[p, q], A[j, q]
+            for q in range(c):
+                b[j, q], b[p, q] = b[p, q], b[j, q]
+        r = 1.0 / A[j, j]
+        for i in range(j + 1, k):
+            f = A[i, j] * r
+            A[i, j] = f
+            for q in range(j + 1, k):
+                A[i, q] -= f * A[j, q]
+            for q in range(c):
+                b[i, q] -= f * b[j, q]
+    for j in range(k - 1, -1, -1):
+        r = 1.0 / A[j, j]
+        for q in range(c):
+            s = b[j, q]
+            for t in range(j + 1, k):
+                s -= A[j, t] * b[t, q]
+            b[j, q] = s * r
+    return True
+
+
+@jit
+def _doubling(A, G, H, tol, max_steps, bound, tiny, steps, settled, active):
+    """The steps of :func:`doubling` for every ``active`` design; ``A``, ``G``, ``H`` (B, n, n) are overwritten."""
+    n = H.shape[1]
+    W = np.empty((n, n)); sol = np.empty((n, 2 * n)); T1 = np.empty((n, n)); T2 = np.empty((n, n)); hn = np.empty((n, n))
+    for b in range(H.shape[0]):
+        a, g, h = A[b], G[b], H[b]
+        k = 0
+        while active[b] and k < max_steps:
+            k += 1
+            for i in range(n):                                 # W = I + g h, sol = [a, g]
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += g[i, t] * h[t, j]
+                    W[i, j] = s + (1.0 if i == j else 0.0)
+                    sol[i, j] = a[i, j]
+                    sol[i, n + j] = g[i, j]
+            if not _lu_solve(W, sol):
+                for i in range(n):
+                    for j in range(2 * n):
+                        sol[i, j] = np.nan
+            for i in range(n):                                 # T1 = a' h
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += a[t, i] * h[t, j]
+                    T1[i, j] = s
+            num, den, ok = 0.0, 0.0, True
+            for i in range(n):                                 # hn = h + T1 WA (symmetrised below)
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += T1[i, t] * sol[t, j]
+                    hn[i, j] = h[i, j] + s
+            for i in range(n):
+                for j in range(i, n):
+                    v = 0.5 * (hn[i, j] + hn[j, i])
+                    hn[i, j] = v
+                    hn[j, i] = v
+            for i in range(n):
+                for j in range(n):
+                    v = hn[i, j]
+                    if not abs(v) < bound:
+                        ok = False
+                    num += (v - h[i, j]) ** 2
+                    den += v * v
+            den = np.sqrt(den)
+            change = np.sqrt(num) / (tiny if den < tiny else den) if ok else np.inf
+            for i in range(n):                                 # T2 = a WG
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += a[i, t] * sol[t, n + j]
+                    T2[i, j] = s
+            for i in range(n):                                 # g = sym(g + T2 a')
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += T2[i, t] * a[j, t]
+                    T1[i, j] = g[i, j] + s
+            for i in range(n):
+                for j in range(n):
+                    g[i, j] = 0.5 * (T1[i, j] + T1[j, i])
+            for i in range(n):                                 # a = a WA
+                for j in range(n):
+                    s = 0.0
+                    for t in range(n):
+                        s += a[i, t] * sol[t, j]
+                    T2[i, j] = s
+            for i in range(n):
+                for j in range(n):
+                    a[i, j] = T2[i, j]
+                    h[i, j] = hn[i, j]
+            steps[b] += 1
+            if change < tol:
+                settled[b] = True
+            active[b] = change >= tol and ok
+
+
 def doubling(A: np.ndarray, G: np.ndarray, H: np.ndarray, tol: float, max_steps: int,
              active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    r"""Stabilising solution of ``X = H + A' X (I + G X)^-1 A`` by doubling, for a stack.
+    r"""Stabilising solution of ``X = H + A' X (I + G X)^-1 A`` by doubling, for a stack (compiled).
 
     The structure-preserving doubling algorithm (Chu, Fan & Lin 2005): with
     ``W = I + G_k H_k``,
@@ -137,6 +255,10 @@ def doubling(A: np.ndarray, G: np.ndarray, H: np.ndarray, tol: float, max_steps:
     symmetric positive semidefinite). A design stops when ``H`` changes by
     less than ``tol`` (relative Frobenius norm) or stops being
     :func:`healthy`. ``active`` (bool (B,)) selects the designs to iterate.
+    The steps run design by design in a compiled loop (numba; ``W`` by LU
+    with partial pivoting, an exactly singular ``W`` gives NaN for that
+    design): for the small systems of a population numpy's cost is its
+    per-call overhead (about 30 times the compiled loop for one 4-state design).
 
     Returns
     -------
@@ -146,28 +268,12 @@ def doubling(A: np.ndarray, G: np.ndarray, H: np.ndarray, tol: float, max_steps:
     settled : (B,) bool
         The design met ``tol`` (False: it blew up or was still moving after ``max_steps``).
     """
-    A, G, H = A.copy(), G.copy(), H.copy()
-    B, n = H.shape[:2]
-    active = np.ones(B, dtype=bool) if active is None else active.copy()
-    steps = np.zeros(B, dtype=int)
-    settled = np.zeros(B, dtype=bool)
-    eye = np.eye(n)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        for _ in range(max_steps):
-            if not active.any():
-                break
-            idx = slice(None) if active.all() else np.flatnonzero(active)  # no copies while all run
-            a, g, h = A[idx], G[idx], H[idx]
-            sol = solve(eye + g @ h, np.concatenate([a, g], axis=2))       # W^-1 [A, G]
-            wa, wg = sol[..., :n], sol[..., n:]
-            h_new = sym(h + a.swapaxes(1, 2) @ h @ wa)
-            ok = healthy(h_new)
-            change = np.where(ok, relchange(h_new, h), np.inf)
-            A[idx], G[idx], H[idx] = a @ wa, sym(g + a @ wg @ a.swapaxes(1, 2)), h_new
-            steps[idx] += 1
-            settled[idx] |= change < tol
-            active[idx] &= (change >= tol) & ok
-    return H, steps, settled
+    A, G, H = (np.array(x, dtype=float, order="C") for x in (A, G, H))
+    B = H.shape[0]
+    steps, settled = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=bool)
+    active = np.ones(B, dtype=bool) if active is None else np.array(active, dtype=bool)
+    _doubling(A, G, H, float(tol), int(max_steps), DIVERGED, _TINY, steps, settled, active)
+    return H, steps.astype(int), settled
 
 
 def stein(A: np.ndarray, C: np.ndarray) -> np.ndarray:
