@@ -8,7 +8,7 @@ loops; the ratio is ``robust_stability`` time over ``linfnorm`` time
 the Lyapunov matrix ``P`` and its verified eigenvalue certificate, which
 ``linfnorm`` does not: the H-infinity norm (SLICOT AB13DD through slycot
 when installed, as ``linfnorm``; the level-set iteration of
-``robustctl._hinfnorm`` otherwise), one bounded-real Riccati solution and
+``robustctl.analysis._hinfnorm`` otherwise), one bounded-real Riccati solution and
 the certificate eigenvalues (the SDP only where the Riccati certificate
 fails; the table counts those). A second table forces the pure
 numpy/scipy level-set norm (``--no-pure`` skips it).
@@ -56,7 +56,7 @@ import numpy as np  # noqa: E402
 
 import robustctl as rc  # noqa: E402
 from benchmarks._report import header, write  # noqa: E402
-from robustctl import _hinfnorm  # noqa: E402
+from robustctl.analysis import _hinfnorm  # noqa: E402
 
 
 def case(n: int, seed: int, discrete: bool):
@@ -91,7 +91,7 @@ def paired(f, g, reps: int, number: int) -> tuple[float, float]:
 
 @contextlib.contextmanager
 def pure_norm():
-    """Single-loop calls without slycot's AB13DD (the level-set norm of robustctl._hinfnorm)."""
+    """Single-loop calls without slycot's AB13DD (the level-set norm of robustctl.analysis._hinfnorm)."""
     saved = _hinfnorm.slicot_ab13dd
     _hinfnorm.slicot_ab13dd = lambda: None  # type: ignore[assignment]
     try:

@@ -81,14 +81,14 @@ POP = 92
 _FIRST_CALL = """
 import json, time, numpy as np
 t0 = time.perf_counter()
-from robustctl.batchsim import simulate_linear
+from robustctl.sim.simulator import simulate_linear
 t1 = time.perf_counter()
 args = (np.array([[-0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.ones((10, 1)))
 simulate_linear(*args, x0=[-1.0])
 t2 = time.perf_counter()
 simulate_linear(*args, x0=[-1.0])
 t3 = time.perf_counter()
-from robustctl import _simkernel
+from robustctl.sim import _kernel as _simkernel
 s = _simkernel.closed_loop.stats
 print(json.dumps(dict(imp=t1 - t0, first=t2 - t1, second=t3 - t2, hits=sum(s.cache_hits.values()))))
 """
@@ -237,7 +237,7 @@ def report(args, comp, kern, rows) -> str:
              f"| fresh copy, first simulation (compiles, writes the cache) | {comp['fresh']['first']:.2f} |",
              (f"| fresh copy, second process, first simulation (loads the cache: {comp['cached']['hits']} hit) "
               f"| {comp['cached']['first']:.2f} |"),
-             (f"| import of robustctl.batchsim (numpy, scipy; numba is imported on the first call) "
+             (f"| import of robustctl.sim.simulator (numpy, scipy; numba is imported on the first call) "
               f"| {comp['cached']['imp']:.2f} |"),
              f"| spawned worker: import moo.problems | {comp['worker']['imp']:.2f} |",
              f"| spawned worker: build the applied MOP | {comp['worker']['build']:.2f} |",

@@ -59,7 +59,7 @@ from moo.molsp import molsp
 from moo.problems.applied import AppliedRLQRProblem
 from moo.problems.generic import GenericRLQRProblem
 from robustctl.models import truck
-from robustctl.pathfollow import simulate
+from robustctl.models.pathfollow import simulate
 
 
 class ElementwiseApplied(ElementwiseProblem):

@@ -14,9 +14,9 @@ calls on the same plant. Three batches:
 * ``92``: one population (92 designs) and one design per call, for the fixed
   cost of a call.
 
-Then the plain recursion alone (``robustctl._rlqr._steady.recursion``, the
+Then the plain recursion alone (``robustctl.synthesis._rlqr.steady.recursion``, the
 fallback of designs the doubling leaves unsettled), the compiled kernel
-(``robustctl._rlqr._kernel``, what ``rlqr_gains`` runs) against the numpy
+(``robustctl.synthesis._rlqr.kernel``, what ``rlqr_gains`` runs) against the numpy
 reference in the same process, best of ``--repeat`` interleaved:
 
 * the generic MOP's fallback designs (``z`` uniform in its search space,
@@ -37,11 +37,10 @@ import control
 import numpy as np
 
 import robustctl as rc
-from robustctl._rlqr import _kernel as kernel
-from robustctl._rlqr import _steady as steady
-from robustctl._rlqr._model import build
-from robustctl._rlqr._step import kkt_step
 from robustctl.models.truck import lqr_weights, truck_plant
+from robustctl.synthesis._rlqr import kernel, steady
+from robustctl.synthesis._rlqr.model import build
+from robustctl.synthesis._rlqr.step import kkt_step
 
 
 def best_of(fn, repeat: int) -> float:

@@ -42,7 +42,7 @@ the route, N * 0.1 s, instead of 5400); the MOEA always uses the problem's
 defaults. The default settings take well under a minute on 2 cores
 (measured on the loaded 2-core machine: generic about 6 s, applied about
 8 s in all, imports and the MOEA included; the simulations run on the
-compiled kernel, :mod:`robustctl.batchsim`).
+compiled kernel, :mod:`robustctl.sim.simulator`).
 
 Writes ``DIR/selection.json`` (settings, z*, win counts of every design, the
 winner's margins, the front's objectives, timings) and

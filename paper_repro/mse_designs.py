@@ -16,11 +16,11 @@ from paper_values import CONTROLLERS
 from truck_margins import appendix_uncertainty
 
 import robustctl as rc
-from robustctl.hinf_game import hinf_game
 from robustctl.models import morais2022, truck
 from robustctl.models.morais2022 import CODE_GAMMA, SETUPS, code_manoeuvre
-from robustctl.path import default_route
-from robustctl.pathfollow import PathFollowingSetup
+from robustctl.models.path import default_route
+from robustctl.models.pathfollow import PathFollowingSetup
+from robustctl.synthesis.hinf_game import hinf_game
 
 # "ours" H-infinity disturbance channels (columns of Bw): a 1 m lateral-displacement
 # impulse (the run's initial offset) and the path curvature scaled by the

@@ -18,7 +18,7 @@ its initial state nor its H-infinity formulation):
   feedforward, ``x_ref = [0, 0, rho_ref, theta_ref]`` (``main.m``) from the
   nominal truck driven open loop by a smooth steering command
   (``parameters.m``; here the route's steady-cornering steering, see
-  :mod:`robustctl.pathfollow`), and the H-infinity design with the same Q and
+  :mod:`robustctl.models.pathfollow`), and the H-infinity design with the same Q and
   R in its performance output, the disturbance entering through ``H`` and no
   input bound (``standard_formulation/h_infinity.m``; there a game-Riccati
   law, here our LMI synthesis, and the code's law as the extra row
@@ -39,7 +39,7 @@ its initial state nor its H-infinity formulation):
   acceptable.
 
 Course (``--course``): ``route`` (default, both set-ups), the 9 km route
-(:func:`robustctl.path.default_route`); ``code``, the code's 30 s manoeuvre
+(:func:`robustctl.models.path.default_route`); ``code``, the code's 30 s manoeuvre
 (two 5 s sine steering lane changes, :func:`robustctl.models.morais2022.code_manoeuvre`).
 
 Controllers, all designed on the nominal (0 %) model with the set-up's Q, R:
@@ -61,12 +61,12 @@ set-up's H-infinity made robust over the 0-300 % payload polytope),
 model, :func:`robustctl.hinf` with ``uncertainty``; the computed model is
 infeasible), ``Hinf_unbounded`` (``ours``: without the input bound) and
 ``Hinf_game`` (``authors``: the code's finite-horizon game-Riccati law at
-``gamma = 14350``, :mod:`robustctl.hinf_game`, stationary gains, realised as
+``gamma = 14350``, :mod:`robustctl.synthesis.hinf_game`, stationary gains, realised as
 in the code with the previous input fed back).
 
 Every controller drives the same truck along the same course from the same
 initial state at 0, 100, 200 and 300 % overload (true plant),
-:class:`robustctl.pathfollow.PathFollowing` in the set-up's loop.
+:class:`robustctl.models.pathfollow.PathFollowing` in the set-up's loop.
 
 Two measures of f1..f4 (``--measure`` picks the one printed and written to
 ``mse_table.*``; the other goes to ``mse_table_<measure>.csv/.md``):
@@ -135,9 +135,9 @@ from paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS
 from truck_margins import MARGINS_NOTE, truck_margins
 
 import robustctl as rc
-from robustctl.batchsim import BACKENDS
 from robustctl.models import morais2022, truck
-from robustctl.pathfollow import PathFollowing, PathFollowingResult
+from robustctl.models.pathfollow import PathFollowing, PathFollowingResult
+from robustctl.sim.simulator import BACKENDS
 
 
 def design_controllers(z=morais2022.RLQR_MOP_Z, uncertainty: str = "printed",

@@ -1,4 +1,14 @@
-"""robustctl: robust state-feedback design (LQR, RLQR, LMI H-infinity and H2) and robust analysis.
+"""robustctl: robust control design (LQR, RLQR, LMI H-infinity and H2), estimation and robust analysis.
+
+The package is laid out by role (``docs/architecture.rst``); every public
+name is importable from here:
+
+* :mod:`robustctl.systems` - plants, uncertainty, pole regions, plant sets, controllers;
+* :mod:`robustctl.estimation` - Kalman and robust filters;
+* :mod:`robustctl.synthesis` - the design methods and :func:`design`;
+* :mod:`robustctl.analysis` - robust stability, guaranteed cost, worst case, reports;
+* :mod:`robustctl.sim` - the batched closed-loop simulator;
+* :mod:`robustctl.models` - the heavy truck, paths and path following (imported on their own).
 
 >>> import robustctl as rc
 >>> from robustctl.models.truck import truck_plant
@@ -15,51 +25,17 @@ True
 Sign convention everywhere: ``u = K x``.
 """
 
-from ._hinf import HinfController, hinf  # cvxpy itself is imported on first use
-from ._margins_report import MarginsReport, margins_report
-from ._rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule, rlqr_step, rlqr_step_block
-from .analysis import (
-    CostBound,
-    CostBoundBatch,
-    HinfBound,
-    RobustStability,
-    RobustStabilityBatch,
-    WorstCase,
-    guaranteed_cost,
-    robust_hinf_bound,
-    robust_stability,
-    worst_case,
-)
-from .controller import Controller
-from .design import design
-from .errors import (
-    ConvergenceError,
-    InfeasibleError,
-    NotStabilizableError,
-    NotStabilizingError,
-    RankConditionError,
-    RobustCtlError,
-)
-from .h2 import H2Controller, h2
-from .input_memory import InputMemoryFeedback
-from .lqr import lqr
-from .performance import lq_output
-from .plant import Plant
-from .regions import ConicSector, Disk, HalfPlane
-from .scenarios import PlantSamples, sample_plants
-from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
-from .uncertainty import NormBounded
+from . import _moved, analysis, errors, estimation, synthesis, systems
+from .analysis import *  # noqa: F403
+from .errors import *  # noqa: F403
+from .estimation import *  # noqa: F403
+from .synthesis import *  # noqa: F403
+from .systems import *  # noqa: F403
 
-__all__ = [
-    "Plant", "NormBounded", "Controller", "design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch",
-    "rlqr_schedule", "RLQRSchedule", "rlqr_step", "rlqr_step_block", "hinf", "HinfController",
-    "h2", "H2Controller", "Disk", "HalfPlane", "ConicSector",
-    "spectral_radius", "is_schur_stable", "STABILITY_MARGIN",
-    "RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
-    "NotStabilizingError",
-]
-__all__ += ["sample_plants", "PlantSamples"]
-__all__ += ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case",
-            "RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase"]
-__all__ += ["lq_output", "InputMemoryFeedback", "margins_report", "MarginsReport"]
+# The public names, by role (each subpackage's __all__; python-control's control/__init__.py does the same).
+# robustctl.sim and robustctl.models keep their names in their own namespaces.
+__all__ = systems.__all__ + estimation.__all__ + synthesis.__all__ + analysis.__all__ + errors.__all__
 __version__ = "0.1.0"
+
+_moved.install()
+del _moved

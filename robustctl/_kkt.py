@@ -28,7 +28,7 @@ import contextlib
 
 import numpy as np
 
-from ._simkernel import _jit as jit
+from ._jit import jit
 from ._validation import as_float_array
 
 __all__ = ["solve", "sym", "weighted_lsq", "doubling", "stein", "relchange", "healthy", "check_penalty",

@@ -19,7 +19,7 @@ import numpy as np
 
 __all__ = ["as_float_array", "as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
            "check_real", "check_positive_vector", "check_int", "check_bool", "check_choice", "as_rng",
-           "check_performance"]
+           "check_performance", "frozen", "frozen_complex"]
 
 #: Symmetry accepted by :func:`check_spd` (relative to the largest entry, at least 1).
 SYMMETRY_TOL = 1e-10
@@ -28,6 +28,20 @@ PSD_TOL = 1e-12
 PD_TOL = 1e-14
 
 _BOOL = (bool, np.bool_)
+
+
+def frozen(arr) -> np.ndarray:
+    """A read-only float64 copy of ``arr`` (the arrays that results and plants hold)."""
+    arr = np.array(arr, dtype=np.float64)
+    arr.flags.writeable = False
+    return arr
+
+
+def frozen_complex(arr) -> np.ndarray:
+    """A read-only complex copy of ``arr``."""
+    arr = np.array(arr, dtype=complex)
+    arr.flags.writeable = False
+    return arr
 
 
 def _has_bool(seq) -> bool:

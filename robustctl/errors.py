@@ -7,7 +7,8 @@ it the usual way.
 
 from __future__ import annotations
 
-__all__ = ["RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError"]
+__all__ = ["RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
+           "NotStabilizingError"]
 
 
 class RobustCtlError(Exception):
@@ -30,7 +31,7 @@ class NotStabilizableError(ConvergenceError, InfeasibleError):
     """The plant is not stabilisable: some unstable mode cannot be moved by the input (PBH test).
 
     Raised by ``lqr``, ``rlqr``, ``hinf`` and ``h2`` before they start
-    (:func:`robustctl.stability.check_stabilizable`), since no gain ``u = K x``
+    (:func:`robustctl.systems.stability.check_stabilizable`), since no gain ``u = K x``
     stabilises such a plant. It is both a :class:`ConvergenceError` (what
     ``lqr`` raised when its Riccati solver failed on such plants) and an
     :class:`InfeasibleError` (what the LMI syntheses raise when no gain

@@ -20,7 +20,7 @@ from ._validation import (
     check_spd,
     check_square,
 )
-from .plant import check_plant, check_plants, check_vertices
+from .systems.plant import check_plant, check_plants, check_vertices
 
 __all__ = ["as_float_array", "as_matrix", "as_batch", "check_square", "check_spd", "check_positive_scalar",
            "check_real", "check_positive_vector", "check_int", "check_bool", "check_choice", "as_rng",

@@ -12,7 +12,8 @@ import pytest
 import scipy.linalg
 
 import robustctl as rc
-from robustctl import _hinfnorm, analysis
+from robustctl import analysis
+from robustctl.analysis import _hinfnorm
 from robustctl.errors import InfeasibleError
 
 

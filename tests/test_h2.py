@@ -109,7 +109,7 @@ def test_controller_type_and_dispatch():
     ctrl = rc.design("h2", plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
     assert isinstance(ctrl, rc.H2Controller) and ctrl.method == "h2" and ctrl.is_stabilizing()
     assert "h2_bound=" in repr(ctrl) and ctrl.info["backoff"] == 1e-3
-    assert rc.h2 is importlib.import_module("robustctl.h2").h2
+    assert rc.h2 is importlib.import_module("robustctl.synthesis.h2").h2
 
 
 def test_tiny_backoff_is_raised_or_reported():
@@ -124,7 +124,7 @@ def test_tiny_backoff_is_raised_or_reported():
 
 
 def test_internal_norm_check(monkeypatch):
-    h2_module = importlib.import_module("robustctl.h2")
+    h2_module = importlib.import_module("robustctl.synthesis.h2")
     monkeypatch.setattr(h2_module, "_h2_norm", lambda *a: 1e9)
     plant, Bw, Cz, Dzu, _ = random_case(0, 3, 1, 1, discrete=True)
     with pytest.raises(rc.ConvergenceError, match=r"closed-loop H2 norms .* exceed the guaranteed"):

@@ -2,7 +2,7 @@
 
 References used here, none of which shares code with the LMI synthesis:
 
-* ``robustctl.hinf_riccati``: bisection on the game Riccati equation (scipy's
+* ``robustctl.synthesis.hinf_riccati``: bisection on the game Riccati equation (scipy's
   DARE with its residual checked; the continuous case through the
   Hamiltonian's ordered Schur form);
 * python-control's ``linfnorm`` (SLICOT AB13DD) of the closed loop;
@@ -25,8 +25,8 @@ import scipy.optimize
 
 import robustctl as rc
 from robustctl import InfeasibleError, Plant
-from robustctl._hinf import HinfController, hinf
-from robustctl.hinf_riccati import hinf_riccati, riccati_level
+from robustctl.synthesis.hinf import HinfController, hinf
+from robustctl.synthesis.hinf_riccati import hinf_riccati, riccati_level
 
 RTOL = 1e-5
 
@@ -235,7 +235,7 @@ def test_discrete_gain_is_certified_at_the_backed_off_level_without_a_second_sol
 
 def test_preconditioning_is_a_similarity(monkeypatch):
     """The LQR coordinates change the solver's path, not the level: same gamma_opt without them."""
-    synthesis = importlib.import_module("robustctl._hinf._synthesis")
+    synthesis = importlib.import_module("robustctl.synthesis.hinf")
 
     plant, Bw, Cz, Dzu, _ = random_case(2, 6, 2, 3, discrete=True)
     with_pre = hinf(plant, Bw=Bw, Cz=Cz, Dzu=Dzu)
@@ -395,8 +395,8 @@ def test_design_dispatch_and_controller_type():
 
 
 def test_package_attribute_is_the_function():
-    """The subpackage is private (robustctl._hinf), so importing it cannot shadow the function on the package."""
-    import robustctl._hinf  # noqa: F401
+    """Importing the module robustctl.synthesis.hinf does not shadow the function robustctl.hinf."""
+    import robustctl.synthesis.hinf  # noqa: F401
 
     assert rc.hinf is hinf and callable(rc.hinf)
 

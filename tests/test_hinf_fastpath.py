@@ -23,8 +23,8 @@ import pytest
 
 import robustctl as rc
 from robustctl import Plant
-from robustctl._hinf import _riccati_path
-from robustctl.uncertainty import NormBounded
+from robustctl.synthesis._hinf import riccati_path as _riccati_path
+from robustctl.systems.uncertainty import NormBounded
 
 RTOL = 1e-5
 
@@ -199,7 +199,7 @@ def test_input_bound_energy_out_of_range_names_w_energy():
 
 def test_riccati_bisection_without_slycot_agrees(monkeypatch):
     """The bisection's DARE: SLICOT SG02AD when installed, scipy otherwise; same level."""
-    from robustctl import hinf_riccati as module
+    from robustctl.synthesis import hinf_riccati as module
 
     plant, Bw, Cz, Dzu = random_case(5, 5)
     with_slycot = module.hinf_riccati(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, rtol=1e-9)

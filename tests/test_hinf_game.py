@@ -1,6 +1,6 @@
-"""Game-Riccati H-infinity (robustctl.hinf_game) against independent references.
+"""Game-Riccati H-infinity (robustctl.synthesis.hinf_game) against independent references.
 
-References: the stationary game Riccati equation of robustctl.hinf_riccati
+References: the stationary game Riccati equation of robustctl.synthesis.hinf_riccati
 (scipy's DARE with an indefinite weight, its own checks), scipy's DARE for the
 LQR limit gamma -> inf, and the saddle point of the stacked finite-horizon
 quadratic game (one linear solve, no recursion).
@@ -12,9 +12,10 @@ import scipy.linalg
 
 from robustctl import InfeasibleError, NormBounded, Plant, lq_output
 from robustctl.errors import ConvergenceError
-from robustctl.hinf_game import hinf_game, with_input_memory
-from robustctl.hinf_riccati import hinf_riccati, riccati_level
 from robustctl.models import morais2022, truck
+from robustctl.synthesis.hinf_game import hinf_game
+from robustctl.synthesis.hinf_riccati import hinf_riccati, riccati_level
+from robustctl.systems.input_memory import with_input_memory
 
 
 def _random_case(seed, n=4, m=2, q=2):

@@ -36,8 +36,8 @@ import scipy.linalg
 from test_hinf import MSD_BW, MSD_CZ, MSD_DZU, cl_norm, msd, random_case, worst_case_input
 
 import robustctl as rc
-from robustctl.hinf_riccati import hinf_riccati
 from robustctl.models import truck
+from robustctl.synthesis.hinf_riccati import hinf_riccati
 
 SCALES = [(1e-6, 1.0), (1e6, 1.0), (1.0, 1e-6), (1.0, 1e6), (1e-3, 1e3), (1e6, 1e6), (1e-6, 1e-6)]
 LEVEL_RTOL = 1e-6

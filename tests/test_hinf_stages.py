@@ -1,7 +1,7 @@
-"""The stages of the LMI H-infinity synthesis (robustctl._hinf._*) one by one, and every fallback path.
+"""The stages of the LMI H-infinity synthesis (robustctl.synthesis.hinf._*) one by one, and every fallback path.
 
 The references are independent of the LMI code: python-control's ``linfnorm``
-of the closed loop, the game-Riccati bisection ``robustctl.hinf_riccati``,
+of the closed loop, the game-Riccati bisection ``robustctl.synthesis.hinf_riccati``,
 scipy's Riccati and Lyapunov solvers, and plain linear algebra (a similarity
 keeps the spectrum, a compressed output keeps the Gram matrix). Solver
 failures that no small test plant produces are injected by wrapping one
@@ -12,6 +12,7 @@ references.
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import sys
 
 import numpy as np
@@ -20,9 +21,16 @@ import scipy.linalg
 from test_hinf import MSD_BW, MSD_CZ, MSD_DZU, cl_norm, msd, random_case, worst_case_input
 
 from robustctl import ConvergenceError, InfeasibleError, Plant
-from robustctl._hinf import _coordinates, _gains, _level, _lmis, _problem, _synthesis, hinf
-from robustctl._hinf import _tolerances as tol
-from robustctl.hinf_riccati import hinf_riccati
+from robustctl.synthesis._hinf import coordinates as _coordinates
+from robustctl.synthesis._hinf import gains as _gains
+from robustctl.synthesis._hinf import level as _level
+from robustctl.synthesis._hinf import lmis as _lmis
+from robustctl.synthesis._hinf import problem as _problem
+from robustctl.synthesis._hinf import tolerances as tol
+from robustctl.synthesis.hinf import hinf
+from robustctl.synthesis.hinf_riccati import hinf_riccati
+
+_synthesis = importlib.import_module("robustctl.synthesis.hinf")  # the module (the package's attribute is the function)
 
 RTOL = 1e-5
 

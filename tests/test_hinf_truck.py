@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from robustctl._hinf import hinf
 from robustctl.models.truck import STEER_LIMIT, truck_plant
+from robustctl.synthesis.hinf import hinf
 
 OVERLOADS = (0.0, 100.0, 200.0, 300.0)
 # Performance: lateral displacement rho and orientation error theta, plus steering effort.
@@ -69,7 +69,7 @@ def test_truck_steering_limit_costs_performance_and_extended_helps(plants):
     ext = hinf(plants[0], Bw=Bw, Cz=CZ, Dzu=DZU, vertices=plants[1:], extended=True)
     assert ext.gamma_opt <= free.gamma_opt * (1 + 1e-6)
     # every vertex's own optimum is a lower bound of the polytopic level
-    from robustctl.hinf_riccati import hinf_riccati
+    from robustctl.synthesis.hinf_riccati import hinf_riccati
 
     worst_vertex = max(hinf_riccati(p, Bw=Bw, Cz=CZ, Dzu=DZU).gamma for p in plants)
     assert ext.gamma_opt >= worst_vertex * (1 - 1e-5)

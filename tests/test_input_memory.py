@@ -5,8 +5,8 @@ import pytest
 
 import robustctl as rc
 from robustctl.models import truck
-from robustctl.path import default_route
-from robustctl.pathfollow import PathFollowing
+from robustctl.models.path import default_route
+from robustctl.models.pathfollow import PathFollowing
 
 
 def _law(seed=0, n=3, m=2):

@@ -7,7 +7,7 @@ import scipy.linalg
 from conftest import random_plant
 
 import robustctl as rc
-from robustctl.lqr import dare
+from robustctl.synthesis.lqr import dare
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -82,7 +82,7 @@ for mod in [m for m in sys.modules if m == "slycot" or m.startswith("slycot.")]:
     del sys.modules[mod]
 import numpy as np
 import robustctl as rc
-from robustctl.hinf_riccati import hinf_riccati
+from robustctl.synthesis.hinf_riccati import hinf_riccati
 
 try:
     import slycot  # noqa: F401

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from robustctl.models import morais2022, truck
-from robustctl.pathfollow import DEFAULT_INITIAL_ERROR, DEFAULT_SETUP
+from robustctl.models.pathfollow import DEFAULT_INITIAL_ERROR, DEFAULT_SETUP
 
 
 def test_the_general_library_does_not_import_the_paper_module():
     """DESIGN.md: the vehicle model, paths, simulator and designs name none of the paper's data."""
-    code = ("import sys, robustctl, robustctl.pathfollow, robustctl.path, robustctl.models, "
-            "robustctl.models.truck, robustctl.batchsim; print('robustctl.models.morais2022' in sys.modules)")
+    code = ("import sys, robustctl, robustctl.models.pathfollow, robustctl.models.path, robustctl.models, "
+            "robustctl.models.truck, robustctl.sim.simulator; print('robustctl.models.morais2022' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 

@@ -14,10 +14,10 @@ from paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS, PAPER_MSE, paper_wi
 from truck_margins import truck_margins
 
 import robustctl as rc
-from robustctl.hinf_game import hinf_game
 from robustctl.models import morais2022, truck
-from robustctl.path import default_route
-from robustctl.pathfollow import simulate
+from robustctl.models.path import default_route
+from robustctl.models.pathfollow import simulate
+from robustctl.synthesis.hinf_game import hinf_game
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -181,7 +181,7 @@ def test_authors_designs_use_the_codes_values():
     assert "EG = [-0.0667 -0.0067]" in d["RLQR_A_code_EG"].note
     # the authors' H-infinity: Bw = H, the authors' Q and R, no bound; independent reference: the
     # game-Riccati bisection (hinf_riccati) on the same (scaled) channels gives the same optimal gain
-    from robustctl.hinf_riccati import hinf_riccati
+    from robustctl.synthesis.hinf_riccati import hinf_riccati
     s = 1 / np.sqrt(R[0, 0])
     Cz, Dzu = rc.lq_output(Q, R)
     ref = hinf_riccati(plant, Bw=np.ones((4, 1)), Cz=s * Cz, Dzu=s * Dzu, rtol=1e-6)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from robustctl.path import Curve, LaneChange, ReferencePath, Straight, default_route
+from robustctl.models.path import Curve, LaneChange, ReferencePath, Straight, default_route
 
 V = 16.6667
 

@@ -8,8 +8,14 @@ import scipy.signal
 
 import robustctl as rc
 from robustctl.models import morais2022, truck
-from robustctl.path import Curve, LaneChange, ReferencePath, Straight, default_route
-from robustctl.pathfollow import DEFAULT_INITIAL_ERROR, DEFAULT_SETUP, PathFollowing, PathFollowingSetup, simulate
+from robustctl.models.path import Curve, LaneChange, ReferencePath, Straight, default_route
+from robustctl.models.pathfollow import (
+    DEFAULT_INITIAL_ERROR,
+    DEFAULT_SETUP,
+    PathFollowing,
+    PathFollowingSetup,
+    simulate,
+)
 
 AUTHORS = morais2022.SETUPS["authors"]
 

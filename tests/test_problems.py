@@ -259,7 +259,7 @@ def test_generic_bad_population(generic):
 # ------------------------------------------------------------------ applied --
 from moo.problems.applied import AppliedRLQRProblem  # noqa: E402
 from robustctl.models import morais2022, truck  # noqa: E402
-from robustctl.path import default_route  # noqa: E402
+from robustctl.models.path import default_route  # noqa: E402
 
 SHORT_PATH_S = 120.0      # a 2-minute stretch of the default route keeps the plain-loop reference quick
 APPLIED_Z = np.random.default_rng(0).uniform(1e-6, 500.0, (12, 7))   # seed 0: one unstable design

@@ -1,4 +1,4 @@
-"""LMI pole regions (robustctl.regions) and pole placement in the H-infinity synthesis.
+"""LMI pole regions (robustctl.systems.regions) and pole placement in the H-infinity synthesis.
 
 References: the closed-form definitions of each region (|z - c| < r,
 Re z < a, |Im z| < tan(angle) (apex - Re z)), the eigenvalues of the closed
@@ -16,7 +16,7 @@ from test_hinf import MSD_BW, MSD_CZ, MSD_DZU, RTOL, cl_norm, msd, random_case
 
 import robustctl as rc
 from robustctl import ConicSector, Disk, HalfPlane, InfeasibleError, Plant
-from robustctl.regions import as_regions, region_lmi
+from robustctl.systems.regions import as_regions, region_lmi
 
 POINTS = np.array([0.0, 0.5, -0.5, 0.95, 1.2, -3.0, 0.3 + 0.4j, 0.3 - 0.4j, -1 + 2j, -2 + 0.5j, -0.1 + 1j, 4j])
 

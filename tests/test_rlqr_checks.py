@@ -31,7 +31,7 @@ def test_rlqr_refuses_a_gain_that_leaves_the_plant_unstable(case):
         rc.rlqr(plant, EF, EG, mu)
     assert isinstance(e.value, rc.ConvergenceError)
     c = rc.design("rlqr", plant, EF, EG, mu, check_stability=False)
-    rho = max(abs(np.linalg.eigvals(plant.F + plant.G @ c.K)))     # independent of robustctl.stability
+    rho = max(abs(np.linalg.eigvals(plant.F + plant.G @ c.K)))     # independent of robustctl.systems.stability
     assert rho > 1.0 and c.info["stabilizing"] is False
     b = rc.rlqr_gains(plant, EF, EG, [mu])                         # batched: flagged, no raise
     assert b.ok[0] and not b.stabilizing[0]

@@ -37,11 +37,10 @@ import pytest
 from conftest import GENERIC_F, GENERIC_G
 
 import robustctl as rc
-from robustctl._rlqr import _kernel as kernel
-from robustctl._rlqr import _steady as steady
-from robustctl._rlqr._model import build
-from robustctl._rlqr._step import kkt_step
 from robustctl.models.truck import lqr_weights, truck_plant
+from robustctl.synthesis._rlqr import kernel, steady
+from robustctl.synthesis._rlqr.model import build
+from robustctl.synthesis._rlqr.step import kkt_step
 
 TOL = 1e-10
 
@@ -403,7 +402,7 @@ def test_generic_mop_objectives_match_the_numpy_path(monkeypatch):
 # -- compilation --------------------------------------------------------------------------------------
 def _recursion_in_worker():
     """Run rlqr_gains and the compiled recursion in this (spawned) process; report where the kernels came from."""
-    from robustctl._rlqr import _kernel as k
+    from robustctl.synthesis._rlqr import kernel as k
     z = np.array([[50.0, 20.0, 80.0, 1.0, 150.0], [10.0, 10.0, 10.0, 10.0, 4.0]])
     out = rc.rlqr_gains(rc.Plant(GENERIC_F, GENERIC_G, 1.0), z[:, None, :3], z[:, None, 3:4],
                         [np.inf, 10 ** np.sqrt(z[1, 4])], max_iter=50)

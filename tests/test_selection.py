@@ -33,8 +33,8 @@ from moo.problems.selection import (
     select_design,
 )
 from robustctl.models import morais2022, truck
-from robustctl.path import default_route
-from robustctl.pathfollow import simulate
+from robustctl.models.path import default_route
+from robustctl.models.pathfollow import simulate
 
 # the generic plant of the paper's Section 4.4, typed in again (not imported from the problem)
 F_G = np.array([[0.9, 0.8, 0.7], [0.01, 0.1, 0.3], [0.0, 0.25, 0.1]])

@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 
 import robustctl as rc
-from robustctl.batchsim import LinearSimulator, SimulationResult, simulate_linear
 from robustctl.models import truck
-from robustctl.path import Curve, ReferencePath, Straight, default_route
-from robustctl.pathfollow import PathFollowing, simulate
+from robustctl.models.path import Curve, ReferencePath, Straight, default_route
+from robustctl.models.pathfollow import PathFollowing, simulate
+from robustctl.sim.simulator import LinearSimulator, SimulationResult, simulate_linear
 
 Q = np.diag([1 / 0.5**2, 1 / 0.1**2, 1 / 0.25**2, 1 / 0.05**2])
 R = np.array([[1 / 0.1**2]])
@@ -406,7 +406,7 @@ def test_input_map_is_explicit(K_lqr):
 # -- compilation cache ----------------------------------------------------------------------
 def _kernel_stats_in_worker():
     """Run a tiny simulation in this (spawned) process; report where the kernel came from."""
-    from robustctl import _simkernel
+    from robustctl.sim import _kernel as _simkernel
 
     res = simulate_linear(np.array([[-0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.ones((10, 1)), x0=[-1.0])
     stats = _simkernel.closed_loop.stats
@@ -428,8 +428,8 @@ import json, time, warnings, numpy as np
 t0 = time.perf_counter()
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
-    from robustctl import _simkernel
-    from robustctl.batchsim import simulate_linear
+    from robustctl.sim import _kernel as _simkernel
+    from robustctl.sim.simulator import simulate_linear
     res = simulate_linear(np.array([[-0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.ones((10, 1)), x0=[-1.0])
 s = _simkernel.closed_loop.stats
 print(json.dumps(dict(hits=sum(s.cache_hits.values()), misses=sum(s.cache_misses.values()),
@@ -457,7 +457,7 @@ def test_fresh_clone_compiles_once_then_loads_the_cache(fresh_copy):
     env = dict(NUMBA_CACHE_DIR="", PYTHONPATH=str(fresh_copy))
     first = _probe(fresh_copy, **env)
     assert first["cached"] and first["misses"] == 1 and first["hits"] == 0
-    assert list((fresh_copy / "robustctl" / "__pycache__").glob("_simkernel.closed_loop*.nbi"))
+    assert list((fresh_copy / "robustctl" / "sim" / "__pycache__").glob("_kernel.closed_loop*.nbi"))
     second = _probe(fresh_copy, **env)
     assert second["hits"] == 1 and second["misses"] == 0
     np.testing.assert_allclose(first["e"], -(0.5 ** np.arange(10)))
@@ -466,7 +466,7 @@ def test_fresh_clone_compiles_once_then_loads_the_cache(fresh_copy):
 
 @pytest.mark.slow
 def test_unwritable_cache_falls_back_to_compiling_in_place(fresh_copy):
-    (fresh_copy / "robustctl" / "__pycache__").write_text("a file, so no cache directory can be made here")
+    (fresh_copy / "robustctl" / "sim" / "__pycache__").write_text("a file, so no cache directory can be made here")
     nowhere = "/proc/robustctl-no-cache"                              # not creatable, even by root
     res = _probe(fresh_copy, PYTHONPATH=str(fresh_copy), NUMBA_CACHE_DIR=nowhere, XDG_CACHE_HOME=nowhere,
                  HOME=nowhere)

@@ -1,4 +1,4 @@
-"""robustctl.stability: spectral radius, Schur/Hurwitz stability with one margin, PBH stabilisability,
+"""robustctl.systems.stability: spectral radius, Schur/Hurwitz stability with one margin, PBH stabilisability,
 against eigenvalues computed directly and plants built with a known uncontrollable mode."""
 
 import control
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import robustctl as rc
-from robustctl.stability import STABILITY_MARGIN, is_stable, unstabilizable_modes
+from robustctl.systems.stability import STABILITY_MARGIN, check_stabilizable, is_stable, unstabilizable_modes
 
 
 def _rho(A):
@@ -84,7 +84,7 @@ def test_a_boundary_mode_of_a_large_plant_is_found_at_a_tolerance_that_scales_wi
     """An uncontrollable mode exactly on the boundary (1, or 0 in continuous time) of a plant with
     ||F|| ~ 1e6 is computed ~1e-10 away from it (eigenvalues are exact to ~eps ||F||): an absolute
     1e-12 would call it stable; UNSTABLE_TOL * max(1, ||[F G]||) does not, in either time domain."""
-    from robustctl.stability import UNSTABLE_TOL
+    from robustctl.systems.stability import UNSTABLE_TOL
 
     boundary = 1.0 if discrete else 0.0
     rng = np.random.default_rng(1)
@@ -100,14 +100,14 @@ def test_a_boundary_mode_of_a_large_plant_is_found_at_a_tolerance_that_scales_wi
         plant = rc.Plant(F, G, 0.1 if discrete else None)
         np.testing.assert_allclose(plant.unstabilizable_modes, [found])
         with pytest.raises(rc.NotStabilizableError, match=r"plant is not stabilisable: its mode lambda"):
-            rc.stability.check_stabilizable(plant)
+            check_stabilizable(plant)
         reachable = rc.Plant(F, T @ np.ones((3, 1)), plant.dt)     # the same mode, reached by the input
         assert reachable.is_stabilizable
     assert missed >= 3       # the case has teeth (about half the draws fall on the stable side)
 
 
 def test_immovable_modes_at_chosen_eigenvalues():
-    from robustctl.stability import immovable_modes
+    from robustctl.systems.stability import immovable_modes
 
     F, G = np.diag([0.5, 0.2, -0.7]), np.array([[0.0], [1.0], [0.0]])      # 0.5 and -0.7 are not reached
     np.testing.assert_allclose(np.sort(immovable_modes(F, G, lambda z: np.abs(z) > 0.3).real), [-0.7, 0.5])
@@ -131,7 +131,7 @@ def test_every_design_raises_not_stabilizable_error_naming_the_vertex():
 
 
 def test_spectral_abscissa_matches_the_eigenvalues():
-    from robustctl.stability import spectral_abscissa
+    from robustctl.systems.stability import spectral_abscissa
 
     A = np.random.default_rng(2).standard_normal((5, 3, 3))
     np.testing.assert_allclose(spectral_abscissa(A), np.linalg.eigvals(A).real.max(axis=-1), rtol=1e-12)
@@ -143,7 +143,7 @@ def test_spectral_abscissa_matches_the_eigenvalues():
 def test_every_stability_decision_uses_the_one_margin(discrete):
     """A loop inside the margin (rho = 1 - 1e-12, or abscissa -1e-12) is unstable for the controller, the
     LMI syntheses' internal check, the robust analysis and the worst-case search alike."""
-    from robustctl._hinf._synthesis import check_closed_loop
+    from robustctl.synthesis.hinf import check_closed_loop
 
     edge = 1.0 if discrete else 0.0
     plant = rc.Plant([[edge + 1e-12]], [[1.0]], 1.0 if discrete else None)

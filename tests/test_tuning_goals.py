@@ -120,7 +120,7 @@ def test_saturated_peak_settling_vs_loop(plants, gains):
 
 
 def test_one_simulation_per_population(plants, gains, monkeypatch):
-    from robustctl.batchsim import LinearSimulator
+    from robustctl.sim.simulator import LinearSimulator
 
     calls = []
     run = LinearSimulator.run

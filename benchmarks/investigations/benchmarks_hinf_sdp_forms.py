@@ -12,7 +12,7 @@ discrete bounded-real LMI in one cvxpy/Clarabel solve. This asks whether a
 smaller SDP, the one in which the projection (elimination) lemma removes
 ``Y = K X``, solves faster, and up to which size. (The library's level
 minimisation of one plant uses the eliminated form,
-``robustctl._hinf._lmis.projected_blocks``, up to the size where this
+``robustctl.synthesis._hinf.lmis.projected_blocks``, up to the size where this
 measures it faster.) Both forms are posed here, on the same data, written
 out independently of the library:
 

@@ -10,7 +10,7 @@ without editing them. The shared helper modules that define an ``__all__``
 "Internals", since public docstrings refer to them.
 
 Each function or class is documented once, under its shortest public name:
-``robustctl.rlqr_gains`` rather than ``robustctl._rlqr.rlqr_gains``. The
+``robustctl.rlqr_gains`` rather than ``robustctl.synthesis.rlqr.rlqr_gains``. The
 module that defines it lists it too, as a link. Modules that share their name
 with the function the package re-exports (``robustctl.design``,
 ``robustctl.lqr``) show their docstring without registering the module name
@@ -22,7 +22,7 @@ Two event handlers keep the references right:
   documented under (``moo.runner.run``, documented as ``moo.run``) links to
   its page; a docstring's short reference (``:class:`Controller```)
   means the name as seen from the module where the docstring is written. An
-  object documented under its package name (``robustctl.rlqr`` from ``robustctl._rlqr``) is rendered in
+  object documented under its package name (``robustctl.rlqr`` from ``robustctl.synthesis.rlqr``) is rendered in
   the package's context, so a short name that Sphinx cannot find there is
   looked up in the namespace of the object's defining module and linked to
   the page of what it names (ours, or another project's through intersphinx).

@@ -25,8 +25,8 @@ import numpy as np
 
 import robustctl as rc
 from robustctl.models import morais2022, truck
-from robustctl.path import default_route
-from robustctl.pathfollow import simulate
+from robustctl.models.path import default_route
+from robustctl.models.pathfollow import simulate
 
 plant = truck.truck_plant(0.0)    # x = [ydot, psidot, rho, theta], u = alpha
 Q, R = truck.lqr_weights()

@@ -24,7 +24,7 @@ from typing import Literal, cast
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import BACKENDS
+from robustctl.sim.simulator import BACKENDS
 
 from .._validation import check_choice
 from ..tuning.goals import OVER
@@ -57,7 +57,7 @@ class ScenarioErrors(ABC):
     aggregate : {"mean", "max"}
         How the scenarios are combined (case-insensitive).
     backend : {"numba", "numpy"}
-        Simulator of :mod:`robustctl.batchsim`: the compiled kernel or the
+        Simulator of :mod:`robustctl.sim.simulator`: the compiled kernel or the
         numpy reference.
 
     Raises

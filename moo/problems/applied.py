@@ -6,7 +6,7 @@ with the doubled steering column (``G2 = [G G]``, steering ``alpha = u1 + u2``,
 :func:`robustctl.models.truck.truck_plant`), designed on the nominal-payload
 model with ``H = [1, 1, 1, 1]^T`` and ``mu = 10**sqrt(z7)``. The gain then
 drives the truck along a reference path at several payloads
-(:class:`robustctl.pathfollow.PathFollowing`, built once per problem), and the
+(:class:`robustctl.models.pathfollow.PathFollowing`, built once per problem), and the
 four objectives are the mean squared path-following errors
 
 * ``f1``: lateral displacement ``rho`` [m^2],
@@ -33,11 +33,11 @@ from typing import ClassVar, Literal
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import DEFAULT_BOUND
 from robustctl.models import morais2022, truck
 from robustctl.models.morais2022 import get_setup
-from robustctl.path import ReferencePath, default_route
-from robustctl.pathfollow import PathFollowing, PathFollowingSetup
+from robustctl.models.path import ReferencePath, default_route
+from robustctl.models.pathfollow import PathFollowing, PathFollowingSetup
+from robustctl.sim.simulator import DEFAULT_BOUND
 from robustctl.validation import check_positive_scalar
 
 from ..tuning import RLQRFamily, TuningProblem
@@ -54,7 +54,7 @@ Z_UPPER = 500.0
 class PathFollowingErrors(ScenarioErrors):
     """The path-following MSEs of gains on the payload scenarios (:class:`AppliedRLQRProblem`).
 
-    ``sim`` is the problem's :class:`robustctl.pathfollow.PathFollowing`;
+    ``sim`` is the problem's :class:`robustctl.models.pathfollow.PathFollowing`;
     calling with gains ``K`` (B, 2, 4) returns the MSEs (B, 4) combined over the
     scenarios (``mean`` or ``max``); the last population's result is
     memoised, so the four goals :class:`PathFollowingError` of one population
@@ -64,7 +64,7 @@ class PathFollowingErrors(ScenarioErrors):
 
     Parameters
     ----------
-    sim : robustctl.pathfollow.PathFollowing
+    sim : robustctl.models.pathfollow.PathFollowing
     plants : list of robustctl.Plant
         The payload scenarios ``sim`` simulates.
     aggregate : {"mean", "max"}
@@ -104,7 +104,7 @@ class AppliedRLQRProblem(TuningProblem):
        doubled-column truck at the nominal payload, ``H = ones((4, 1))``,
        weights ``Q``, ``R``; the whole population is designed in one batched call;
     3. the closed loop is simulated, for all designs and payload scenarios in
-       one compiled run (:class:`robustctl.pathfollow.PathFollowing`): true truck at
+       one compiled run (:class:`robustctl.models.pathfollow.PathFollowing`): true truck at
        each overload, steering ``alpha = sat_0.45(u1 + u2 [+ alpha_ff])``, with
        the reference, loop and initial state of the ``setup``: ``"ours"`` (the
        default) tracks the nominal model's steady cornering with its steering
@@ -128,7 +128,7 @@ class AppliedRLQRProblem(TuningProblem):
 
     Parameters
     ----------
-    setup : str or robustctl.pathfollow.PathFollowingSetup
+    setup : str or robustctl.models.pathfollow.PathFollowingSetup
         ``"ours"`` (default) or ``"authors"``: reference, loop, initial state,
         the default weights and reference points
         (:data:`robustctl.models.morais2022.SETUPS`; a set-up of another name gets
@@ -162,7 +162,7 @@ class AppliedRLQRProblem(TuningProblem):
         and cheaper than the plain recursion on ill-conditioned designs,
         ``benchmarks/bench_rlqr.py``), or the plain recursion.
     path : ReferencePath, optional
-        Reference path (default :func:`robustctl.path.default_route`, 540 s).
+        Reference path (default :func:`robustctl.models.path.default_route`, 540 s).
     overloads : sequence of float
         Payload overloads of the scenarios in percent (>= 0, 0 = nominal payload,
         100 = twice the payload). Default ``(0, 100)``: the nominal payload and
@@ -175,12 +175,12 @@ class AppliedRLQRProblem(TuningProblem):
     hv_ref_point, molsp_ref_point : (4,) array_like, optional
         Override the reference points.
     backend : {"numba", "numpy"}
-        Simulator (:mod:`robustctl.batchsim`): the compiled kernel (default)
+        Simulator (:mod:`robustctl.sim.simulator`): the compiled kernel (default)
         or the numpy reference.
 
     Attributes
     ----------
-    setup : robustctl.pathfollow.PathFollowingSetup
+    setup : robustctl.models.pathfollow.PathFollowingSetup
     hv_ref_point : (4,) ndarray
         ``"ours"``: hypervolume reference point ``[0.0625, 1.5625e-4, 0.0225, 1e-4]``, the
         squares of the RMS errors ``[0.25 m, 0.0125 rad/s, 0.15 m/s, 0.01 rad]``.

@@ -19,7 +19,7 @@ The problem is a :class:`moo.tuning.TuningProblem`: the family is
 :class:`moo.tuning.RLQRFamily` on the nominal plant, the scenarios are the
 true plants at the realisations ``delta_s``, and the three objectives are
 goals (:class:`RegulationError`) that share one batched simulation
-(:class:`robustctl.batchsim.LinearSimulator`, compiled kernel by default) per
+(:class:`robustctl.sim.simulator.LinearSimulator`, compiled kernel by default) per
 population.
 
 References
@@ -38,7 +38,7 @@ from typing import Literal
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import LinearSimulator
+from robustctl.sim.simulator import LinearSimulator
 
 from .._validation import as_matrix, check_int
 from ..tuning import RLQRFamily, TuningProblem
@@ -190,7 +190,7 @@ class GenericRLQRProblem(TuningProblem):
     hv_ref_point, molsp_ref_point : (3,) array_like, optional
         Override the reference points (see below).
     backend : {"numba", "numpy"}
-        Simulator of the regulation runs (:mod:`robustctl.batchsim`): the
+        Simulator of the regulation runs (:mod:`robustctl.sim.simulator`): the
         compiled kernel (default) or the numpy reference. One run per
         scenario and initial state, ``horizon + 1`` samples, zero reference.
 

@@ -64,11 +64,11 @@ from dataclasses import dataclass
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import check_gains
 from robustctl.models import morais2022, truck
 from robustctl.models.morais2022 import get_setup
-from robustctl.path import ReferencePath, default_route
-from robustctl.pathfollow import PathFollowing, PathFollowingSetup
+from robustctl.models.path import ReferencePath, default_route
+from robustctl.models.pathfollow import PathFollowing, PathFollowingSetup
+from robustctl.sim.simulator import check_gains
 
 from .._validation import as_matrix, check_int
 from ..tuning import TuningProblem
@@ -219,7 +219,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None,
 
     Each ``Delta_s`` is a payload overload ``150 (1 + Delta_s)`` % held over the
     run (:func:`overload_from_delta`); every design drives the true truck at
-    that payload along ``path`` (:class:`robustctl.pathfollow.PathFollowing`
+    that payload along ``path`` (:class:`robustctl.models.pathfollow.PathFollowing`
     in the ``setup``'s loop, 0.45 rad steering limit; ``"ours"``: nominal
     steady-cornering reference and feedforward, 1 m initial offset;
     ``"authors"``: the authors' regulation loop), and
@@ -240,7 +240,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None,
     m, 1 rad/s, 1 m/s, 0.1 rad]``. ``E = T * sum_i f_i / sigma_i^2``
     with ``f_i`` the MOP's per-scenario MSEs. A gain with non-finite entries
     gets ``+inf``; a run that diverges is frozen by the simulator at its bound
-    (a huge finite error, see :mod:`robustctl.batchsim`).
+    (a huge finite error, see :mod:`robustctl.sim.simulator`).
 
     Parameters
     ----------
@@ -249,7 +249,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None,
     deltas : (S,) array_like
         Realisations in ``[-1, 1]``.
     path : ReferencePath, optional
-        Default :func:`robustctl.path.default_route` (540 s); a shorter one
+        Default :func:`robustctl.models.path.default_route` (540 s); a shorter one
         (``ReferencePath.truncated``) makes the selection cheaper.
     scales : (4,) array_like, optional
         ``sigma``; e.g. ``np.sqrt(AppliedRLQRProblem().hv_ref_point)`` weights
@@ -270,7 +270,7 @@ def applied_errors(K, deltas, *, path: ReferencePath | None = None, scales=None,
     if path is None:
         path = default_route()
     elif not isinstance(path, ReferencePath):
-        raise TypeError(f"path must be a robustctl.path.ReferencePath, got {type(path).__name__}")
+        raise TypeError(f"path must be a robustctl.models.path.ReferencePath, got {type(path).__name__}")
     steering = np.ones((1, Kb.shape[1]))                   # alpha = u1 (+ u2 on the doubled column)
     E = np.empty((Kb.shape[0], overloads.size))
     for start in range(0, overloads.size, _SCENARIO_CHUNK):

@@ -22,7 +22,7 @@ matrices, one compiled simulation), each reducing the scenarios with
 Time domain (one simulation per population, shared; :class:`Response`):
 from ``x[0] = x0`` the loop ``u[k] = sat(K (x[k] - r[k]))``,
 ``x[k+1] = F x[k] + G u[k]`` runs ``T = steps`` samples on every scenario
-(:class:`robustctl.batchsim.LinearSimulator`, the compiled kernel), with the
+(:class:`robustctl.sim.simulator.LinearSimulator`, the compiled kernel), with the
 error ``e = x - r`` (``r = 0`` without a reference):
 
 ========================  ================================================  ==========
@@ -79,8 +79,8 @@ from typing import Any, Literal, cast
 import numpy as np
 
 import robustctl as rc
-from robustctl.batchsim import BACKENDS, DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
-from robustctl.regions import Region, as_regions
+from robustctl.sim.simulator import BACKENDS, DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
+from robustctl.systems.regions import Region, as_regions
 from robustctl.validation import (
     as_float_array,
     as_matrix,
@@ -209,7 +209,7 @@ class Response:
 
     From ``x[0] = x0`` every design runs ``u[k] = sat(K (x[k] - r[k]))``,
     ``x[k+1] = F x[k] + G u[k]`` for ``steps`` samples on every scenario in
-    one batched simulation (:class:`robustctl.batchsim.LinearSimulator`). The
+    one batched simulation (:class:`robustctl.sim.simulator.LinearSimulator`). The
     goals of :meth:`error`, :meth:`peak_input` and :meth:`settling_time` read
     that one simulation: it is kept for the last ``(K, plants)`` (same plants
     objects, equal gains), so several goals of one population cost one run.
@@ -227,10 +227,10 @@ class Response:
     u_limit : float or (m,) array_like, optional
         Saturation ``|u_j| <= u_limit_j``; default none.
     backend : {"numba", "numpy"}
-        The compiled kernel or the numpy reference (:mod:`robustctl.batchsim`).
+        The compiled kernel or the numpy reference (:mod:`robustctl.sim.simulator`).
     bound : float
         Divergence bound on ``|x - r|`` (a run beyond it is frozen there; see
-        :mod:`robustctl.batchsim`), so a saturated loop that drifts away gets
+        :mod:`robustctl.sim.simulator`), so a saturated loop that drifts away gets
         a large finite error.
     """
 

@@ -54,7 +54,7 @@ Norm-bounded robust stability without an SDP
 The margin is the small-gain value ``1 / ||E (zI - A)^-1 H||_inf``,
 computed by a level-set H-infinity norm (Bruinsma & Steinbuch 1990;
 imaginary-axis eigenvalues of a Hamiltonian, the discrete case through a
-bilinear transform; :mod:`robustctl._hinfnorm`) to ``2e-10`` relative, on
+bilinear transform; :mod:`robustctl.analysis._hinfnorm`) to ``2e-10`` relative, on
 the whole stack of gains at once. One gain per call uses SLICOT's AB13DD
 (the same algorithm with a structure-preserving Hamiltonian eigensolver,
 through slycot) when slycot is installed, the level-set iteration without
@@ -119,11 +119,12 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 
 from __future__ import annotations
 
-from .._margins_report import MarginsReport, margins_report  # noqa: F401 (re-exported: the margins report)
-from ._cost import guaranteed_cost, robust_hinf_bound
-from ._results import CostBound, CostBoundBatch, HinfBound, RobustStability, RobustStabilityBatch, WorstCase
-from ._stability import robust_stability
-from ._worst import worst_case
+from .cost import guaranteed_cost, robust_hinf_bound
+from .margins_report import MarginsReport, margins_report
+from .results import CostBound, CostBoundBatch, HinfBound, RobustStability, RobustStabilityBatch, WorstCase
+from .robust_stability import robust_stability
+from .worst_case import worst_case
 
-__all__ = ["RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase",
-           "robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case"]
+__all__ = ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case", "margins_report",
+           "RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase",
+           "MarginsReport"]

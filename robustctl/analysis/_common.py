@@ -12,10 +12,10 @@ import scipy.linalg
 
 from .. import _cvx
 from .._validation import as_float_array, as_matrix
-from ..controller import Controller
 from ..errors import ConvergenceError
-from ..plant import Plant
-from ..stability import spectral_abscissa, spectral_radius
+from ..systems.controller import Controller
+from ..systems.plant import Plant
+from ..systems.stability import spectral_abscissa, spectral_radius
 
 # Regularisation (relative to the weight's norm) of the Lyapunov equation defining the coordinates.
 _REG = 1e-3

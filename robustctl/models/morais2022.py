@@ -1,8 +1,8 @@
 """The data and set-ups of Morais et al. (2022) and of the authors' public code, Barbosa et al. (2019).
 
 Everything specific to the paper lives here; the general library (the truck
-model :mod:`robustctl.models.truck`, the paths :mod:`robustctl.path`, the
-path-following simulator :mod:`robustctl.pathfollow` and the designs) names
+model :mod:`robustctl.models.truck`, the paths :mod:`robustctl.models.path`, the
+path-following simulator :mod:`robustctl.models.pathfollow` and the designs) names
 none of it and does not import this module. The truck MOP
 (:mod:`moo.problems.applied`, :mod:`moo.problems.selection`) and the
 ``paper_repro`` scripts do.
@@ -37,11 +37,11 @@ game-Riccati level of its H-infinity law (:data:`CODE_GAMMA`,
 Set-ups
 -------
 The paper states neither its reference, its initial state nor its weights.
-:data:`SETUPS` holds the two :class:`~robustctl.pathfollow.PathFollowingSetup`
+:data:`SETUPS` holds the two :class:`~robustctl.models.pathfollow.PathFollowingSetup`
 of the reproduction (:func:`get_setup` by name):
 
 ``"ours"`` (the engineering set-up)
-    The simulator's default, :data:`robustctl.pathfollow.DEFAULT_SETUP`:
+    The simulator's default, :data:`robustctl.models.pathfollow.DEFAULT_SETUP`:
     ``x_ref`` and ``alpha_ff`` are the nominal model's steady cornering along
     the path (:func:`robustctl.models.truck.reference_states`; ``x_ref =
     [beta_1 v, v, 0, -beta_1] kappa``), with the steady-state steering as
@@ -86,11 +86,10 @@ import dataclasses
 
 import numpy as np
 
-from .._validation import as_batch, check_choice
-from ..path import LaneChange, ReferencePath, Straight
-from ..pathfollow import DEFAULT_SETUP, PathFollowingSetup
-from ..plant import _frozen
+from .._validation import as_batch, check_choice, frozen
 from . import truck
+from .path import LaneChange, ReferencePath, Straight
+from .pathfollow import DEFAULT_SETUP, PathFollowingSetup
 
 __all__ = [
     "RLQR_MOP_Z", "PRINTED_EF", "PRINTED_EG", "PRINTED_LOG10_MU_SQ", "algebraic_uncertainty",
@@ -125,8 +124,8 @@ def algebraic_uncertainty(source: str = "printed", *, params: truck.TruckParamet
     mu = 10.0 ** np.sqrt(PRINTED_LOG10_MU_SQ)
     if source == "computed":
         return truck.algebraic_uncertainty(mu=mu, params=params)
-    return truck.AlgebraicUncertainty(_frozen(np.ones((4, 1))), _frozen(np.array([PRINTED_EF])),
-                                      _frozen(np.array([PRINTED_EG])), float(mu), "printed")
+    return truck.AlgebraicUncertainty(frozen(np.ones((4, 1))), frozen(np.array([PRINTED_EF])),
+                                      frozen(np.array([PRINTED_EG])), float(mu), "printed")
 
 
 def uncertainty_from_z(z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -246,7 +245,7 @@ def code_manoeuvre(*, params: truck.TruckParameters | None = None) -> ReferenceP
     and its negative from ``t = 20 s`` (back). This is the path whose
     steady-cornering steering (``alpha_per_kappa kappa``,
     :func:`robustctl.models.truck.steady_state_cornering`, nominal payload)
-    is that command: straights and two :class:`~robustctl.path.LaneChange`
+    is that command: straights and two :class:`~robustctl.models.path.LaneChange`
     elements of ``5 v`` metres and offset ``0.01 L^2 / (2 pi alpha_per_kappa)``
     (``L = 5 v``), so the ``"open_loop"`` reference of the ``"authors"``
     set-up (:data:`SETUPS`) along it is the code's ``x_ref`` (at our 0.1 s
@@ -273,7 +272,7 @@ SETUPS = {
 
 
 def get_setup(setup: str | PathFollowingSetup) -> PathFollowingSetup:
-    """A :class:`~robustctl.pathfollow.PathFollowingSetup` by name (a key of :data:`SETUPS`), or ``setup`` itself."""
+    """A :class:`~robustctl.models.pathfollow.PathFollowingSetup` by name (a key of :data:`SETUPS`), or ``setup``."""
     if isinstance(setup, PathFollowingSetup):
         return setup
     if not isinstance(setup, str):

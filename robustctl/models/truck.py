@@ -58,8 +58,8 @@ from dataclasses import dataclass, fields
 import numpy as np
 import scipy.linalg
 
-from .._validation import as_batch, check_positive_scalar
-from ..plant import Plant, _frozen
+from .._validation import as_batch, check_positive_scalar, frozen
+from ..systems.plant import Plant
 
 __all__ = [
     "TruckParameters", "PAPER_PARAMETERS", "STATE_NAMES", "STATE_UNITS", "OBJECTIVE_STATES",
@@ -76,7 +76,7 @@ OBJECTIVE_STATES = (2, 1, 0, 3)
 #: Steering saturation used in the paper's simulations [rad].
 STEER_LIMIT = 0.45
 #: Input map of the doubled steering column: the steering angle is ``alpha = u1 + u2``
-#: (``input_map`` of :func:`robustctl.pathfollow.simulate`).
+#: (``input_map`` of :func:`robustctl.models.pathfollow.simulate`).
 DOUBLED_INPUT_MAP = ((1.0, 1.0),)
 
 @dataclass(frozen=True)
@@ -342,7 +342,7 @@ def open_loop_reference(kappa, overload: float = 0.0, *, params: TruckParameters
     (there: two 5 s sine steering lane changes on a straight road). Here the
     command is the steady-cornering steering of the path's curvature,
     ``u_ref[k] = alpha_per_kappa kappa[k]`` (:func:`steady_state_cornering`),
-    so lane changes and bends of any :class:`robustctl.path.ReferencePath`
+    so lane changes and bends of any :class:`robustctl.models.path.ReferencePath`
     give the command::
 
         x_ref[0] = 0,   x_ref[k+1] = F x_ref[k] + G u_ref[k] + Gk kappa[k]
@@ -444,7 +444,7 @@ def algebraic_uncertainty(*, mu: float = 1e9, params: TruckParameters | None = N
     gG = G[0] - G[1]
     EF = (np.array([1.0, 1.0, 1.0, 0.1]) * gF[0])[None, :]
     EG = (np.array([0.1, 0.1]) * gG[0, 0])[None, :]
-    return AlgebraicUncertainty(_frozen(np.ones((4, 1))), _frozen(EF), _frozen(EG), float(mu), "computed")
+    return AlgebraicUncertainty(frozen(np.ones((4, 1))), frozen(EF), frozen(EG), float(mu), "computed")
 
 
 #: Acceptable errors of Bryson's rule: ydot 0.5 m/s, psidot 0.1 rad/s (5.7 deg/s),

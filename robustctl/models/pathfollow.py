@@ -1,0 +1,500 @@
+"""Truck path following (Morais et al. 2022, Section 4.5): the paper's closed-loop runs on the batched simulator.
+
+The true plant is the truck (:mod:`robustctl.models.truck`) at each
+scenario's payload overload; the controller knows only the nominal model.
+Along a :class:`robustctl.models.path.ReferencePath`::
+
+    e[k]     = x[k] - x_ref[k]
+    alpha[k] = sat_{steer_limit}( M K e[k] + alpha_ff[k] )
+    x[k+1]   = F x[k] + G alpha[k] + Gk kappa[k]
+
+with ``F, G, Gk`` the ZOH model of the true vehicle
+(:func:`robustctl.models.truck.discretise`), ``kappa`` the path curvature and
+``M`` the map from the controller's inputs to the steering angle (``[[1]]``
+for a plain gain, ``[[1, 1]]`` for the doubled steering column
+``alpha = u1 + u2`` of the applied RLQR designs,
+:data:`robustctl.models.truck.DOUBLED_INPUT_MAP`).
+
+Set-ups
+-------
+A :class:`PathFollowingSetup` fixes the reference, the loop and the
+initial state, together with the design weights ``Q``, ``R`` that the
+controllers of a study share. The default, :data:`DEFAULT_SETUP` (the
+engineering set-up): ``x_ref`` and ``alpha_ff`` are the nominal model's
+steady cornering along the path
+(:func:`robustctl.models.truck.reference_states`; ``x_ref = [beta_1 v, v, 0,
+-beta_1] kappa``), with the steady-state steering as feedforward: the
+nominal plant follows a constant-curvature path with zero error, and errors
+come from transients, the initial offset and the payload mismatch; every
+state is a *tracking* error. Bryson's weights
+(:func:`robustctl.models.truck.lqr_weights`) and a 1 m initial offset.
+The other reference, ``"open_loop"``, follows the nominal truck driven open
+loop by the path's steady-cornering steering
+(:func:`robustctl.models.truck.open_loop_reference`) and regulates the
+lateral velocity and the yaw rate to zero. The set-ups of the paper and of
+its authors' code are in :mod:`robustctl.models.morais2022`.
+
+:class:`PathFollowing` discretises the scenarios and builds the reference
+once (an optimiser's problem keeps one); :func:`simulate` is the one-call form.
+The simulation itself, the divergence rule and the backends are those of
+:mod:`robustctl.sim.simulator`. A law that also feeds back the previous steering
+angle (``K_input``, e.g. :mod:`robustctl.synthesis.hinf_game`'s delayed
+full-information law) runs on the plant augmented by that angle as a state.
+
+References
+----------
+Morais et al. (2022), Section 4.5.2 (the four objectives f1..f4 and the
+payload cases). K. J. Astrom & R. M. Murray, *Feedback Systems*, 2nd ed.,
+Princeton 2021, Sec. 8.5 (feedforward plus feedback on the tracking error).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from dataclasses import fields as dataclass_fields
+from typing import Any, Literal
+
+import numpy as np
+
+from .._validation import as_batch, as_float_array, check_bool, check_choice, check_positive_scalar
+from ..sim.simulator import DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
+from ..systems.input_memory import InputMemoryFeedback
+from . import truck as _truck
+from .path import ReferencePath
+
+__all__ = ["PathFollowing", "PathFollowingResult", "PathFollowingSetup", "DEFAULT_SETUP", "simulate",
+           "DEFAULT_INITIAL_ERROR"]
+
+#: Initial path-following error of the default set-up: the truck starts 1 m to the
+#: left of the path, parallel to it, at steady speed ([ydot, psidot, rho, theta]).
+DEFAULT_INITIAL_ERROR = (0.0, 0.0, 1.0, 0.0)
+
+
+@dataclass(frozen=True)
+class PathFollowingSetup:
+    """How a path-following study is posed: reference, loop, initial state and design weights.
+
+    Attributes
+    ----------
+    name : str
+    reference : {"steady", "open_loop"}
+        ``"steady"``: ``x_ref`` is the nominal model's steady cornering along
+        the path, every state tracked
+        (:func:`robustctl.models.truck.reference_states`). ``"open_loop"``:
+        ``x_ref = [0, 0, rho_ol, theta_ol]`` from the nominal truck driven open
+        loop by the path's steady-cornering steering
+        (:func:`robustctl.models.truck.open_loop_reference`); the lateral
+        velocity and the yaw rate are regulated to zero.
+    feedforward : bool
+        Add the steady-cornering steering ``alpha_per_kappa kappa`` (the
+        reference's steering command) to the feedback.
+    x0 : tuple of 4 floats
+        Initial error ``x[0] - x_ref[0]`` (``x_ref[0] = 0`` at the start of a
+        straight).
+    Q_diag : tuple of 4 floats
+        State weight ``Q = diag(Q_diag)`` of every design of the study.
+    r : float
+        Steering weight on the plain truck; the doubled steering column uses
+        ``R = 2 r I2`` (the cheapest split of a steering angle costs the same,
+        see :func:`robustctl.models.truck.lqr_weights`).
+    source : str
+        Where the choices come from.
+    """
+
+    name: str
+    reference: Literal["steady", "open_loop"]
+    feedforward: bool
+    x0: tuple[float, float, float, float]
+    Q_diag: tuple[float, float, float, float]
+    r: float
+    source: str = ""
+
+    def __post_init__(self):
+        check_choice(self.reference, "reference", ("steady", "open_loop"))
+        check_bool(self.feedforward, "feedforward")
+        as_batch(self.x0, "x0", (4,))
+        if np.any(as_batch(self.Q_diag, "Q_diag", (4,)) < 0):
+            raise ValueError(f"Q_diag must be >= 0, got {self.Q_diag}")
+        check_positive_scalar(self.r, "r")
+
+    def weights(self, *, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """``Q`` (4, 4) and ``R``: ``[[r]]``, or ``2 r I2`` on the doubled steering column."""
+        Q = np.diag(np.asarray(self.Q_diag, dtype=float))
+        return Q, (2.0 * self.r * np.eye(2) if doubled else np.array([[float(self.r)]]))
+
+
+_Q_DEFAULT, _R_DEFAULT = _truck.lqr_weights()
+#: The default set-up (module docstring): steady-cornering tracking with feedforward,
+#: Bryson's weights, a 1 m initial offset.
+DEFAULT_SETUP = PathFollowingSetup(
+    "engineering", "steady", True, DEFAULT_INITIAL_ERROR, tuple(np.diag(_Q_DEFAULT).tolist()),
+    float(_R_DEFAULT[0, 0]),
+    "steady-cornering tracking with feedforward, Bryson's weights (robustctl.models.truck.lqr_weights), "
+    "1 m initial offset")
+
+
+def _check_setup(setup) -> PathFollowingSetup:
+    if not isinstance(setup, PathFollowingSetup):
+        raise TypeError(f"setup must be a PathFollowingSetup (the paper's set-ups by name: "
+                        f"robustctl.models.morais2022.get_setup), got {type(setup).__name__}")
+    return setup
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class PathFollowingResult(SimulationResult):
+    """A :class:`~robustctl.sim.simulator.SimulationResult` of the truck, with its path.
+
+    :meth:`mse` reports the paper's ``[f1, f2, f3, f4]`` = MSE of the
+    ``[rho, psidot, ydot, theta]`` errors (lateral displacement [m^2], yaw rate
+    [(rad/s)^2], lateral velocity [(m/s)^2], orientation [rad^2];
+    :attr:`objective_names`), while ``errors`` and :meth:`state_mse` keep
+    the model's state order ``[ydot, psidot, rho, theta]``
+    (:data:`robustctl.models.truck.STATE_NAMES`). ``mse("zero")`` is the
+    *regulation* error (MSE of the states themselves); for the truck it
+    differs from the tracking error only in ``ydot``, ``psidot`` and ``theta``
+    (``rho_ref = 0``): in a bend the yaw rate must be ``v kappa``, so its
+    regulation error measures the path as much as the controller.
+
+    Attributes
+    ----------
+    path : ReferencePath
+    overloads : tuple
+        Scenario overloads in percent (floats, or (T,) arrays when time-varying).
+    """
+
+    path: ReferencePath | None = None
+    overloads: tuple | None = None
+
+    def _path(self) -> ReferencePath:
+        if self.path is None:
+            raise ValueError("this result has no path (path=None): the poses need the reference path")
+        return self.path
+
+    def reference_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global position ``(X, Y)`` of the reference, each (T,) or (S, T).
+
+        The path displaced by ``rho_ref`` along its left normal (the path itself for the ``"steady"`` reference).
+        """
+        path = self._path()
+        h = path.heading[: self.T]
+        rho = self.x_ref[..., 2]
+        return path.X[: self.T] - rho * np.sin(h), path.Y[: self.T] + rho * np.cos(h)
+
+    @property
+    def steering(self) -> np.ndarray:
+        """Applied steering angle, shape (B, S, T)."""
+        self._need_trajectories()
+        assert self.inputs is not None                 # kept with the errors
+        return self.inputs[..., 0]
+
+    def pose(self, method: Literal["path", "integrated"] = "path") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Global position and heading of the vehicle, each of shape (B, S, T).
+
+        ``method="path"`` (default): the path point at ``s = v t`` displaced by
+        ``rho`` along the path's left normal, with heading ``path heading + theta``:
+        ``X = X_p - rho sin(h_p)``, ``Y = Y_p + rho cos(h_p)``, ``heading = h_p + theta``.
+        This is the model's own frame (its ``rho, theta`` are defined relative
+        to the path point reached at speed ``v``), so the drawn track is
+        exactly the simulated one, with no drift.
+
+        ``method="integrated"``: dead reckoning from the simulated body
+        velocities, ``psi' = psidot``, ``X' = v cos(psi) - ydot sin(psi)``,
+        ``Y' = v sin(psi) + ydot cos(psi)`` (trapezoidal rule), from the start
+        pose of the ``"path"`` method. It differs from ``"path"`` by the
+        linearisation of the model (second order in ``theta`` and
+        ``kappa rho``), which accumulates along the route.
+        """
+        check_choice(method, "method", ("path", "integrated"))
+        self._need_trajectories()
+        x = self.states
+        rho, theta = x[..., 2], x[..., 3]
+        path = self._path()
+        h = path.heading[: self.T]
+        X0 = path.X[0] - rho[..., 0] * np.sin(h[0])
+        Y0 = path.Y[0] + rho[..., 0] * np.cos(h[0])
+        if method == "path":
+            return (path.X[: self.T] - rho * np.sin(h), path.Y[: self.T] + rho * np.cos(h),
+                    h + theta)
+        dt, v = path.dt, path.speed
+
+        def integrate(rate, start):
+            steps = 0.5 * (rate[..., 1:] + rate[..., :-1]) * dt
+            return np.concatenate([start[..., None], start[..., None] + np.cumsum(steps, axis=-1)], axis=-1)
+
+        psi = integrate(x[..., 1], h[0] + theta[..., 0])
+        ydot = x[..., 0]
+        X = integrate(v * np.cos(psi) - ydot * np.sin(psi), X0)
+        Y = integrate(v * np.sin(psi) + ydot * np.cos(psi), Y0)
+        return X, Y, psi
+
+
+def _scenarios(overloads, T: int) -> tuple:
+    """Normalise ``overloads`` to a tuple of floats / (T,) arrays."""
+    if isinstance(overloads, (str, bytes)) or overloads is None:
+        raise TypeError(f"overloads must be a number or a sequence of numbers / (T,) arrays, "
+                        f"got {type(overloads).__name__}")
+    if np.ndim(overloads) == 0:
+        return (float(_truck.check_overload(overloads, "overloads")),)
+    items = list(overloads)
+    if not items:
+        raise ValueError("overloads must not be empty")
+    out: list[float | np.ndarray] = []
+    for i, ov in enumerate(items):
+        if np.ndim(ov) == 0:
+            out.append(float(_truck.check_overload(ov, f"overloads[{i}]")))
+        else:
+            a = np.asarray(_truck.check_overload(ov, f"overloads[{i}]"), dtype=float)
+            if a.shape != (T,):
+                raise ValueError(f"overloads[{i}] is time-varying and must have shape ({T},) "
+                                 f"(the path's samples), got {a.shape}")
+            out.append(a)
+    return tuple(out)
+
+
+class PathFollowing:
+    """The truck along ``path`` at S payload scenarios, ready to simulate gains (checked once).
+
+    Parameters
+    ----------
+    path : ReferencePath
+        Speed and ``dt`` must equal the model's ``params.v`` and ``params.dt``.
+    overloads : float, or sequence of S floats / (T,) arrays
+        Payload overload of each scenario in percent (>= 0); an array gives a
+        time-varying payload (e.g. unloading at a stop), sample by sample.
+    setup : PathFollowingSetup
+        Reference, loop and initial state (module docstring; default :data:`DEFAULT_SETUP`).
+    params : TruckParameters, optional
+    nominal_overload : float
+        Overload of the model the reference and feedforward are computed on.
+    steer_limit : float or None
+        Steering saturation [rad] (0.45 in the paper); None for none.
+    feedforward : bool, optional
+        Add the reference's steering command (default: the set-up's).
+    x0 : (4,) or (S, 4) array_like, optional
+        Initial error ``x[0] - x_ref[0]`` (default: the set-up's).
+    bound : float
+        Divergence bound (see :mod:`robustctl.sim.simulator`).
+    input_map : (1, m) array_like, optional
+        How the controller's m inputs make the steering angle: ``[[1]]`` (the
+        default, for gains of one row) or e.g. ``[[1, 1]]`` for the doubled
+        steering column (:data:`robustctl.models.truck.DOUBLED_INPUT_MAP`).
+        Gains of several rows need it: without it they are summed, with a
+        ``DeprecationWarning`` (the earlier, implicit behaviour).
+    """
+
+    def __init__(self, path: ReferencePath, overloads=0.0, *, setup: PathFollowingSetup = DEFAULT_SETUP,
+                 params: _truck.TruckParameters | None = None, nominal_overload: float = 0.0,
+                 steer_limit: float | None = _truck.STEER_LIMIT, feedforward: bool | None = None, x0=None,
+                 bound: float = DEFAULT_BOUND, input_map=None):
+        p = _truck._params(params)
+        self.setup = _check_setup(setup)
+        if not isinstance(path, ReferencePath):
+            raise TypeError(f"path must be a robustctl.models.path.ReferencePath, got {type(path).__name__}")
+        if abs(path.speed - p.v) > 1e-9 * p.v or abs(path.dt - p.dt) > 1e-12:
+            raise ValueError(f"path speed/dt ({path.speed:g} m/s, {path.dt:g} s) must equal the model's "
+                             f"({p.v:g} m/s, {p.dt:g} s)")
+        T = path.T
+        scen = _scenarios(overloads, T)
+        values = np.unique(np.concatenate([np.atleast_1d(s) for s in scen]))   # discretise each once
+        Fu, Gu, Gku = _truck.discretise(values, params=p)
+        if all(np.ndim(s) == 0 for s in scen):
+            idx = np.searchsorted(values, np.array(scen))
+            F, G = Fu[idx], Gu[idx]                                             # (S, 4, 4), (S, 4, 1)
+            w = Gku[idx][:, None, :] * path.kappa[None, :, None]               # (S, T, 4)
+        else:
+            idx = np.stack([np.searchsorted(values, np.broadcast_to(s, (T,))) for s in scen])  # (S, T)
+            F, G = Fu[idx], Gu[idx]                                             # (S, T, 4, 4) ...
+            w = Gku[idx] * path.kappa[None, :, None]
+        if self.setup.reference == "steady":
+            x_ref, a_ff = _truck.reference_states(path.kappa, nominal_overload, params=p)
+        else:
+            x_ref, a_ff = _truck.open_loop_reference(path.kappa, nominal_overload, params=p)
+            x_ref[:, :2] = 0.0                        # lateral velocity and yaw rate regulated to zero
+        feedforward = self.setup.feedforward if feedforward is None else check_bool(feedforward, "feedforward")
+        u_ff = a_ff if feedforward else np.zeros_like(a_ff)
+        x0 = self.setup.x0 if x0 is None else x0
+        self._given_map = input_map is not None
+        self._linear = LinearSimulator(
+            F, G, x_ref, u_ff=u_ff[:, None], w=w, x0=x0, u_limit=steer_limit, input_map=input_map, bound=bound,
+            objectives=_truck.OBJECTIVE_STATES, state_names=_truck.STATE_NAMES, dt=p.dt)
+        self._memory: LinearSimulator | None = None    # the plant augmented by the previous steering angle
+        self._memory_args = dict(F=F, G=G, x_ref=x_ref, u_ff=u_ff, w=w, x0=np.asarray(x0, dtype=float),
+                                 steer_limit=steer_limit, bound=bound, dt=p.dt)
+        self.path = path
+        self.overloads = scen
+
+    @property
+    def S(self) -> int:
+        """Number of payload scenarios."""
+        return self._linear.S
+
+    @property
+    def T(self) -> int:
+        """Number of samples along the path."""
+        return self._linear.T
+
+    def _memory_simulator(self) -> LinearSimulator:
+        """``[x; alpha_prev]``: ``F_a = [[F, 0], [0, 0]]``, ``G_a = [G; 1]`` (built on first use)."""
+        if self._memory is None:
+            a = self._memory_args
+            F, G = a["F"], a["G"]
+            Fa = np.zeros((*F.shape[:-2], 5, 5))
+            Fa[..., :4, :4] = F
+            Ga = np.concatenate([G, np.ones((*G.shape[:-2], 1, 1))], axis=-2)
+
+            def pad(v):                              # the memory state's entry: zero reference, disturbance, start
+                return np.concatenate([v, np.zeros((*v.shape[:-1], 1))], axis=-1)
+
+            self._memory = LinearSimulator(
+                Fa, Ga, pad(a["x_ref"]), u_ff=a["u_ff"][:, None], w=pad(a["w"]), x0=pad(a["x0"]),
+                u_limit=a["steer_limit"], bound=a["bound"], objectives=_truck.OBJECTIVE_STATES,
+                state_names=(*_truck.STATE_NAMES, "alpha_prev"), dt=a["dt"])
+        return self._memory
+
+    def run(self, K, *, K_input=None, keep_trajectories: bool = True, nan_gains: Literal["raise", "flag"] = "raise",
+            backend: Literal["numba", "numpy"] = "numba") -> PathFollowingResult:
+        """Simulate B gains on every scenario.
+
+        Parameters
+        ----------
+        K : (m, 4) or (B, m, 4) array_like
+            Gains with ``u = K e`` (``m`` = the input map's columns).
+        K_input : (m, 1) or (B, m, 1) array_like, optional
+            Gain on the previous applied (saturated) steering angle, for laws
+            with input memory: ``u[k] = K e[k] + K_input alpha[k-1]``,
+            ``alpha[-1] = 0`` (one-row gains, no input map).
+        keep_trajectories : bool
+            False keeps only the MSE sums (for optimisers).
+        nan_gains : {"raise", "flag"}
+            ``"flag"``: gains with NaN entries (failed designs, e.g.
+            ``RLQRBatch.K`` where ``ok`` is False) are reported as diverged at
+            step 0 with MSE ``bound**2`` instead of raising.
+        backend : {"numba", "numpy"}
+            Compiled kernel (default) or the numpy reference.
+
+        Returns
+        -------
+        PathFollowingResult
+            ``errors`` (B, S, T, 4), ``steering`` (B, S, T), ``mse()`` (B, S, 4)
+            in the paper's order f1..f4; ``pose()`` for plotting.
+        """
+        if K_input is not None:
+            return self._run_with_memory(K, K_input, keep_trajectories, nan_gains, backend)
+        sim = self._linear
+        shape: tuple[int, ...]
+        try:
+            shape = np.shape(K) if not isinstance(K, (str, bytes)) else ()
+        except ValueError:                          # ragged nested lists: check_gains names K
+            shape = ()
+        m = shape[-2] if len(shape) in (2, 3) else 1
+        if not self._given_map and m > 1:
+            warnings.warn(f"K has {m} rows but the truck has one steering input: summing them "
+                          f"(alpha = u1 + ... + u{m}) without an input_map is deprecated; pass "
+                          f"input_map=[[1] * {m}] (robustctl.models.truck.DOUBLED_INPUT_MAP for two)",
+                          DeprecationWarning, stacklevel=3)
+            sim = sim.with_input_map(np.ones((1, m)))
+        res = sim.run(K, keep_trajectories=keep_trajectories, nan_gains=nan_gains, backend=backend)
+        return PathFollowingResult(**vars(res), path=self.path, overloads=self.overloads)
+
+    def run_laws(self, laws: Sequence[InputMemoryFeedback], *, keep_trajectories: bool = True,
+                 backend: Literal["numba", "numpy"] = "numba") -> PathFollowingResult:
+        """Simulate a list of one-row laws, static and with input memory mixed, in their order.
+
+        The static laws (``K_input`` None) run as one batch of :meth:`run`,
+        those with input memory as a second one (``run(K, K_input=...)``); the
+        result's batch axis follows ``laws``.
+
+        Parameters
+        ----------
+        laws : sequence of InputMemoryFeedback
+            Laws ``u[k] = K e[k] (+ K_input alpha[k-1])`` with one-row ``K``
+            (1, 4) on the steering angle.
+        keep_trajectories : bool
+            False keeps only the MSE sums.
+        backend : {"numba", "numpy"}
+            Compiled kernel (default) or the numpy reference.
+
+        Returns
+        -------
+        PathFollowingResult
+            As :meth:`run`, B = ``len(laws)``.
+        """
+        laws = list(laws)
+        if not laws or not all(isinstance(law, InputMemoryFeedback) for law in laws):
+            raise TypeError("laws must be a non-empty sequence of robustctl.InputMemoryFeedback")
+        static = [b for b, law in enumerate(laws) if law.K_input is None]
+        memory = [b for b, law in enumerate(laws) if law.K_input is not None]
+        parts = []
+        if static:
+            parts.append(self.run(np.stack([laws[b].K for b in static]), keep_trajectories=keep_trajectories,
+                                  backend=backend))
+        if memory:
+            parts.append(self.run(np.stack([laws[b].K for b in memory]),
+                                  K_input=np.stack([Ku for b in memory if (Ku := laws[b].K_input) is not None]),
+                                  keep_trajectories=keep_trajectories, backend=backend))
+        if len(parts) == 1:
+            return parts[0]
+        order = np.argsort(static + memory)                                  # back to the laws' order
+        stacked: dict[str, Any] = {}
+        for f in dataclass_fields(parts[0]):
+            a, b = getattr(parts[0], f.name), getattr(parts[1], f.name)
+            batched = f.name in ("errors", "inputs", "sq_error_sum", "sq_state_sum", "diverged", "diverged_step",
+                                 "saturated_steps")
+            stacked[f.name] = np.concatenate([a, b])[order] if batched and a is not None else a
+        return PathFollowingResult(**stacked)
+
+    def _run_with_memory(self, K, K_input, keep, nan_gains, backend) -> PathFollowingResult:
+        if self._given_map:
+            raise ValueError("K_input needs one-row gains on the steering angle (no input_map)")
+        Kb, bad = check_gains(K, 4, nan_gains)
+        Ku = as_float_array(K_input, "K_input")
+        Ku = Ku[None] if Ku.ndim == 2 else Ku
+        if Kb.shape[1] != 1 or Ku.ndim != 3 or Ku.shape[1:] != (1, 1) or Ku.shape[0] not in (1, Kb.shape[0]):
+            raise ValueError(f"K_input must have shape (1, 1) or (B, 1, 1) for K of shape (B, 1, 4), "
+                             f"got K {np.shape(K)} and K_input {np.shape(K_input)}")
+        bad_u = ~np.isfinite(Ku).all(axis=(1, 2))
+        if bad_u.any() and nan_gains == "raise":
+            raise ValueError("K_input must have finite entries (found NaN or inf); "
+                             "nan_gains='flag' reports such gains as diverged instead")
+        Ka = np.concatenate([Kb, np.broadcast_to(Ku, (Kb.shape[0], 1, 1))], axis=2)
+        Ka[bad | bad_u] = np.nan                    # flagged by the simulator (nan_gains="flag" here)
+        res = self._memory_simulator().run(Ka, keep_trajectories=keep, nan_gains=nan_gains, backend=backend)
+        fields = vars(res).copy()
+        for name in ("errors", "sq_error_sum", "sq_state_sum", "x_ref"):
+            if fields[name] is not None:
+                fields[name] = fields[name][..., :4]
+        fields["state_names"] = _truck.STATE_NAMES
+        return PathFollowingResult(**fields, path=self.path, overloads=self.overloads)
+
+    def __repr__(self) -> str:
+        return (f"PathFollowing(path={self.path.name!r}, setup={self.setup.name!r}, S={self.S}, T={self.T}, "
+                f"input_map={'given' if self._given_map else 'default'})")
+
+
+def simulate(K, path: ReferencePath, overloads=0.0, *, setup: PathFollowingSetup = DEFAULT_SETUP,
+             params: _truck.TruckParameters | None = None, nominal_overload: float = 0.0,
+             steer_limit: float | None = _truck.STEER_LIMIT, feedforward: bool | None = None, x0=None,
+             bound: float = DEFAULT_BOUND, keep_trajectories: bool = True,
+             nan_gains: Literal["raise", "flag"] = "raise", input_map=None, K_input=None,
+             backend: Literal["numba", "numpy"] = "numba") -> PathFollowingResult:
+    """Truck path following: B gains x S payload scenarios over ``path``, in one call.
+
+    ``PathFollowing(path, overloads, ...).run(K, ...)``; see :class:`PathFollowing`
+    (scenarios, set-up, input map) and :meth:`PathFollowing.run` (gains,
+    ``K_input``, result). A gain of several rows needs ``input_map`` (e.g.
+    ``[[1, 1]]`` for the doubled steering column); without it the rows are
+    summed with a ``DeprecationWarning``.
+
+    Returns
+    -------
+    PathFollowingResult
+        ``errors`` (B, S, T, 4), ``steering`` (B, S, T), ``mse()`` (B, S, 4)
+        in the paper's order f1..f4 = MSE of rho, psidot, ydot, theta;
+        ``pose()`` for plotting.
+    """
+    sim = PathFollowing(path, overloads, setup=setup, params=params, nominal_overload=nominal_overload,
+                        steer_limit=steer_limit, feedforward=feedforward, x0=x0, bound=bound,
+                        input_map=input_map)
+    return sim.run(K, K_input=K_input, keep_trajectories=keep_trajectories, nan_gains=nan_gains, backend=backend)

@@ -1,0 +1,343 @@
+"""Compiled (numba) kernels of the RLQR step, the plain recursion and the doubling steps.
+
+:func:`kkt_step`, :func:`recursion` and :func:`doubling` compute, design by
+design in one compiled loop, what ``robustctl.synthesis._rlqr.step.kkt_step``,
+``robustctl.synthesis._rlqr.steady.recursion`` and ``robustctl.synthesis._rlqr.steady.doubling_loop``
+compute with stacked numpy calls (those stay the references the tests
+compare with). On the small systems of the MOPs (``n = 3`` or 4, ``m = l = 1``
+or 2) numpy's cost is its per-call overhead, about 75 us per step whatever
+the batch; the kernel takes about 1 us per design and recursion step and
+0.4 us per design and doubling step (``benchmarks/bench_rlqr.py``).
+
+Same arithmetic, same rules:
+
+* the step is the penalty/KKT form of :mod:`robustctl.synthesis.rlqr`, with the same
+  operations in the same order (``Pt = sym((I + P S)^-1 P)`` only when the
+  batch is ``soft``, the KKT solve, ``L = (I + S P)^-1 Lc``,
+  ``P = sym(Q + K'RK + lambda^-1 nu'nu + Lc' Pt Lc)``); only the rounding of
+  the sums and the solves differs from numpy/LAPACK (a few ulps per step);
+  the doubling step is that of ``doubling_loop``, with ``(I + Gs H)^-1 [A, Gs]``
+  by the same LU;
+* the solves are LU with partial pivoting (as LAPACK's ``getrf``: the first
+  largest pivot, multipliers scaled by the pivot's reciprocal); an exactly
+  zero pivot is a singular system and gives NaN for that solve's result of
+  that design only, as ``robustctl.synthesis._rlqr.step.solve`` does;
+* the recursion stops a design when one step changes ``P`` by less than
+  ``tol`` (relative Frobenius norm) or ``P`` is not healthy (an entry not
+  below ``robustctl.synthesis._rlqr.steady.DIVERGED`` in magnitude, or NaN), after
+  at most ``max_iter`` steps; the doubling likewise with its own ``tol``
+  (on ``H``) and ``max_steps``.
+
+Compilation: ``cache=True``, ``nogil=True`` (:func:`robustctl._jit.jit`),
+two entry points (``_recursion``, whose single step is ``max_iter = 1``, and
+``_doubling``), each compiled once on a fresh clone (slice assignments cost
+twice as much to compile and are written as loops), then loaded from the
+cache in each new process (``benchmarks/bench_experiment.py`` measures both).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._jit import jit
+from .model import Model
+from .step import Step
+
+__all__ = ["doubling", "kkt_step", "recursion"]
+
+_TINY = np.finfo(float).tiny
+
+
+@jit
+def _lu_solve(A, b):
+    """Solve ``A x = b`` in place (``A`` (k, k) becomes its LU factors, ``b`` (k, c) the solution).
+
+    Partial pivoting; returns False (and leaves ``b`` unspecified) when a pivot is exactly zero.
+    """
+    k, c = b.shape
+    for j in range(k):
+        p, big = j, abs(A[j, j])
+        for i in range(j + 1, k):
+            if abs(A[i, j]) > big:
+                p, big = i, abs(A[i, j])
+        if A[p, j] == 0.0:
+            return False
+        if p != j:
+            for q in range(k):
+                A[j, q], A[p, q] = A[p, q], A[j, q]
+            for q in range(c):
+                b[j, q], b[p, q] = b[p, q], b[j, q]
+        r = 1.0 / A[j, j]
+        for i in range(j + 1, k):
+            f = A[i, j] * r
+            A[i, j] = f
+            for q in range(j + 1, k):
+                A[i, q] -= f * A[j, q]
+            for q in range(c):
+                b[i, q] -= f * b[j, q]
+    for j in range(k - 1, -1, -1):
+        r = 1.0 / A[j, j]
+        for q in range(c):
+            s = b[j, q]
+            for t in range(j + 1, k):
+                s -= A[j, t] * b[t, q]
+            b[j, q] = s * r
+    return True
+
+
+@jit
+def _fill(A, value):
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            A[i, j] = value
+
+
+@jit
+def _copy(A, out):
+    """``out[i, j] = A[i, j]`` over ``out``'s shape."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            out[i, j] = A[i, j]
+
+
+@jit
+def _product(A, B, out):
+    """``out = A B`` (A (i, t), B (t, j); views such as ``A.T`` too) into ``out[:i, :j]``."""
+    for i in range(A.shape[0]):
+        for j in range(B.shape[1]):
+            s = 0.0
+            for t in range(A.shape[1]):
+                s += A[i, t] * B[t, j]
+            out[i, j] = s
+
+
+@jit
+def _eye_plus_product(A, B, out):
+    """``out = I + A B`` (A (k, t), B (t, k)) into ``out[:k, :k]``."""
+    _product(A, B, out)
+    for i in range(A.shape[0]):
+        for j in range(B.shape[1]):
+            out[i, j] = (1.0 if i == j else 0.0) + out[i, j]
+
+
+@jit
+def _relchange(new, old, tiny):
+    """``||new - old||_F / max(||new||_F, tiny)`` (NaN stays NaN)."""
+    num, den = 0.0, 0.0
+    for i in range(new.shape[0]):
+        for j in range(new.shape[1]):
+            num += (new[i, j] - old[i, j]) ** 2
+            den += new[i, j] * new[i, j]
+    den = np.sqrt(den)
+    return np.sqrt(num) / (tiny if den < tiny else den)  # noqa: FURB136 (NaN stays NaN, as np.maximum)
+
+
+@jit
+def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc):
+    """One step ``P -> (Pn, K, L)`` for one design (``li = lambda^-1``); the rest are work arrays.
+
+    ``Pt``, ``Lc`` (n, n), ``M`` (n, max(n, m)), ``GP`` (m, n), ``kkt`` (m + l, m + l), ``sol`` (m + l, n).
+    """
+    n, m = G.shape
+    l = EF.shape[0]
+    if soft:                                            # Pt = sym((I + P S)^-1 P)
+        _eye_plus_product(P, S, M)
+        _copy(P, Lc)
+        if not _lu_solve(M, Lc):
+            _fill(Lc, np.nan)
+        for i in range(n):
+            for j in range(n):
+                Pt[i, j] = 0.5 * (Lc[i, j] + Lc[j, i])
+    else:
+        _copy(P, Pt)
+    _product(G.T, Pt, GP)                               # GP = G'Pt
+    for a in range(m):                                  # kkt = [[R + G'Pt G, EG'], [EG, -li I]]
+        for c in range(m):                              # sol = -[G'Pt F; EF]
+            s = 0.0
+            for j in range(n):
+                s += GP[a, j] * G[j, c]
+            kkt[a, c] = R[a, c] + s
+        for r in range(l):
+            kkt[a, m + r] = EG[r, a]
+            kkt[m + r, a] = EG[r, a]
+        for j in range(n):
+            s = 0.0
+            for i in range(n):
+                s += GP[a, i] * F[i, j]
+            sol[a, j] = -s
+    for r in range(l):
+        for q in range(l):
+            kkt[m + r, m + q] = -li * (1.0 if r == q else 0.0)
+        for j in range(n):
+            sol[m + r, j] = -EF[r, j]
+    if not _lu_solve(kkt, sol):
+        _fill(sol, np.nan)
+    _copy(sol, K)
+    for i in range(n):                                  # Lc = F + G K
+        for j in range(n):
+            s = 0.0
+            for a in range(m):
+                s += G[i, a] * K[a, j]
+            Lc[i, j] = F[i, j] + s
+    _copy(Lc, L)
+    if soft:                                            # L = (I + S P)^-1 Lc
+        _eye_plus_product(S, P, M)
+        if not _lu_solve(M, L):
+            _fill(L, np.nan)
+    # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt; Pt, last read
+    # for Lc'Pt, then takes (Lc'Pt) Lc
+    _product(K.T, R, M)
+    _product(M[:, :m], K, Pn)
+    for i in range(n):
+        for j in range(n):
+            v = 0.0
+            for r in range(l):
+                v += sol[m + r, i] * sol[m + r, j]
+            Pn[i, j] = (Q[i, j] + Pn[i, j]) + li * v
+    _product(Lc.T, Pt, M)
+    _product(M[:, :n], Lc, Pt)
+    for i in range(n):
+        for j in range(n):
+            Pn[i, j] += Pt[i, j]
+    for i in range(n):
+        for j in range(i + 1, n):
+            v = 0.5 * (Pn[i, j] + Pn[j, i])
+            Pn[i, j] = v
+            Pn[j, i] = v
+        Pn[i, i] = 0.5 * (Pn[i, i] + Pn[i, i])
+
+
+@jit
+def _work(n, m, l):
+    """Work arrays of ``_step``: ``Pt, M, GP, kkt, sol, Lc``."""
+    return (np.empty((n, n)), np.empty((n, max(n, m))), np.empty((m, n)), np.empty((m + l, m + l)),
+            np.empty((m + l, n)), np.empty((n, n)))
+
+
+@jit
+def _healthy(P, bound):
+    for i in range(P.shape[0]):
+        for j in range(P.shape[1]):
+            if not abs(P[i, j]) < bound:
+                return False
+    return True
+
+
+@jit
+def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, tiny, K, L, iterations, active):
+    """The recursion from ``P`` (B, n, n, overwritten with the result) for every design.
+
+    ``K``, ``L`` (B, m, n), (B, n, n) receive those of each design's last step (one entry point
+    for the recursion and the single step, ``max_iter = 1``: the kernel is compiled once).
+    """
+    n, m = G.shape
+    Pt, M, GP, kkt, sol, Lc = _work(n, m, EF.shape[1])
+    Pn = np.empty((n, n))
+    for b in range(P.shape[0]):
+        Pb = P[b]
+        it, act = 0, True
+        while act and it < max_iter:
+            it += 1
+            _step(Pb, F, G, Q, R, EF[b], EG[b], S[b], lam_inv[b], soft, Pn, K[b], L[b], Pt, M, GP, kkt, sol, Lc)
+            change = _relchange(Pn, Pb, tiny)
+            _copy(Pn, Pb)
+            act = not change < tol and _healthy(Pn, bound)
+        iterations[b] = it
+        active[b] = act
+
+
+@jit
+def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
+    """The doubling loop of ``robustctl.synthesis._rlqr.steady.doubling`` for every ``active`` design.
+
+    ``A``, ``Gs``, ``H`` (B, n, n) are overwritten with each design's last iterate; per step
+    ``W = I + Gs H``, ``[WA, WG] = W^-1 [A, Gs]``, ``H <- sym(H + (A'H) WA)``, ``A <- A WA``,
+    ``Gs <- sym(Gs + (A WG) A')``, until ``H`` changes by less than ``tol`` or is not healthy.
+    """
+    n = H.shape[1]
+    W, sol, AH, AW, hn = np.empty((n, n)), np.empty((n, 2 * n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
+    for b in range(H.shape[0]):
+        a, g, h = A[b], Gs[b], H[b]
+        k = 0
+        while active[b] and k < max_steps:
+            k += 1
+            _eye_plus_product(g, h, W)
+            for i in range(n):
+                for j in range(n):
+                    sol[i, j] = a[i, j]
+                    sol[i, n + j] = g[i, j]
+            if not _lu_solve(W, sol):
+                _fill(sol, np.nan)
+            _product(a.T, h, AH)                          # h_new = sym(h + (a'h) WA)
+            _product(AH, sol[:, :n], hn)
+            for i in range(n):
+                for j in range(n):
+                    hn[i, j] = h[i, j] + hn[i, j]
+            for i in range(n):
+                for j in range(i, n):
+                    v = 0.5 * (hn[i, j] + hn[j, i])
+                    hn[i, j] = v
+                    hn[j, i] = v
+            ok = _healthy(hn, bound)
+            change = _relchange(hn, h, tiny) if ok else np.inf
+            _product(a, sol[:, n:], AW)                   # g = sym(g + (a WG) a')
+            _product(AW, a.T, W)
+            for i in range(n):
+                for j in range(n):
+                    W[i, j] = g[i, j] + W[i, j]
+            for i in range(n):
+                for j in range(n):
+                    g[i, j] = 0.5 * (W[i, j] + W[j, i])
+            _product(a, sol[:, :n], AW)                   # a = a WA
+            _copy(AW, a)
+            _copy(hn, h)
+            steps[b] += 1
+            settled[b] |= change < tol
+            active[b] = change >= tol and ok
+
+
+def doubling(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, max_steps: int, diverged: float,
+             active: np.ndarray):
+    """The doubling loop of ``robustctl.synthesis._rlqr.steady.doubling``, compiled, from ``(A, Gs, H)`` (B, n, n).
+
+    ``active``: the designs to iterate (the others are returned as given, 0 steps).
+    Returns ``(H, steps, settled)`` as the numpy loop does.
+    """
+    A, Gs, H = (np.array(x, dtype=float, order="C") for x in (A, Gs, H))
+    steps, settled = np.zeros(H.shape[0], dtype=np.int64), np.zeros(H.shape[0], dtype=bool)
+    _doubling(A, Gs, H, float(tol), int(max_steps), float(diverged), _TINY, steps, settled,
+              np.array(active, dtype=bool))
+    return H, steps.astype(int), settled
+
+
+def _args(d: Model):
+    """The model's arrays as C-contiguous, writable float64 arrays (one compiled signature)."""
+    return tuple(np.array(a, dtype=float, order="C") for a in (d.F, d.G, d.Q, d.R, d.EF, d.EG, d.S, d.lam_inv))
+
+
+def _run(d: Model, P: np.ndarray, tol: float, max_iter: int, diverged: float):
+    """``_recursion`` from ``P`` (B, n, n): ``(P, K, L, iterations, active)``."""
+    B, (n, m) = d.size, d.G.shape
+    P = np.array(np.broadcast_to(P, (B, n, n)), dtype=float, order="C")
+    K, L = np.empty((B, m, n)), np.empty((B, n, n))
+    iterations, active = np.zeros(B, dtype=np.int64), np.ones(B, dtype=bool)
+    _recursion(P, *_args(d), bool(d.soft), float(tol), int(max_iter), float(diverged), _TINY, K, L,
+               iterations, active)
+    return P, K, L, iterations, active
+
+
+def kkt_step(P: np.ndarray, d: Model) -> Step:
+    """The numpy ``robustctl.synthesis._rlqr.step.kkt_step``, compiled: one step for every design of ``d``."""
+    P, K, L, _, _ = _run(d, P, 0.0, 1, np.inf)
+    return Step(P, K, L)
+
+
+def recursion(d: Model, P0: np.ndarray, tol: float, max_iter: int, diverged: float):
+    """The plain recursion with :func:`kkt_step` from ``P0`` for every design of ``d``.
+
+    ``diverged``: ``P`` is not healthy once an entry reaches it in magnitude.
+    Returns ``(P, iterations, active)``; ``active`` True where the design was
+    still moving after ``max_iter`` steps.
+    """
+    P, _, _, iterations, active = _run(d, P0, tol, max_iter, diverged)
+    return P, iterations.astype(int), active

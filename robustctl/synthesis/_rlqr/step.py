@@ -1,0 +1,139 @@
+"""One RLQR recursion step ``P[k+1] -> (P[k], K[k], L[k])``.
+
+The batched penalty/KKT form and the paper's block system (the reference).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..._kkt import solve, sym
+from ..._validation import as_matrix, check_spd
+from ...systems.plant import Plant
+from .model import DEFAULT_ALPHA, Model, _norm2, build
+
+
+class Step(NamedTuple):
+    """One step for a batch: ``P`` (B, n, n) ``= P[k]``, ``K`` (B, m, n), ``L`` (B, n, n)."""
+
+    P: np.ndarray
+    K: np.ndarray
+    L: np.ndarray
+
+
+def kkt_step(P: np.ndarray, d: Model) -> Step:
+    """The penalty/KKT form of the step (:mod:`robustctl.synthesis.rlqr`) for every design of ``d``."""
+    n, m = d.G.shape
+    l = d.EF.shape[1]
+    eye = np.eye(n)
+    soft = d.soft
+    Pt = sym(solve(eye + P @ d.S, P)) if soft else P
+    GtPt = d.G.T @ Pt                                              # (B, m, n)
+    kkt = np.zeros((P.shape[0], m + l, m + l))
+    kkt[:, :m, :m] = d.R + GtPt @ d.G
+    kkt[:, :m, m:] = d.EG.swapaxes(1, 2)
+    kkt[:, m:, :m] = d.EG
+    kkt[:, m:, m:] = -d.lam_inv[:, None, None] * np.eye(l)
+    sol = solve(kkt, -np.concatenate([GtPt @ d.F, d.EF], axis=1))  # (B, m + l, n)
+    K, nu = sol[:, :m], sol[:, m:]
+    Lc = d.F + d.G @ K
+    L = solve(eye + d.S @ P, Lc) if soft else Lc
+    # Q + K'RK + lambda^-1 nu'nu (= Q + K'RK + lambda ||EF + EG K||^2) + Lc' Pt Lc
+    stage = d.Q + K.swapaxes(1, 2) @ d.R @ K + d.lam_inv[:, None, None] * (nu.swapaxes(1, 2) @ nu)
+    return Step(sym(stage + Lc.swapaxes(1, 2) @ Pt @ Lc), K, L)
+
+
+def block_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float) -> Step:
+    """The block system of Theorem 1 for one design (float arrays); ``P``, ``K``, ``L`` without batch axis."""
+    n, m = G.shape
+    hh = _norm2(H)
+    if hh == 0.0:
+        EF, EG = EF[:0], EG[:0]
+    l = EF.shape[0]
+    Sigma = np.zeros((n + l, n + l))
+    if not np.isinf(mu):
+        lam = (1.0 + alpha) * mu * hh
+        Sigma[:n, :n] = np.eye(n) / mu - (H @ H.T / lam if l else 0.0)
+        Sigma[n:, n:] = np.eye(l) / lam if l else 0.0
+    Fh, Gh = np.vstack([F, EF]), np.vstack([G, EG])
+    Ih = np.vstack([np.eye(n), np.zeros((l, n))])
+    off = np.concatenate([[0], np.cumsum([n, m, n, n + l, n, m])])
+    Xi = np.zeros((off[-1], off[-1]))
+    for i, j, blk in ((0, 0, np.linalg.inv(P_next)), (0, 4, np.eye(n)),
+                      (1, 1, np.linalg.inv(R)), (1, 5, np.eye(m)),
+                      (2, 2, np.linalg.inv(Q)),
+                      (3, 3, Sigma), (3, 4, Ih), (3, 5, -Gh),
+                      (4, 0, np.eye(n)), (4, 3, Ih.T),
+                      (5, 1, np.eye(m)), (5, 3, -Gh.T)):
+        Xi[off[i]:off[i + 1], off[j]:off[j + 1]] = blk
+    b = np.zeros((off[-1], n))
+    b[off[2]:off[3]] = -np.eye(n)
+    b[off[3]:off[4]] = Fh
+    sol = np.linalg.solve(Xi, b)
+    return Step(sym(b.T @ sol), sol[off[5]:off[6]], sol[off[4]:off[5]])
+
+
+def block_steps(P: np.ndarray, d: Model) -> Step:
+    """:func:`block_step` for every design of ``d`` (a loop: the reference, for small batches).
+
+    A numerically singular system (``P`` no longer invertible: divergence) gives NaN.
+    """
+    B, n = P.shape[:2]
+    out = Step(np.full_like(P, np.nan), np.full((B, d.G.shape[1], n), np.nan), np.full_like(P, np.nan))
+    for i in range(B):
+        try:
+            step = block_step(P[i], d.F, d.G, d.EF[i], d.EG[i], d.Q, d.R, d.H, float(d.mu[i]), d.alpha)
+        except np.linalg.LinAlgError:
+            continue
+        for arr, value in zip(out, step, strict=True):
+            arr[i] = value
+    return out
+
+
+def _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite: bool):
+    """The arguments of the single-step functions, validated like :func:`robustctl.rlqr`'s."""
+    d = build(Plant(F, G, 1.0), EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, batch=False)
+    n = d.F.shape[0]
+    P_next = check_spd(as_matrix(P_next, "P_next", rows=n, cols=n), "P_next", semidefinite=not definite)
+    if definite:
+        check_spd(d.Q, "Q")
+    return P_next, d
+
+
+def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_ALPHA):
+    """One RLQR step by the paper's block system (Theorem 1, PAPER_NOTES reading).
+
+    ``Xi`` has block rows of sizes (n, m, n, n + l, n, m)::
+
+        Xi = [[P^-1, 0,    0,    0,      I,     0     ],
+              [0,    R^-1, 0,    0,      0,     I     ],
+              [0,    0,    Q^-1, 0,      0,     0     ],
+              [0,    0,    0,    Sigma,  Ihat,  -Ghat ],
+              [I,    0,    0,    Ihat',  0,     0     ],
+              [0,    I,    0,    -Ghat', 0,     0     ]]
+
+    ``b = [0; 0; -I; Fhat; 0; 0]``; ``L`` is block 5 and ``K`` block 6 of
+    ``Xi^-1 b``, ``P = b' Xi^-1 b``. ``Sigma = blkdiag(mu^-1 I - lambda^-1 H H',
+    lambda^-1 I)`` with ``lambda = (1 + alpha) ||mu H'H||`` (``Sigma = 0`` at
+    ``mu = inf``; with ``H = 0`` the EF/EG rows are dropped, the
+    ``lambda -> 0`` limit). Needs ``P_next`` and ``Q`` positive definite.
+
+    Returns ``(L, K, P)``. Dense ``(4n + 2m + l)``-square solve: for tests and
+    small problems, not for batches. Arguments are validated like :func:`robustctl.rlqr`'s.
+    """
+    P_next, d = _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite=True)
+    P, K, L = block_step(P_next, d.F, d.G, d.EF[0], d.EG[0], d.Q, d.R, d.H, float(d.mu[0]), d.alpha)
+    return L, K, P
+
+
+def rlqr_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_ALPHA):
+    """One RLQR step by the penalty/KKT form (:mod:`robustctl.synthesis.rlqr`). Returns ``(L, K, P)``.
+
+    Same arguments as :func:`rlqr_step_block`; ``P_next`` and ``Q`` may be
+    only positive semidefinite.
+    """
+    P_next, d = _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite=False)
+    P, K, L = kkt_step(P_next[None], d)
+    return L[0], K[0], P[0]
