@@ -38,7 +38,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._kkt import doubling, healthy, relchange, solve, stein, sym
-from ..stability import is_schur_stable
+from ..systems.stability import is_schur_stable
 from ._model import FilterModel
 from ._recursion import Gains, constraint, step
 

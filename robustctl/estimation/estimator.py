@@ -32,7 +32,7 @@ from ._model import FilterModel
 from ._recursion import step as filter_step
 
 if TYPE_CHECKING:
-    from ..plant import Plant
+    from ..systems.plant import Plant
 
 __all__ = ["Estimator", "EstimatorBatch", "FilterRun", "FORMS"]
 
