@@ -162,7 +162,8 @@ def _lu_solve(A, b):
 def _doubling(A, G, H, tol, max_steps, bound, tiny, steps, settled, active):
     """The steps of :func:`doubling` for every ``active`` design; ``A``, ``G``, ``H`` (B, n, n) are overwritten."""
     n = H.shape[1]
-    W = np.empty((n, n)); sol = np.empty((n, 2 * n)); T1 = np.empty((n, n)); T2 = np.empty((n, n)); hn = np.empty((n, n))
+    W, T1, T2, hn = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
+    sol = np.empty((n, 2 * n))
     for b in range(H.shape[0]):
         a, g, h = A[b], G[b], H[b]
         k = 0
@@ -206,7 +207,7 @@ def _doubling(A, G, H, tol, max_steps, bound, tiny, steps, settled, active):
                     num += (v - h[i, j]) ** 2
                     den += v * v
             den = np.sqrt(den)
-            change = np.sqrt(num) / (tiny if den < tiny else den) if ok else np.inf
+            change = np.sqrt(num) / max(den, tiny) if ok else np.inf
             for i in range(n):                                 # T2 = a WG
                 for j in range(n):
                     s = 0.0

@@ -43,7 +43,7 @@ def random_model(seed: int, mu, *, output_uncertainty: bool = True, q: int = 2, 
 @pytest.mark.parametrize("output_uncertainty", [False, True])
 def test_closed_form_step_equals_the_block_system(mu, output_uncertainty):
     """x[k|k], P[k|k] and the a-priori x[k|k-1], P[k|k-1] of both forms agree to rounding."""
-    d, data, _ = random_model(1, mu, output_uncertainty=output_uncertainty)
+    d, _, _ = random_model(1, mu, output_uncertainty=output_uncertainty)
     rng = np.random.default_rng(7)
     n, m, p = 4, 2, 2
     Pf_prev = spd(rng, n)
@@ -122,7 +122,7 @@ def test_mu_to_inf_is_the_limit():
 
 def test_batch_equals_single_designs():
     B = 5
-    d, data, unc = random_model(6, np.inf, B=B)
+    _, data, unc = random_model(6, np.inf, B=B)
     mus = np.array([0.5, 10.0, 1e8, 1e20, np.inf])
     batch = robust_model(*data.values(), **unc, mu=mus, alpha=0.1)
     st = steady_state(batch)
@@ -160,7 +160,7 @@ def test_doubling_and_stein_against_scipy():
         assert np.allclose(X[i], scipy.linalg.solve_discrete_lyapunov(A[i].T, C[i]), rtol=1e-12, atol=0)
     # X = H + A' X (I + G X)^-1 A is the DARE of (A, B) with G = B R^-1 B', H = Q
     Bm, Q = rng.normal(size=(3, 4, 2)), C
-    H, steps, settled = doubling(A * 3, Bm @ Bm.swapaxes(1, 2), Q, 1e-14, 64)
+    H, _, settled = doubling(A * 3, Bm @ Bm.swapaxes(1, 2), Q, 1e-14, 64)
     assert settled.all()
     for i in range(3):
         assert np.allclose(H[i], scipy.linalg.solve_discrete_are(3 * A[i], Bm[i], Q[i], np.eye(2)), rtol=1e-10)

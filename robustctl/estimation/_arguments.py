@@ -5,12 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from .._validation import as_batch, as_float_array, as_matrix, check_choice, check_spd
+from ..errors import ConvergenceError
 from ..systems.plant import Plant, check_plant
-from ..systems.stability import unstabilizable_modes
+from ..systems.stability import UNSTABLE_TOL, immovable_modes
 from .estimator import FORMS
 
-__all__ = ["outputs", "noise_input", "covariance", "covariance_stack", "cross_covariance", "check_detectable",
-           "check_form", "undetectable_modes", "design_stack"]
+__all__ = ["outputs", "noise_input", "covariance", "covariance_stack", "cross_covariance", "check_form",
+           "design_stack", "check_noise_reaches_boundary"]
 
 
 def outputs(plant, what: str) -> Plant:
@@ -72,22 +73,6 @@ def cross_covariance(N, W: np.ndarray, V: np.ndarray) -> np.ndarray | None:
     return np.array(arr)
 
 
-def undetectable_modes(plant: Plant) -> np.ndarray:
-    """Modes of ``F`` that are not stable and that ``C`` does not see (PBH test on ``(F', C')``)."""
-    C = plant.output_matrices()[0]
-    return unstabilizable_modes(plant.F.T, C.T, discrete=plant.is_discrete)
-
-
-def check_detectable(plant: Plant) -> None:
-    """``ValueError`` naming ``C`` if ``(C, F)`` is not detectable: no estimator's error would converge."""
-    stuck = undetectable_modes(plant)
-    if stuck.size:
-        kind = "|lambda| >= 1" if plant.is_discrete else "Re(lambda) >= 0"
-        raise ValueError(f"(C, F) is not detectable: the mode lambda = {complex(stuck[0]):.6g} ({kind}) of F is not "
-                         "seen by the output matrix C (PBH rank test), so no estimator's error converges; measure "
-                         "that mode (add a row to C)")
-
-
 def check_form(form, plant: Plant) -> str:
     """``"filter"`` or ``"predictor"``; a continuous-time plant has one form (``"filter"``)."""
     form = check_choice(form, "form", FORMS)
@@ -108,3 +93,29 @@ def design_stack(value, name: str, shape: tuple[int | None, int], what: tuple[st
         arr = as_matrix(arr, name, rows=shape[0], cols=shape[1], rows_what=what[0], cols_what=what[1],
                         allow_empty=True)[None]
     return as_batch(arr, name, (None, *shape), ("", *what))
+
+
+def check_noise_reaches_boundary(F: np.ndarray, Bw: np.ndarray, W: np.ndarray, *, discrete: bool) -> None:
+    """``ConvergenceError`` if a mode of ``F`` on the stability boundary is not reached by the noise ``Bw W^1/2``.
+
+    The filter Riccati equation (without cross term; with one, ``F - S V^-1 C``
+    and ``W - N V^-1 N'``) has a stabilising solution iff ``(C, F)`` is
+    detectable and ``(F, Bw W^1/2)`` has no unreachable mode on the unit circle
+    (the imaginary axis) (Lancaster & Rodman, *Algebraic Riccati Equations*,
+    1995, Thm 13.1.3, dual form): such a mode (an integrator without noise) is
+    estimated ever better but never at a fixed rate. PBH test at the modes
+    within ``max(1e-6, 1e3 UNSTABLE_TOL ||F||)`` of the boundary.
+    """
+    w, Q = np.linalg.eigh(0.5 * (W + W.T))
+    root = Bw @ (Q * np.sqrt(np.clip(w, 0.0, None)))
+    edge = max(1e-6, 1e3 * UNSTABLE_TOL * max(1.0, float(np.linalg.norm(F, 2))))
+    if discrete:
+        modes = immovable_modes(F, root, lambda lam: np.abs(np.abs(lam) - 1.0) <= edge)
+    else:
+        modes = immovable_modes(F, root, lambda lam: np.abs(lam.real) <= edge)
+    if modes.size:
+        where = "unit circle" if discrete else "imaginary axis"
+        raise ConvergenceError(
+            f"no stabilising steady-state filter: the mode lambda = {complex(modes[0]):.6g} of F on the {where} is not "
+            f"reached by the process noise Bw W Bw' (PBH test), so its estimate converges ever more slowly and no "
+            "fixed gain is optimal and stable; add process noise on that mode")

@@ -26,7 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FilterModel", "kalman_model", "robust_model"]
+__all__ = ["FilterModel", "kalman_model", "robust_model", "RANK_TOL"]
+
+#: A row of ``[EF, EBw W^1/2]`` (``EC``) carries information when its singular value exceeds this times the largest.
+RANK_TOL = 1e-12
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,6 +56,7 @@ class FilterModel:
     Y: np.ndarray          # (B, q, q)
     EC: np.ndarray         # (B, q2, n)
     li: np.ndarray         # (B,)
+    ell: np.ndarray        # (B, q): the EF rows' noise, li where the row is live, 1 where it carries no information
     # the raw noise and uncertainty data, for the block (KKT) form
     Bw: np.ndarray         # (n, nw)
     W: np.ndarray          # (B, nw, nw)
@@ -76,8 +80,8 @@ class FilterModel:
             return self
         return FilterModel(self.F, self.G, self.C, self.D, self.Q[mask], self.R[mask],
                            None if self.S is None else self.S[mask], self.EF[mask], self.EG[mask],
-                           self.X[mask], self.Y[mask], self.EC[mask], self.li[mask], self.Bw, self.W[mask],
-                           self.V[mask], self.EBw[mask], self.Phi1[mask], self.Phi2[mask])
+                           self.X[mask], self.Y[mask], self.EC[mask], self.li[mask], self.ell[mask], self.Bw,
+                           self.W[mask], self.V[mask], self.EBw[mask], self.Phi1[mask], self.Phi2[mask])
 
 
 def _stack(a: np.ndarray, B: int) -> np.ndarray:
@@ -89,9 +93,9 @@ def kalman_model(F, G, C, D, Bw, W, V, N=None) -> FilterModel:
     B, n, m, p, nw = W.shape[0], F.shape[0], G.shape[1], C.shape[0], Bw.shape[1]
     Q = Bw @ W @ Bw.T
     S = None if N is None else Bw @ N
-    V = _stack(V, B)
     return FilterModel(F, G, C, D, Q, V, S, np.zeros((B, 0, n)), np.zeros((B, 0, m)), np.zeros((B, n, 0)),
-                       np.zeros((B, 0, 0)), np.zeros((B, 0, n)), np.zeros(B), Bw, W, V, np.zeros((B, 0, nw)),
+                       np.zeros((B, 0, 0)), np.zeros((B, 0, n)), np.zeros(B), np.zeros((B, 0)), Bw, W, V,
+                       np.zeros((B, 0, nw)),
                        np.zeros((B, n, n)), np.zeros((B, p, p)))
 
 
@@ -120,10 +124,39 @@ def robust_model(F, G, C, D, Bw, W, V, *, H, EF, EG, EBw, HC, EC, mu, alpha: flo
         li = mu_inv / ((1.0 + alpha) * h)
         Phi1 = mu_inv[:, None, None] * (np.eye(n) - H @ H.T / ((1.0 + alpha) * h))
         Phi2 = mu_inv[:, None, None] * (np.eye(p) - HC @ HC.T / ((1.0 + alpha) * h))
-    BwW = Bw @ W
     Q = Bw @ W @ Bw.T + Phi1
     R = V + Phi2
+    EF, EG, EBw, live = _compress(EF, EG, EBw, W)
+    ell = np.where(live, li[:, None], 1.0)
+    if EC.shape[0]:  # EC -> U' EC = S V', its rows without information dropped (as in _compress)
+        _, s, Vt = np.linalg.svd(EC, full_matrices=False)
+        keep = s > RANK_TOL * s[0]
+        EC = s[keep, None] * Vt[keep]
+    BwW = Bw @ W
     X = BwW @ EBw.swapaxes(1, 2)
     Y = EBw @ W @ EBw.swapaxes(1, 2)
-    return FilterModel(F, G, C, D, Q, R, None, EF, EG, X, Y, np.broadcast_to(EC, (B, *EC.shape)), li, Bw,
+    return FilterModel(F, G, C, D, Q, R, None, EF, EG, X, Y, np.broadcast_to(EC, (B, *EC.shape)), li, ell, Bw,
                        _stack(W, B), _stack(V, B), EBw, Phi1, Phi2)
+
+
+def _compress(EF, EG, EBw, W):
+    """The uncertainty rows rotated to the row space of ``[EF, EBw W^1/2]`` (B, q, .), rows outside it zeroed.
+
+    ``[EF EG EBw] -> U' [EF EG EBw]`` with ``[EF, EBw W^1/2] = U S V'`` (an
+    orthogonal ``U``: ``H Delta [EF EG EBw] = H (Delta U) (U' [EF EG EBw])``
+    with ``Delta U`` a contraction as well, the same uncertain model and the
+    same cost). A row with a zero singular value (relative ``RANK_TOL``) then
+    says nothing about ``x`` and ``w``: it is zeroed (``EG`` included) and
+    ``live`` is False, so that at ``mu = inf`` no rank condition is needed.
+    Returns ``(EF, EG, EBw, live)``.
+    """
+    B, q = EF.shape[:2]
+    if q == 0:
+        return EF, EG, EBw, np.zeros((B, 0), dtype=bool)
+    w, Qw = np.linalg.eigh(W)
+    root = Qw * np.sqrt(np.clip(w, 0.0, None))
+    U, s, _ = np.linalg.svd(np.concatenate([EF, EBw @ root], axis=2))
+    live = np.zeros((B, q), dtype=bool)
+    live[:, :s.shape[1]] = s > RANK_TOL * np.maximum(s[:, :1], np.finfo(float).tiny)
+    Ut = U.swapaxes(1, 2) * live[:, :, None]
+    return Ut @ EF, Ut @ EG, Ut @ EBw, live

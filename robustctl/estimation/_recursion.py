@@ -66,13 +66,14 @@ def prediction(Pf: np.ndarray, Lf: np.ndarray, Re: np.ndarray, d: FilterModel):
     """``(P+, Fe, Ge, Je)``: the a-priori covariance of the next state (before ``EC``) and the estimator's model."""
     FPf = d.F @ Pf
     P = FPf @ d.F.T + d.Q
-    Fe, Ge = np.broadcast_to(d.F, P.shape), np.broadcast_to(d.G, (*P.shape[:2], d.G.shape[1]))
     Je = np.zeros_like(Lf)
     if d.EF.shape[1]:
-        SE = sym(d.EF @ Pf @ _T(d.EF) + d.Y + d.li[:, None, None] * np.eye(d.EF.shape[1]))
+        SE = sym(d.EF @ Pf @ _T(d.EF) + d.Y + d.ell[:, :, None] * np.eye(d.EF.shape[1]))
         J = _T(solve(SE, _T(FPf @ _T(d.EF) + d.X)))
         Fe, Ge = d.F - J @ d.EF, d.G - J @ d.EG
         P = P - J @ SE @ _T(J)
+    else:
+        Fe, Ge = np.repeat(d.F[None], P.shape[0], axis=0), np.repeat(d.G[None], P.shape[0], axis=0)
     if d.S is not None:
         Je = _T(solve(Re, _T(d.S)))
         cross = d.F @ Lf @ _T(d.S)
@@ -148,7 +149,7 @@ def block_step(x: np.ndarray, Pf: np.ndarray, u_prev: np.ndarray, u: np.ndarray,
     if q:                                                                   # uncertainty of the dynamics
         rows.append(np.hstack([d.EF[0], d.EBw[0], zeros((q, p + n))]))
         rhs.append(-d.EG[0] @ u_prev)
-        cov.append(li * np.eye(q))
+        cov.append(np.diag(d.ell[0]))
     if q2:                                                                  # uncertainty of the output
         rows.append(np.hstack([zeros((q2, n + nw + p)), d.EC[0]]))
         rhs.append(zeros(q2))

@@ -93,34 +93,37 @@ def standard_form(d: FilterModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(A, G, H)`` of the doubling, ``X = H + A' X (I + G X)^-1 A`` with ``A = Abar'`` (module docstring)."""
     n = d.F.shape[0]
     Rinv_C = solve(d.R, np.broadcast_to(d.C, (d.size, *d.C.shape)))          # R^-1 C
-    A = np.broadcast_to(d.F, (d.size, n, n)).copy()
+    A = np.broadcast_to(d.F, (d.size, n, n))
     Gm = d.C.T @ Rinv_C
-    H = d.Q.copy()
+    H = d.Q
     if d.S is not None:
-        A -= d.S @ Rinv_C
-        H -= d.S @ solve(d.R, _T(d.S))
-    if d.uncertain:
+        A = A - d.S @ Rinv_C
+        H = H - d.S @ solve(d.R, _T(d.S))
+    if d.uncertain:  # lambda^-1 floored for the doubling (module docstring)
         size = np.maximum(_size(d.EF @ d.Q @ _T(d.EF)), _size(d.Y))
         size = np.maximum(size, _size(d.EC @ d.Q @ _T(d.EC)))
-        ell = np.maximum(d.li, FLOOR * np.where(size > 0, size, 1.0))[:, None, None]
-    if d.EF.shape[1]:
-        Ybar = d.Y + ell * np.eye(d.EF.shape[1])
-        sol = solve(Ybar, np.concatenate([d.EF, _T(d.X)], axis=2))         # Ybar^-1 [EF, X']
-        A -= d.X @ sol[..., :n]
-        H -= d.X @ sol[..., n:]
-        Gm = Gm + _T(d.EF) @ sol[..., :n]
-    if d.EC.shape[1]:
-        Gm = Gm + _T(d.EC) @ d.EC / ell
+        floor = FLOOR * np.where(size > 0, size, 1.0)
+        if d.EF.shape[1]:
+            Ybar = d.Y + np.maximum(d.ell, floor[:, None])[:, :, None] * np.eye(d.EF.shape[1])
+            sol = solve(Ybar, np.concatenate([d.EF, _T(d.X)], axis=2))     # Ybar^-1 [EF, X']
+            A = A - d.X @ sol[..., :n]
+            H = H - d.X @ sol[..., n:]
+            Gm = Gm + _T(d.EF) @ sol[..., :n]
+        if d.EC.shape[1]:
+            Gm = Gm + _T(d.EC) @ d.EC / np.maximum(d.li, floor)[:, None, None]
     return _T(A), sym(Gm), sym(H)
 
 
 def evaluate(P: np.ndarray, d: FilterModel) -> Evaluation:
     """One exact step from ``P`` (a-priori, after ``EC``) for every design; NaN where ``P`` is not healthy."""
-    B, n = P.shape[:2]
     good = healthy(P)
-    g = step(np.where(good[:, None, None], P, np.eye(n)), d)
-    residual = np.where(good, relchange(g.P_next, P), np.inf)
-    stable = good & np.asarray(is_schur_stable(g.closed_loop(d.C)), dtype=bool)
+    everywhere = bool(good.all())
+    g = step(P if everywhere else np.where(good[:, None, None], P, np.eye(P.shape[1])), d)
+    residual = relchange(g.P_next, P)
+    stable = np.asarray(is_schur_stable(g.closed_loop(d.C)), dtype=bool)
+    if not everywhere:
+        residual[~good] = np.inf
+        stable &= good
     return Evaluation(P, g, residual, stable)
 
 
@@ -132,11 +135,11 @@ def _rows(ev: Evaluation, idx: np.ndarray) -> Evaluation:
 def _put(ev: Evaluation, where: np.ndarray, other: Evaluation) -> Evaluation:
     """``ev`` with the designs ``where`` (indices) replaced by ``other``."""
     out = []
-    for mine, theirs in zip((ev.P, *ev.gains, ev.residual, ev.stable),
-                            (other.P, *other.gains, other.residual, other.stable), strict=True):
-        mine = mine.copy()
-        mine[where] = theirs
-        out.append(mine)
+    for a, b in zip((ev.P, *ev.gains, ev.residual, ev.stable), (other.P, *other.gains, other.residual, other.stable),
+                    strict=True):
+        a = a.copy()  # noqa: PLW2901 (a copy of each field, then written)
+        a[where] = b
+        out.append(a)
     return Evaluation(out[0], Gains(*out[1:-2]), out[-2], out[-1])
 
 
@@ -200,18 +203,19 @@ def steady_state(d: FilterModel, tol: float = DEFAULT_TOL, max_iter: int = DEFAU
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         if accelerate:
             X, iterations, settled = doubling(*standard_form(d), DOUBLING_TOL, DOUBLING_MAX_STEPS)
-            ev = evaluate(constraint(np.where(healthy(X)[:, None, None], X, np.nan), d)[0], d)
-            sub = np.flatnonzero(settled & ev.stable & ~ev.accepted(tol))
-            if sub.size:
-                refined, count = newton(ev.P[sub], d.select(sub), tol)
-                ev = _put(ev, sub, refined)
-                iterations[sub] += count
-            todo = np.flatnonzero(~ev.accepted(tol))
-            if todo.size:
-                sub_d = d.select(todo)
-                P, steps = recursion(sub_d, start(sub_d), tol, max_iter)
-                ev = _put(ev, todo, evaluate(P, sub_d))
-                iterations[todo] += steps
+            ev = evaluate(constraint(X, d)[0], d)
+            if not ev.accepted(tol).all():
+                sub = np.flatnonzero(settled & ev.stable & ~ev.accepted(tol))
+                if sub.size:                                   # Newton, then the recursion where it misses
+                    refined, count = newton(ev.P[sub], d.select(sub), tol)
+                    ev = _put(ev, sub, refined)
+                    iterations[sub] += count
+                todo = np.flatnonzero(~ev.accepted(tol))
+                if todo.size:
+                    sub_d = d.select(todo)
+                    P, steps = recursion(sub_d, start(sub_d), tol, max_iter)
+                    ev = _put(ev, todo, evaluate(P, sub_d))
+                    iterations[todo] += steps
         else:
             P, iterations = recursion(d, start(d), tol, max_iter)
             ev = evaluate(P, d)

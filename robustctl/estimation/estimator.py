@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._validation import as_float_array, as_matrix, check_spd
+from ..errors import ConvergenceError
 from ._model import FilterModel
 from ._recursion import step as filter_step
 
@@ -128,6 +129,7 @@ class Estimator:
 
     @property
     def n(self) -> int:
+        """Number of states."""
         return self.P.shape[0]
 
     @property
@@ -242,7 +244,6 @@ class Estimator:
                 x = xf @ g.Fe[0].T + U[:, k] @ g.Ge[0].T + e @ g.Je[0].T
                 P = g.P_next
         if not (np.isfinite(P_prior).all() and np.isfinite(x_filt).all()):
-            from ..errors import ConvergenceError
             raise ConvergenceError("the time-varying filter produced non-finite values (is P0 positive "
                                    "definite where the uncertainty constraints need it?)")
         if single:
@@ -272,9 +273,8 @@ class EstimatorBatch:
     ok : (B,) bool ndarray
         The design converged to a stabilising steady state.
     reason : (B,) str ndarray
-        ``"ok"``, ``"rank"`` (``mu = inf`` and the uncertainty rows are not of
-        full row rank), ``"undetectable"`` (``(C, F)`` is not detectable:
-        every design), ``"not converged"`` or ``"diverged"``.
+        ``"ok"``, ``"undetectable"`` (``(C, F)`` is not detectable: every
+        design), ``"not converged"`` or ``"diverged"``.
     stable : (B,) bool ndarray
         The estimator's own loop ``F - L_predictor C`` is stable (always True where ``ok``).
     iterations : (B,) int ndarray

@@ -27,9 +27,16 @@ import scipy.linalg
 from .._validation import check_int, check_positive_scalar
 from ..errors import ConvergenceError
 from ..systems.plant import Plant
-from ..systems.stability import is_stable, spectral_abscissa
-from ._arguments import (check_detectable, check_form, covariance, covariance_stack, cross_covariance, noise_input,
-                         outputs, undetectable_modes)
+from ..systems.stability import check_detectable, is_stable, spectral_abscissa
+from ._arguments import (
+    check_form,
+    check_noise_reaches_boundary,
+    covariance,
+    covariance_stack,
+    cross_covariance,
+    noise_input,
+    outputs,
+)
 from ._model import kalman_model
 from ._steady import DEFAULT_MAX_ITER, DEFAULT_TOL, SteadyState, steady_state
 from .estimator import Estimator, EstimatorBatch
@@ -60,6 +67,16 @@ def _estimator(st: SteadyState, i: int, plant: Plant, form: str, method: str, in
                      method, info, model)
 
 
+def _check_noise(plant: Plant, Bw, W, V, N) -> None:
+    """Raise if a mode on the stability boundary is not reached by the process noise (the usual failure)."""
+    if N is None:
+        check_noise_reaches_boundary(plant.F, Bw, W, discrete=plant.is_discrete)
+    else:  # the pair without cross term: F - Bw N V^-1 C and W - N V^-1 N'
+        NV = np.linalg.solve(V, N[0].T).T
+        check_noise_reaches_boundary(plant.F - Bw @ NV @ plant.output_matrices()[0], Bw, W - NV @ N[0].T,
+                                     discrete=plant.is_discrete)
+
+
 def _continuous(plant: Plant, Bw, W, V, N, info: dict) -> Estimator:
     """The Kalman-Bucy filter: ``A P + P A' - (P C' + S) V^-1 (P C' + S)' + Bw W Bw' = 0``, ``S = Bw N``."""
     A, C = plant.F, plant.output_matrices()[0]
@@ -69,6 +86,7 @@ def _continuous(plant: Plant, Bw, W, V, N, info: dict) -> Estimator:
     try:
         P = scipy.linalg.solve_continuous_are((A - S @ np.linalg.solve(V, C)).T, C.T, Q - S @ VS, V)
     except (ValueError, np.linalg.LinAlgError) as exc:
+        _check_noise(plant, Bw, W, V, N)
         raise ConvergenceError(f"no stabilising solution of the filter's continuous Riccati equation ({exc}); "
                                "does the process noise Bw W Bw' reach every mode of F on the imaginary axis?") from None
     P = 0.5 * (P + P.T)
@@ -78,6 +96,7 @@ def _continuous(plant: Plant, Bw, W, V, N, info: dict) -> Estimator:
     residual = float(np.linalg.norm(terms[0] + terms[1] - terms[2] + terms[3]) / max(
         sum(float(np.linalg.norm(t)) for t in terms), np.finfo(float).tiny))
     if not (np.all(np.isfinite(P)) and residual < _CARE_TOL and is_stable(A - L @ C, discrete=False)):
+        _check_noise(plant, Bw, W, V, N)
         raise ConvergenceError(
             f"no stabilising solution of the filter's continuous Riccati equation (relative residual {residual:.3g}, "
             f"spectral abscissa of A - L C {spectral_abscissa(A - L @ C):.6g}); does the process noise reach every "
@@ -190,13 +209,14 @@ def kalman(plant: Plant, W, V, *, Bw=None, N=None, form: str = "filter", tol: fl
     V = covariance(V, "V", plant.p, "the number of outputs", definite=True)
     N = cross_covariance(N, W[None], V[None])
     check_detectable(plant)
+    C, D = plant.output_matrices()
     info = {"W": W, "V": V, "N": None if N is None else N[0], "Bw": Bw}
     if not plant.is_discrete:
         return _continuous(plant, Bw, W, V, N, info)
-    C, D = plant.output_matrices()
     d = kalman_model(plant.F, plant.G, C, D, Bw, W[None], V[None], N)
     st = steady_state(d, tol, max_iter)
     if st.reason[0] != "ok":
+        _check_noise(plant, Bw, W, V, N)         # the usual cause, named
         raise _failure(st, 0, max_iter, tol, "Kalman filter's")
     info.update(residual=float(st.residual[0]), iterations=int(st.iterations[0]))
     return _estimator(st, 0, plant, form, "kalman", info, d)
@@ -262,9 +282,9 @@ def kalman_gains(plant: Plant, W, V, *, Bw=None, N=None, form: str = "filter", t
     N = cross_covariance(N, W, V)
     C, D = plant.output_matrices()
     d = kalman_model(plant.F, plant.G, C, D, Bw, W, V, N)
-    if undetectable_modes(plant).size:
+    if not plant.is_detectable:
         return _flagged(B, plant, form, "undetectable")
-    return batch_result(steady_state(d, tol, max_iter), form, np.ones(B, dtype=bool), "undetectable")
+    return batch_result(steady_state(d, tol, max_iter), form)
 
 
 def _flagged(B: int, plant: Plant, form: str, reason: str) -> EstimatorBatch:
@@ -276,22 +296,12 @@ def _flagged(B: int, plant: Plant, form: str, reason: str) -> EstimatorBatch:
                           np.full(B, np.inf), form)
 
 
-def batch_result(st: SteadyState, form: str, solved: np.ndarray, other: str) -> EstimatorBatch:
-    """The :class:`EstimatorBatch` of a steady state computed for the designs ``solved`` (the rest: ``other``)."""
+def batch_result(st: SteadyState, form: str) -> EstimatorBatch:
+    """The :class:`EstimatorBatch` of a steady state (NaN gains where a design failed)."""
     g = st.gains
-    Lp = g.Fe @ g.Lf + g.Je
-    B = solved.shape[0]
-    idx = np.flatnonzero(solved)
-
-    def full(a: np.ndarray, fill=np.nan) -> np.ndarray:
-        out = np.full((B, *a.shape[1:]), fill, dtype=a.dtype if a.dtype.kind in "biU" else float)
-        out[idx] = a
-        return out
-
-    reason = full(st.reason, other)
-    ok = reason == "ok"
-    arrays = [full(a) for a in ((g.Lf if form == "filter" else Lp), st.P, g.Fe, g.Ge, g.Je)]
-    for a in arrays:
+    ok = st.reason == "ok"
+    L, P, F, G, J = ((g.Lf if form == "filter" else g.Fe @ g.Lf + g.Je).copy(), st.P.copy(), g.Fe.copy(), g.Ge.copy(),
+                     g.Je.copy())
+    for a in (L, P, F, G, J):
         a[~ok] = np.nan
-    return EstimatorBatch(*arrays, ok, reason, full(st.stable, False), full(st.iterations, 0),
-                          full(st.residual, np.inf), form)
+    return EstimatorBatch(L, P, F, G, J, ok, st.reason, st.stable & ok, st.iterations, st.residual, form)

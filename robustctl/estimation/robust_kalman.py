@@ -25,43 +25,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._kkt import DEFAULT_ALPHA, check_penalty
+from .._kkt import DEFAULT_ALPHA, check_penalty, relchange
 from .._validation import as_matrix, check_bool, check_choice, check_int, check_positive_scalar
-from ..errors import RankConditionError
+from ..errors import ConvergenceError
 from ..systems.plant import Plant
-from ._arguments import (check_detectable, check_form, covariance, design_stack, noise_input, outputs,
-                         undetectable_modes)
+from ..systems.stability import check_detectable
+from ._arguments import check_form, covariance, design_stack, noise_input, outputs
 from ._model import FilterModel, robust_model
 from ._recursion import block_step
-from ._steady import DEFAULT_MAX_ITER, DEFAULT_TOL, SteadyState, steady_state
+from ._steady import DEFAULT_MAX_ITER, DEFAULT_TOL, steady_state
 from .estimator import Estimator, EstimatorBatch
 from .kalman import _estimator, _failure, _flagged, batch_result
 
 __all__ = ["robust_kalman", "robust_kalman_gains"]
 
-#: The rows of ``[EF EBw]`` (``EC``) have full row rank when the smallest singular value exceeds this times the largest.
-RANK_TOL = 1e-12
 _IMPLEMENTATIONS = ("closed", "block")
-
-
-def _rank_ok(E: np.ndarray) -> np.ndarray:
-    """Per design: ``E`` (B, q, k) has full row rank ``q`` (True when ``q = 0``)."""
-    B, q, k = E.shape
-    if q == 0:
-        return np.ones(B, dtype=bool)
-    if q > k:
-        return np.zeros(B, dtype=bool)
-    sv = np.linalg.svd(E, compute_uv=False)
-    return sv[:, -1] > RANK_TOL * np.maximum(sv[:, 0], 1e-300)
-
-
-def _rank(d: FilterModel, mu: np.ndarray) -> np.ndarray:
-    """Per design: unless ``mu = inf``, True; else ``[EF EBw]`` and ``EC`` have full row rank (the constraints hold)."""
-    ok = np.ones(d.size, dtype=bool)
-    inf = np.isinf(mu)
-    if inf.any():
-        ok[inf] = _rank_ok(np.concatenate([d.EF, d.EBw], axis=2)[inf]) & _rank_ok(d.EC[inf])
-    return ok
 
 
 def _build(plant, W, V, Bw, H, EF, EG, EBw, HC, EC, mu, alpha, batch: bool):
@@ -111,17 +89,16 @@ def _lam(d: FilterModel, mu: np.ndarray) -> np.ndarray:
         return np.where(d.uncertain, np.where(mu == np.inf, np.inf, 1.0 / d.li), 0.0)
 
 
-def _block(d: FilterModel, tol: float, max_iter: int) -> Estimator | tuple:
+def _block(d: FilterModel, tol: float, max_iter: int) -> tuple:
     """The steady state by the block (KKT) system alone: its plain recursion, then its linear maps."""
     n, m, p = d.F.shape[0], d.G.shape[1], d.C.shape[0]
     zn, zm, zp = np.zeros(n), np.zeros(m), np.zeros(p)
-    Pf = np.eye(n)
-    for it in range(1, max_iter + 1):
+    Pf, it, change = np.eye(n), 0, np.inf
+    while it < max_iter and change >= tol:
+        it += 1
         Pf_new = block_step(zn, Pf, zm, zm, zp, d)[1]
-        change = np.linalg.norm(Pf_new - Pf) / max(np.linalg.norm(Pf_new), 1e-300)
+        change = float(relchange(Pf_new[None], Pf[None])[0])
         Pf = Pf_new
-        if not change >= tol:
-            break
     P = block_step(zn, Pf, zm, zm, zp, d, measure=False)[1]
     # x[k|k] = Mx x[k-1|k-1] + Mu u[k-1] + Lf (y[k] - D u[k]): the block system's linear maps, column by column
     Mx = np.column_stack([block_step(e, Pf, zm, zm, zp, d)[0] for e in np.eye(n)])
@@ -158,8 +135,11 @@ def robust_kalman(plant: Plant, W, V, *, Bw=None, H, EF, EG=None, EBw=None, HC=N
     mu : float
         Penalty in ``[1e-100, inf]``; ``np.inf`` gives the optimal robust
         filter of Ishihara, Terra & Cerri (2015), in which ``EF x + EG u +
-        EBw w = 0`` and ``EC x = 0`` hold exactly and ``H``, ``HC`` drop out
-        (needs ``[EF EBw]`` and ``EC`` of full row rank).
+        EBw w = 0`` and ``EC x = 0`` hold exactly and ``H``, ``HC`` drop out.
+        The rows are first rotated onto the row space of ``[EF, EBw W^1/2]``
+        (and of ``EC``) and the rows outside it, which say nothing about the
+        state, dropped: the same uncertain model, and no rank condition at
+        ``mu = inf``.
     alpha : float, default 0.1
         ``lambda = (1 + alpha) mu max(||H'H||, ||HC'HC||)`` (as for :func:`robustctl.rlqr`).
     form : {"filter", "predictor"}
@@ -187,8 +167,6 @@ def robust_kalman(plant: Plant, W, V, *, Bw=None, H, EF, EG=None, EBw=None, HC=N
     ValueError
         The plant is continuous-time or has no ``C``; an argument of the
         wrong shape (the message names it); ``(C, F)`` not detectable.
-    RankConditionError
-        ``mu = inf`` and ``[EF EBw]`` or ``EC`` is not of full row rank.
     ConvergenceError
         No stabilising steady state.
 
@@ -261,17 +239,11 @@ def robust_kalman(plant: Plant, W, V, *, Bw=None, H, EF, EG=None, EBw=None, HC=N
     max_iter = check_int(max_iter, "max_iter")
     plant, d, mu_arr, info = _build(plant, W, V, Bw, H, EF, EG, EBw, HC, EC, mu, alpha, batch=False)
     form = check_form(form, plant)
-    if not _rank(d, mu_arr)[0]:
-        raise RankConditionError(
-            "mu = inf makes EF x + EG u + EBw w = 0 and EC x = 0 exact constraints: [EF EBw] "
-            f"({d.EF.shape[1]}x{d.EF.shape[2] + d.EBw.shape[2]}) and EC ({d.EC.shape[1]}x{d.EC.shape[2]}) must "
-            "have full row rank; use a finite mu or fewer rows")
     check_detectable(plant)
     info.update(mu=float(mu_arr[0]), **{"lambda": float(_lam(d, mu_arr)[0])}, implementation=implementation)
     if implementation == "block":
         P, Pf, Lf, Fe, Ge, it, change = _block(d, tol, max_iter)
         if not (np.all(np.isfinite(P)) and change < tol):
-            from ..errors import ConvergenceError
             raise ConvergenceError(f"the block recursion did not reach a steady state in max_iter={max_iter} steps "
                                    f"(relative change of P {change:.3g}, tol={tol:g})")
         info.update(residual=float(change), iterations=it)
@@ -303,8 +275,7 @@ def robust_kalman_gains(plant: Plant, W, V, *, Bw=None, H, EF, EG=None, EBw=None
     -------
     EstimatorBatch
         ``L`` (B, n, p), ``P``, the filters' models ``F``, ``G``, and the
-        per-design ``ok``, ``reason`` (``"rank"``: ``mu = inf`` with ``[EF
-        EBw]`` not of full row rank; ``"undetectable"``: every design, when
+        per-design ``ok``, ``reason`` (``"undetectable"``: every design, when
         ``(C, F)`` is not detectable; ``"diverged"``, ``"not converged"``). A
         design's failure is flagged, never raised; designs with the same
         arguments equal :func:`robust_kalman`'s.
@@ -330,12 +301,8 @@ def robust_kalman_gains(plant: Plant, W, V, *, Bw=None, H, EF, EG=None, EBw=None
     """
     tol = check_positive_scalar(tol, "tol")
     max_iter = check_int(max_iter, "max_iter")
-    plant, d, mu_arr, _ = _build(plant, W, V, Bw, H, EF, EG, EBw, None, None, mu, alpha, batch=True)
+    plant, d, _, _ = _build(plant, W, V, Bw, H, EF, EG, EBw, None, None, mu, alpha, batch=True)
     form = check_form(form, plant)
-    if undetectable_modes(plant).size:
+    if not plant.is_detectable:
         return _flagged(d.size, plant, form, "undetectable")
-    rank_ok = _rank(d, mu_arr)
-    st: SteadyState | None = steady_state(d.select(rank_ok), tol, max_iter) if rank_ok.any() else None
-    if st is None:
-        return _flagged(d.size, plant, form, "rank")
-    return batch_result(st, form, rank_ok, "rank")
+    return batch_result(steady_state(d, tol, max_iter), form)
