@@ -57,7 +57,7 @@ def _T(a: np.ndarray) -> np.ndarray:
 def measurement(P: np.ndarray, d: FilterModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(Pf, Lf, Re)`` from the a-priori ``P`` (B, n, n)."""
     CP = d.C @ P
-    Re = sym(CP @ d.C.T + d.R)
+    Re = CP @ d.C.T + d.R
     Lf = _T(solve(Re, CP))
     return sym(P - Lf @ Re @ _T(Lf)), Lf, Re
 

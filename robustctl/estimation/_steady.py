@@ -37,8 +37,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._kkt import doubling, healthy, relchange, solve, stein, sym
-from ..systems.stability import is_schur_stable
+from .._kkt import DIVERGED, doubling, healthy, relchange, solve, stein, sym
+from ..systems.stability import is_schur_stable, stability_of_eigenvalues
 from ._model import FilterModel
 from ._recursion import Gains, constraint, step
 
@@ -53,6 +53,8 @@ DOUBLING_MAX_STEPS = 64
 FLOOR = 1e-8
 #: Newton corrections of a doubling result at most.
 NEWTON_STEPS = 4
+#: Stacks of at most this many matrices are tested for stability by their eigenvalues.
+SMALL = 8
 
 
 class Evaluation(NamedTuple):
@@ -90,14 +92,17 @@ def _size(a: np.ndarray) -> np.ndarray:
 
 
 def standard_form(d: FilterModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(A, G, H)`` of the doubling, ``X = H + A' X (I + G X)^-1 A`` with ``A = Abar'`` (module docstring)."""
+    """``(A, G, H)`` of the doubling, ``X = H + A' X (I + G X)^-1 A`` with ``A = Abar'`` (module docstring).
+
+    ``G`` and ``H`` are symmetric up to rounding (the doubling symmetrises its iterates).
+    """
     n = d.F.shape[0]
-    Rinv_C = solve(d.R, np.broadcast_to(d.C, (d.size, *d.C.shape)))          # R^-1 C
-    A = np.broadcast_to(d.F, (d.size, n, n))
+    Rinv_C = solve(d.R, d.C[None] if d.size == 1 else np.broadcast_to(d.C, (d.size, *d.C.shape)))  # R^-1 C
+    A = d.F.T[None] if d.size == 1 else np.broadcast_to(d.F.T, (d.size, n, n))   # A = Abar'
     Gm = d.C.T @ Rinv_C
     H = d.Q
     if d.S is not None:
-        A = A - d.S @ Rinv_C
+        A = A - _T(d.S @ Rinv_C)
         H = H - d.S @ solve(d.R, _T(d.S))
     if d.uncertain:  # lambda^-1 floored for the doubling (module docstring)
         size = np.maximum(_size(d.EF @ d.Q @ _T(d.EF)), _size(d.Y))
@@ -106,21 +111,33 @@ def standard_form(d: FilterModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if d.EF.shape[1]:
             Ybar = d.Y + np.maximum(d.ell, floor[:, None])[:, :, None] * np.eye(d.EF.shape[1])
             sol = solve(Ybar, np.concatenate([d.EF, _T(d.X)], axis=2))     # Ybar^-1 [EF, X']
-            A = A - d.X @ sol[..., :n]
+            A = A - _T(d.X @ sol[..., :n])
             H = H - d.X @ sol[..., n:]
             Gm = Gm + _T(d.EF) @ sol[..., :n]
         if d.EC.shape[1]:
             Gm = Gm + _T(d.EC) @ d.EC / np.maximum(d.li, floor)[:, None, None]
-    return _T(A), sym(Gm), sym(H)
+    return A, Gm, H
+
+
+def _stable(A: np.ndarray) -> np.ndarray:
+    """``rho(A) < 1 - STABILITY_MARGIN`` per matrix of a stack (:func:`~robustctl.systems.stability.is_schur_stable`).
+
+    A few finite matrices (one design) take their eigenvalues directly
+    (:func:`~robustctl.systems.stability.stability_of_eigenvalues`), without
+    the argument checks that cost a single design as much as the eigenvalues.
+    """
+    if A.shape[0] <= SMALL and np.isfinite(A).all():
+        return stability_of_eigenvalues(np.linalg.eigvals(A), discrete=True)[1]
+    return np.asarray(is_schur_stable(A), dtype=bool)
 
 
 def evaluate(P: np.ndarray, d: FilterModel) -> Evaluation:
     """One exact step from ``P`` (a-priori, after ``EC``) for every design; NaN where ``P`` is not healthy."""
-    good = healthy(P)
-    everywhere = bool(good.all())
+    everywhere = bool(np.abs(P).max(initial=0.0) < DIVERGED)     # the usual case, in one reduction
+    good = np.ones(P.shape[0], dtype=bool) if everywhere else healthy(P)
     g = step(P if everywhere else np.where(good[:, None, None], P, np.eye(P.shape[1])), d)
     residual = relchange(g.P_next, P)
-    stable = np.asarray(is_schur_stable(g.closed_loop(d.C)), dtype=bool)
+    stable = _stable(g.closed_loop(d.C))
     if not everywhere:
         residual[~good] = np.inf
         stable &= good
@@ -143,16 +160,16 @@ def _put(ev: Evaluation, where: np.ndarray, other: Evaluation) -> Evaluation:
     return Evaluation(out[0], Gains(*out[1:-2]), out[-2], out[-1])
 
 
-def newton(P: np.ndarray, d: FilterModel, tol: float) -> tuple[Evaluation, np.ndarray]:
-    """Newton refinement of approximate fixed points ``P`` (after ``EC``).
+def newton(ev: Evaluation, d: FilterModel, tol: float) -> tuple[Evaluation, np.ndarray]:
+    """Newton refinement of approximate fixed points, from their evaluation ``ev`` (after ``EC``).
 
     Up to ``NEWTON_STEPS`` steps ``P <- P + Z``, ``Z = A Z A' + f(P) - P``,
     while the design's loop is stable and its residual above ``tol``; the
     evaluation with the smallest residual is kept. Returns it and the
-    number of evaluations per design.
+    number of steps per design.
     """
-    ev = best = evaluate(P, d)
-    count = np.ones(P.shape[0], dtype=int)
+    best = ev
+    count = np.zeros(ev.P.shape[0], dtype=int)
     for _ in range(NEWTON_STEPS):
         go = np.flatnonzero(ev.stable & ~(ev.residual < tol) & healthy(ev.gains.P_next))
         if not go.size:
@@ -199,7 +216,6 @@ def steady_state(d: FilterModel, tol: float = DEFAULT_TOL, max_iter: int = DEFAU
     ``accelerate``: doubling, Newton refinement, then the plain recursion
     where both miss the test; otherwise the plain recursion only (from :func:`start`).
     """
-    B = d.size
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         if accelerate:
             X, iterations, settled = doubling(*standard_form(d), DOUBLING_TOL, DOUBLING_MAX_STEPS)
@@ -207,7 +223,7 @@ def steady_state(d: FilterModel, tol: float = DEFAULT_TOL, max_iter: int = DEFAU
             if not ev.accepted(tol).all():
                 sub = np.flatnonzero(settled & ev.stable & ~ev.accepted(tol))
                 if sub.size:                                   # Newton, then the recursion where it misses
-                    refined, count = newton(ev.P[sub], d.select(sub), tol)
+                    refined, count = newton(_rows(ev, sub), d.select(sub), tol)
                     ev = _put(ev, sub, refined)
                     iterations[sub] += count
                 todo = np.flatnonzero(~ev.accepted(tol))
@@ -219,8 +235,10 @@ def steady_state(d: FilterModel, tol: float = DEFAULT_TOL, max_iter: int = DEFAU
         else:
             P, iterations = recursion(d, start(d), tol, max_iter)
             ev = evaluate(P, d)
-    diverged = ~healthy(ev.gains.P_next) | ~np.isfinite(ev.gains.Lf).all(axis=(1, 2))
-    reason = np.full(B, "ok", dtype="<U13")
-    reason[diverged] = "diverged"
-    reason[~diverged & ~ev.accepted(tol)] = "not converged"
+    accepted = ev.accepted(tol)
+    if accepted.all():
+        reason = np.full(accepted.shape, "ok", dtype="<U13")
+    else:
+        diverged = ~healthy(ev.gains.P_next) | ~np.isfinite(ev.gains.Lf).all(axis=(1, 2))
+        reason = np.where(diverged, "diverged", np.where(accepted, "ok", "not converged")).astype("<U13")
     return SteadyState(ev.P, ev.gains, iterations, ev.residual, ev.stable, reason)
