@@ -115,23 +115,23 @@ def main(argv=None) -> None:
     cmd = "python -m benchmarks.bench_estimation " + " ".join(sys.argv[1:] if argv is None else argv)
     lines = header("Estimation: the Kalman filter and the batched robust filter against control.dlqe", cmd.strip())
     lines += [
-        f"The paper's truck (n = 4, m = 1) with three sensors (rho, theta, psidot), Bw = I. Peer: "
-        f"`control.dlqe` (python-control {control.__version__}) on the same plant, timed in the same process, "
-        f"alternating with ours for each round; medians over the rounds, BLAS on one thread. "
-        f"`rc.kalman` against `dlqe` on this plant: gains and a-priori covariance agree to {agree:.1e} (relative).",
+        (f"The paper's truck (n = 4, m = 1) with three sensors (rho, theta, psidot), Bw = I. Peer: "
+         f"`control.dlqe` (python-control {control.__version__}) on the same plant, timed in the same process, "
+         f"alternating with ours for each round; medians over the rounds, BLAS on one thread. "
+         f"`rc.kalman` against `dlqe` on this plant: gains and a-priori covariance agree to {agree:.1e} (relative)."),
         "",
         "| what | peer | ours | ours / peer: median (max) | target | met |",
         "|---|---|---|---|---|---|",
-        f"| steady-state `rc.kalman`, one design per call ({args.rounds} rounds x {args.calls} calls) | "
-        f"{single[1] * 1e6:.1f} us | {single[2] * 1e6:.1f} us | **{single[0]:.2f}** ({single[3]:.2f}) | <= 1.5 | "
-        f"{'yes' if single_ok else 'NO'} |",
-        f"| `rc.robust_kalman_gains`, {args.batch} uncertainty models in one call against {args.batch} `dlqe` "
-        f"calls ({rounds} rounds) | {many[1] * 1e3:.1f} ms | {many[2] * 1e3:.1f} ms | **{many[0]:.3f}** "
-        f"({many[3]:.3f}) | <= 0.2 | {'yes' if many_ok else 'NO'} |",
+        (f"| steady-state `rc.kalman`, one design per call ({args.rounds} rounds x {args.calls} calls) | "
+         f"{single[1] * 1e6:.1f} us | {single[2] * 1e6:.1f} us | **{single[0]:.2f}** ({single[3]:.2f}) | <= 1.5 | "
+         f"{'yes' if single_ok else 'NO'} |"),
+        (f"| `rc.robust_kalman_gains`, {args.batch} uncertainty models in one call against {args.batch} `dlqe` "
+         f"calls ({rounds} rounds) | {many[1] * 1e3:.1f} ms | {many[2] * 1e3:.1f} ms | **{many[0]:.3f}** "
+         f"({many[3]:.3f}) | <= 0.2 | {'yes' if many_ok else 'NO'} |"),
         "",
-        f"Robust batch: {int(result.ok.sum())}/{len(result)} designs ok; iterations (doubling steps plus Newton "
-        f"steps) {np.bincount(result.iterations).tolist()} (count per number of iterations), per design "
-        f"{many[2] / args.batch * 1e6:.1f} us.",
+        (f"Robust batch: {int(result.ok.sum())}/{len(result)} designs ok; iterations (doubling steps plus Newton "
+         f"steps) {np.bincount(result.iterations).tolist()} (count per number of iterations), per design "
+         f"{many[2] / args.batch * 1e6:.1f} us."),
     ]
     print("\n".join(lines[3:]))
     write(lines, args.out)
