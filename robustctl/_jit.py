@@ -1,4 +1,4 @@
-"""The one way robustctl compiles a numba kernel: :func:`jit`.
+"""The one way robustctl compiles a numba kernel: :func:`~robustctl._jit.jit`.
 
 ``cache=True`` writes the machine code next to the module (``__pycache__``)
 or, if that directory is not writable, to numba's user-wide cache directory

@@ -8,7 +8,7 @@ it the usual way.
 from __future__ import annotations
 
 __all__ = ["RobustCtlError", "ConvergenceError", "RankConditionError", "InfeasibleError", "NotStabilizableError",
-           "NotStabilizingError"]
+           "NotDetectableError", "NotStabilizingError"]
 
 
 class RobustCtlError(Exception):
@@ -36,6 +36,16 @@ class NotStabilizableError(ConvergenceError, InfeasibleError):
     ``lqr`` raised when its Riccati solver failed on such plants) and an
     :class:`InfeasibleError` (what the LMI syntheses raise when no gain
     exists), so handlers written for either keep working.
+    """
+
+
+class NotDetectableError(ConvergenceError, InfeasibleError):
+    """The plant is not detectable: some unstable mode is not seen by the outputs ``C`` (PBH test).
+
+    The dual of :class:`NotStabilizableError`, raised by the estimators and
+    the output-feedback syntheses before they start
+    (:func:`robustctl.systems.stability.check_detectable`): no observer gain
+    makes the estimation error of such a plant converge.
     """
 
 

@@ -480,7 +480,8 @@ def test_results_are_frozen_and_readable():
 
 def test_bad_input_names_the_argument():
     plant, K, unc = random_case(0, 3, True, 0.05)
-    with pytest.raises(TypeError, match=r"controller must be a robustctl\.Controller or a \(Plant, K\) pair"):
+    with pytest.raises(TypeError,
+                       match=r"controller must be a robustctl\.Controller, a ControllerBatch or a \(Plant, K\) pair"):
         rc.robust_stability(K, unc)
     with pytest.raises(ValueError, match="K must have 2 rows \\(the number of inputs\\), got shape \\(3, 3\\)"):
         rc.robust_stability((plant, np.eye(3)), unc)

@@ -395,6 +395,7 @@ def build_designs(problem: TuningProblem, X_front, *, seed=None) -> DesignSet:
     batch = problem.gains(np.vstack([X, z_random]))
     K_rlqr = np.where(batch.ok[:, None, None], batch.K, np.nan)
     K_nom = rc.lqr(problem.plant, Q=problem.Q, R=problem.R).K
+    assert K_nom is not None                                 # lqr designs a state feedback
     N = X.shape[0]
     extras = [("nominal", "nominal", K_nom[None], np.full((1, problem.n_var), np.nan))]
     if isinstance(problem, AppliedRLQRProblem):

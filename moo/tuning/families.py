@@ -269,6 +269,7 @@ class RLQRFamily:
     def nominal(self) -> np.ndarray:
         """The gain with no uncertainty: the LQR of ``Q``, ``R`` on the design plant (through the input map)."""
         K = rc.lqr(self.design_plant, Q=self.Q, R=self.R).K
+        assert K is not None                                 # lqr designs a state feedback
         return K if self.input_map is None else self.input_map @ K
 
     def __repr__(self) -> str:

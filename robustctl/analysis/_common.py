@@ -13,9 +13,11 @@ import scipy.linalg
 from .. import _cvx
 from .._validation import as_float_array, as_matrix
 from ..errors import ConvergenceError
-from ..systems.controller import Controller
+from ..systems.controller import Controller, ControllerBatch
+from ..systems.interconnect import augmented_gain
 from ..systems.plant import Plant
 from ..systems.stability import spectral_abscissa, spectral_radius
+from ..systems.uncertainty import NormBounded, check_norm_bounded
 
 # Regularisation (relative to the weight's norm) of the Lyapunov equation defining the coordinates.
 _REG = 1e-3
@@ -41,13 +43,61 @@ _ASCENT_ITER = 200
 
 
 # ---------------------------------------------------------------- validation
+def _augmented_plant(plant: Plant, order: int) -> Plant:
+    """``(diag(F, 0), diag(G, I), dt)``: the plant whose static gain ``K_a`` is a dynamic controller's loop."""
+    if order == 0:
+        return plant
+    n = plant.n
+    Fa = np.zeros((n + order, n + order))
+    Fa[:n, :n] = plant.F
+    return Plant(Fa, scipy.linalg.block_diag(plant.G, np.eye(order)), plant.dt)
+
+
+def _augmented_uncertainty(uncertainty: NormBounded, order: int) -> NormBounded:
+    """The uncertainty of the augmented loop: ``H_a = [H; 0]``, ``EF_a = [EF 0]``, ``EG_a = [EG 0]``.
+
+    The controller is known exactly: the uncertainty acts on the plant part
+    (:mod:`robustctl.systems.interconnect`).
+    """
+    if order == 0:
+        return uncertainty
+    H, EF, EG = uncertainty.H, uncertainty.EF, uncertainty.EG
+    pad = np.zeros((EF.shape[0], order))
+    return NormBounded(np.vstack([H, np.zeros((order, H.shape[1]))]), np.hstack([EF, pad]), np.hstack([EG, pad]))
+
+
+def _uncertain_loop(controller, uncertainty, batch: bool = False) -> tuple[Plant, np.ndarray, NormBounded]:
+    """``(plant, K, uncertainty)`` of :func:`_loop`, the uncertainty checked against the controller's plant.
+
+    For a dynamic controller all three are those of the augmented loop.
+    """
+    plant, K = _loop(controller, batch)
+    base = controller[0] if isinstance(controller, tuple) else controller.plant
+    return plant, K, _augmented_uncertainty(check_norm_bounded(uncertainty, base), plant.n - base.n)
+
+
 def _loop(controller, batch: bool = False) -> tuple[Plant, np.ndarray]:
-    """``(plant, K)`` from a Controller or a ``(plant, K)`` pair.
+    """``(plant, K)`` from a Controller, a ControllerBatch or a ``(plant, K)`` pair.
 
     With ``batch``, ``K`` may also be a stack (B, m, n) (returned 3-D; its
-    entries may be non-finite: the caller flags those designs).
+    entries may be non-finite: the caller flags those designs). A dynamic
+    controller (or batch) comes back as the static gain ``K_a`` of its
+    augmented plant (:mod:`robustctl.systems.interconnect`); an ill-posed
+    loop of a batch has NaN entries.
     """
+    if isinstance(controller, ControllerBatch) or (isinstance(controller, Controller) and controller.is_dynamic):
+        single = isinstance(controller, Controller)
+        if not single and not batch:
+            raise TypeError("controller must be one robustctl.Controller here, got a ControllerBatch; "
+                            "analyse its designs one at a time (batch[i])")
+        stack = controller.as_batch() if isinstance(controller, Controller) else controller
+        C, D = stack.plant.output_matrices()
+        Ka, ok = augmented_gain(C, D, stack.Ac, stack.Bc, stack.Cc, stack.Dc)
+        if single and not ok[0]:
+            raise ValueError("controller: the loop is ill posed (I - Dc D is singular: u depends on itself)")
+        return _augmented_plant(stack.plant, stack.order), Ka[0] if single else Ka
     if isinstance(controller, Controller):
+        assert controller.K is not None
         return controller.plant, controller.K
     if isinstance(controller, tuple) and len(controller) == 2 and isinstance(controller[0], Plant):
         plant = controller[0]
@@ -65,7 +115,8 @@ def _loop(controller, batch: bool = False) -> tuple[Plant, np.ndarray]:
         K = as_matrix(controller[1], "K", rows=plant.m, cols=plant.n,
                       rows_what="the number of inputs", cols_what="the number of states")
         return plant, K
-    raise TypeError(f"controller must be a robustctl.Controller or a (Plant, K) pair, got {type(controller).__name__}")
+    raise TypeError(f"controller must be a robustctl.Controller, a ControllerBatch or a (Plant, K) pair, "
+                    f"got {type(controller).__name__}")
 
 
 # ---------------------------------------------------------------- linear algebra

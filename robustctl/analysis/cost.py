@@ -19,7 +19,7 @@ from ..errors import InfeasibleError
 from ..systems.controller import Controller
 from ..systems.plant import Plant
 from ..systems.stability import is_stable, stability_of_eigenvalues
-from ..systems.uncertainty import NormBounded, check_norm_bounded
+from ..systems.uncertainty import NormBounded
 from . import _hinfnorm
 from ._common import (
     _COST_LMI_TOL,
@@ -27,18 +27,17 @@ from ._common import (
     _blocks,
     _Coordinates,
     _diag,
-    _loop,
     _lyapunov_factor,
     _radius,
     _solve_info,
+    _uncertain_loop,
 )
 from .results import CostBound, CostBoundBatch, HinfBound, _ro
 
 
 def _robust_loop(controller, uncertainty, what: str):
     """``(plant, K, A, H, E)`` after checking that the loop is robustly stable (small gain < 1)."""
-    plant, K = _loop(controller)
-    unc = check_norm_bounded(uncertainty, plant)
+    plant, K, unc = _uncertain_loop(controller, uncertainty)
     discrete = plant.is_discrete
     A, H, E = plant.F + plant.G @ K, unc.H, unc.EF + unc.EG @ K
     if not is_stable(A, discrete=discrete):
@@ -90,7 +89,7 @@ def _cost_lmi_eigs(A, H, E, QK, P, lam, discrete: bool) -> np.ndarray:
 
 def _guaranteed_cost_batch(plant: Plant, K: np.ndarray, unc: NormBounded, Q: np.ndarray, R: np.ndarray,
                            x0: np.ndarray | None) -> CostBoundBatch:
-    """:func:`guaranteed_cost` of a stack of gains by Riccati equations and a search over the multiplier.
+    """:func:`robustctl.guaranteed_cost` of a stack of gains by Riccati equations and a search over the multiplier.
 
     For a fixed ``lam`` the smallest ``P`` of the guaranteed-cost LMI is the
     stabilising solution ``P_lam`` of the bounded-real Riccati equation of
@@ -246,24 +245,22 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     """
     import cvxpy as cp
 
-    plant, K = _loop(controller, batch=True)
-    if K.ndim == 3:
-        unc = check_norm_bounded(uncertainty, plant)
-        n, m = plant.n, plant.m
-        Qc = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
-                                 cols_what="the number of states"), "Q", semidefinite=True)
-        Rc = check_spd(as_matrix(R, "R", rows=m, cols=m, rows_what="the number of inputs",
-                                 cols_what="the number of inputs"), "R", semidefinite=True)
-        x0b = None if x0 is None else as_batch(x0, "x0", (n,), ("the number of states",))
-        return _guaranteed_cost_batch(plant, K, unc, Qc, Rc, x0b)
-    plant, K, A, H, E = _robust_loop(controller, uncertainty, "guaranteed cost")
-    n, m, p = plant.n, plant.m, H.shape[1]
+    plant, K, unc = _uncertain_loop(controller, uncertainty, batch=True)
+    base = controller[0] if isinstance(controller, tuple) else controller.plant
+    n, m, order = base.n, base.m, plant.n - base.n
     Q = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
                             cols_what="the number of states"), "Q", semidefinite=True)
     R = check_spd(as_matrix(R, "R", rows=m, cols=m, rows_what="the number of inputs",
                             cols_what="the number of inputs"), "R", semidefinite=True)
     if x0 is not None:
         x0 = as_batch(x0, "x0", (n,), ("the number of states",))
+    if order:   # a dynamic controller: its states start at 0 and its own update is not weighted
+        Q, R = _diag(Q, np.zeros((order, order))), _diag(R, np.zeros((order, order)))
+        x0 = None if x0 is None else np.concatenate([x0, np.zeros(order)])
+    if K.ndim == 3:
+        return _guaranteed_cost_batch(plant, K, unc, Q, R, x0)
+    plant, K, A, H, E = _robust_loop(controller, uncertainty, "guaranteed cost")
+    n, p = plant.n, H.shape[1]
     QK = Q + K.T @ R @ K
     T = _Coordinates(_lyapunov_factor(A, QK, plant.is_discrete))
     Ah, QKh = T.A(A), T.Q(QK)
@@ -319,8 +316,12 @@ def robust_hinf_bound(controller: Controller | tuple[Plant, ArrayLike], uncertai
     import cvxpy as cp
 
     plant, K, A, H, E = _robust_loop(controller, uncertainty, "robust H-infinity bound")
-    n, p = plant.n, H.shape[1]
-    Bw, Cz, Dzu, Dzw = check_performance(n, plant.m, Bw, Cz, Dzu, Dzw)
+    base = controller[0] if isinstance(controller, tuple) else controller.plant
+    n, p, order = plant.n, H.shape[1], plant.n - base.n
+    Bw, Cz, Dzu, Dzw = check_performance(base.n, base.m, Bw, Cz, Dzu, Dzw)
+    if order:   # a dynamic controller: w and z act on the plant's states and inputs only
+        Bw = np.vstack([Bw, np.zeros((order, Bw.shape[1]))])
+        Cz, Dzu = (np.hstack([M, np.zeros((M.shape[0], order))]) for M in (Cz, Dzu))
     C = Cz + Dzu @ K
     q = Bw.shape[1]
     T = _Coordinates(_lyapunov_factor(A, C.T @ C, plant.is_discrete))

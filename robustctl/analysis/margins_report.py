@@ -137,10 +137,13 @@ def _model(name: str, model) -> NormBounded | list[Plant]:
     return list(model)
 
 
-def _law(name: str, law) -> InputMemoryFeedback:
+def _law(name: str, law, plant: Plant) -> InputMemoryFeedback | Controller:
+    """A law with input memory, or a dynamic controller of ``plant`` (analysed as its augmented loop)."""
     if isinstance(law, InputMemoryFeedback):
         return law
     if isinstance(law, Controller):
+        if law.K is None:
+            return Controller.dynamic(*law._matrices(), law.method, plant)
         return InputMemoryFeedback(law.K)
     try:
         return InputMemoryFeedback(law)
@@ -164,7 +167,8 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
     plant : Plant
         The nominal plant the controllers were designed for.
     controllers : Mapping of str to (m, n) array_like, Controller or InputMemoryFeedback
-        Named gains ``u = K x`` (or laws with input memory), in row order.
+        Named gains ``u = K x``, laws with input memory or dynamic output
+        feedbacks (analysed with ``plant``), in row order.
     models : Mapping of str to NormBounded or sequence of Plant
         Named uncertainty models, in column order; a sequence of plants is
         a polytope's vertices besides ``plant``.
@@ -205,18 +209,22 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
         raise TypeError("controllers must be a non-empty mapping of name -> gain")
     if not isinstance(models, Mapping) or not models:
         raise TypeError("models must be a non-empty mapping of name -> NormBounded or list of Plant")
-    laws = {str(c): _law(str(c), law) for c, law in controllers.items()}
+    laws = {str(c): _law(str(c), law, plant) for c, law in controllers.items()}
     checked = {str(k): _model(str(k), m) for k, m in models.items()}
     results: dict[str, Mapping[str, RobustStability | str]] = {}
     for name, law in laws.items():
-        nominal = law.augmented_plant(plant)
         row: dict[str, RobustStability | str] = {}
         for key, model in checked.items():
             try:
-                if isinstance(model, NormBounded):
-                    res = robust_stability((nominal, law.gain), law.augmented_uncertainty(model, plant))
+                if isinstance(law, Controller):
+                    res = (robust_stability(law, model) if isinstance(model, NormBounded)
+                           else robust_stability(law, vertices=model))
+                elif isinstance(model, NormBounded):
+                    res = robust_stability((law.augmented_plant(plant), law.gain),
+                                           law.augmented_uncertainty(model, plant))
                 else:
-                    res = robust_stability((nominal, law.gain), vertices=[law.augmented_plant(v) for v in model])
+                    res = robust_stability((law.augmented_plant(plant), law.gain),
+                                           vertices=[law.augmented_plant(v) for v in model])
                 row[key] = cast("RobustStability", res)        # one gain (m, n): never a batch
             except (RobustCtlError, ValueError) as exc:
                 row[key] = f"n/a ({str(exc).splitlines()[0][:60]})"

@@ -205,7 +205,7 @@ class CostBound:
 
 @dataclass(frozen=True, eq=False, repr=False)
 class CostBoundBatch:
-    """Guaranteed LQ costs of a stack of gains ``K`` (B, m, n) on one plant (:func:`guaranteed_cost`).
+    """Guaranteed LQ costs of a stack of gains ``K`` (B, m, n) on one plant (:func:`robustctl.guaranteed_cost`).
 
     Design ``b`` gets the bound of :class:`CostBound` (computed by Riccati
     equations and a search over the multiplier instead of an SDP), as

@@ -22,7 +22,7 @@ from ..errors import ConvergenceError, InfeasibleError
 from ..systems.controller import Controller
 from ..systems.plant import Plant, check_vertices
 from ..systems.stability import is_stable, stability_of_eigenvalues
-from ..systems.uncertainty import NormBounded, check_norm_bounded
+from ..systems.uncertainty import NormBounded
 from . import _hinfnorm
 from ._common import (
     _BACKOFF,
@@ -33,6 +33,7 @@ from ._common import (
     _POLY_T,
     _SDA_MIN_N,
     _STRICT,
+    _augmented_plant,
     _block,
     _blocks,
     _Coordinates,
@@ -42,6 +43,7 @@ from ._common import (
     _min_eig,
     _radius,
     _solve_info,
+    _uncertain_loop,
 )
 from .results import RobustStability, RobustStabilityBatch, _ro
 
@@ -510,16 +512,18 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
     >>> rc.robust_stability(ctrl, vertices=[truck_plant(300.0)]).certified
     True
     """
-    plant, K = _loop(controller, batch=True)
     if (uncertainty is None) == (vertices is None):
         raise ValueError("give exactly one of uncertainty (a NormBounded) and vertices (a list of Plant)")
     if vertices is not None:
+        plant, K = _loop(controller, batch=True)
+        base = controller[0] if isinstance(controller, tuple) else controller.plant
         # a polytope needs a vertex besides the nominal plant
-        plants = check_vertices(plant, vertices, reference="the controller's plant", non_empty=True)
+        plants = check_vertices(base, vertices, reference="the controller's plant", non_empty=True)
+        plants = [plant, *(_augmented_plant(v, plant.n - base.n) for v in plants[1:])]
         if K.ndim == 2:
             return _polytope_stability(plants, K)
         return _polytope_batch(plants, K)
-    unc = check_norm_bounded(uncertainty, plant)
+    plant, K, unc = _uncertain_loop(controller, uncertainty, batch=True)
     if K.ndim == 2:
         return _norm_bounded_stability(plant, K, unc)
     return _norm_bounded_batch(plant, K, unc)

@@ -14,8 +14,8 @@ from .._validation import as_rng, check_int, frozen
 from ..systems.controller import Controller
 from ..systems.plant import Plant
 from ..systems.stability import is_stable
-from ..systems.uncertainty import NormBounded, check_norm_bounded
-from ._common import _ASCENT_ITER, _loop, _radius
+from ..systems.uncertainty import NormBounded
+from ._common import _ASCENT_ITER, _radius, _uncertain_loop
 from .results import WorstCase
 
 
@@ -115,8 +115,7 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     """
     import control
 
-    plant, K = _loop(controller)
-    unc = check_norm_bounded(uncertainty, plant)
+    plant, K, unc = _uncertain_loop(controller, uncertainty)
     try:
         n_starts = check_int(n_starts, "n_starts", minimum=0)
     except TypeError as exc:  # worst_case has raised ValueError for every bad n_starts: keep that type

@@ -10,7 +10,7 @@ For B gains and S scenarios (plants) at once::
 maps its m inputs to the plant's p physical inputs (identity by default);
 ``F``, ``G``, ``x_ref``, ``u_ff``, ``w`` may differ between scenarios and, for
 the plant, between time steps. :class:`LinearSimulator` checks the plant,
-reference and options once; its :meth:`~LinearSimulator.run` then checks only
+reference and options once; its :meth:`~robustctl.sim.simulator.LinearSimulator.run` then checks only
 the gains, so an optimiser that simulates a population per generation pays
 the argument checks once. :func:`simulate_linear` does both in one call.
 
@@ -63,7 +63,7 @@ __all__ = ["SimulationResult", "LinearSimulator", "simulate_linear", "check_gain
 
 #: Divergence bound on ``|x - x_ref|`` (any component), in the states' units.
 DEFAULT_BOUND = 1e3
-#: Names :meth:`LinearSimulator.run` accepts as ``backend``.
+#: Names :meth:`robustctl.sim.simulator.LinearSimulator.run` accepts as ``backend``.
 BACKENDS = ("numba", "numpy")
 
 

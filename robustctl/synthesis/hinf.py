@@ -257,8 +257,8 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
 
     ``x+ = F x + Bw w + G u``, ``z = Cz x + Dzw w + Dzu u`` (discrete plant) or
     ``x' = F x + Bw w + G u`` (continuous plant, ``plant.dt is None``; ``F``,
-    ``G`` are then ``A``, ``B``). The LMIs are given in the docstring of :mod:`robustctl.synthesis.hinf`;
-    the stages in that of :mod:`robustctl.synthesis.hinf`.
+    ``G`` are then ``A``, ``B``). The LMIs and the stages of the
+    synthesis are given in the docstring of its module, ``robustctl.synthesis.hinf``.
 
     Parameters
     ----------
@@ -313,7 +313,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         ``||Delta||_2 <= 1`` (also time-varying) around every vertex: the
         bound ``gamma`` then holds for every such plant (quadratic
         stability and performance, by the S-procedure with one multiplier
-        per vertex; see :mod:`robustctl.synthesis.hinf`). The convex counterpart of
+        per vertex; see ``robustctl.synthesis.hinf``). The convex counterpart of
         :func:`robustctl.rlqr`. ``H = 0`` or ``[EF EG] = 0`` is the nominal
         design. Pole regions apply to the nominal vertices. Standard LMI only.
     solver : str, default "CLARABEL"
@@ -354,7 +354,7 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
         ``solve_time``, ``iterations`` and ``certificate`` (of the blocks
         that solve imposed: ``hinf_projected[0]`` and ``hinf_phi[0]`` when
         the level of the plain discrete problem was minimised with ``Y``
-        eliminated, see :mod:`robustctl.synthesis.hinf`); centring solves also name
+        eliminated, see ``robustctl.synthesis.hinf``); centring solves also name
         their ``centring`` variant. ``synthesis`` (``"lmi"`` or
         ``"riccati"``: the path that returned the gain) and, with
         ``synthesis="riccati"``, ``riccati`` (bisection ``iterations`` and

@@ -9,13 +9,15 @@ and PBH tests that they need (:mod:`robustctl.systems.stability`). This
 layer imports only robustctl's base modules (errors, validation).
 """
 
-from .controller import Controller
+from .controller import Controller, ControllerBatch
 from .input_memory import InputMemoryFeedback
+from .noise import noise_covariance
 from .plant import Plant
 from .regions import ConicSector, Disk, HalfPlane
 from .scenarios import PlantSamples, sample_plants
 from .stability import STABILITY_MARGIN, is_schur_stable, spectral_radius
 from .uncertainty import NormBounded
 
-__all__ = ["Plant", "NormBounded", "Controller", "InputMemoryFeedback", "Disk", "HalfPlane", "ConicSector",
-           "sample_plants", "PlantSamples", "spectral_radius", "is_schur_stable", "STABILITY_MARGIN"]
+__all__ = ["Plant", "NormBounded", "Controller", "ControllerBatch", "InputMemoryFeedback", "Disk", "HalfPlane",
+           "ConicSector", "sample_plants", "PlantSamples", "noise_covariance", "spectral_radius", "is_schur_stable",
+           "STABILITY_MARGIN"]

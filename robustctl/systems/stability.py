@@ -37,10 +37,11 @@ import numpy as np
 import scipy.linalg
 
 from .._validation import as_float_array, as_matrix, check_square
-from ..errors import NotStabilizableError
+from ..errors import NotDetectableError, NotStabilizableError
 
 __all__ = ["STABILITY_MARGIN", "spectral_radius", "spectral_abscissa", "is_schur_stable", "is_stable",
-           "stability_of_eigenvalues", "immovable_modes", "unstabilizable_modes", "check_stabilizable"]
+           "stability_of_eigenvalues", "immovable_modes", "unstabilizable_modes", "check_stabilizable",
+           "undetectable_modes", "check_detectable"]
 
 #: A discrete loop is stable when ``rho(A) < 1 - STABILITY_MARGIN``.
 STABILITY_MARGIN = 1e-9
@@ -200,6 +201,13 @@ def unstabilizable_modes(F, G, *, discrete: bool = True) -> np.ndarray:
     return _immovable(F, G, scale, modes[unstable])
 
 
+def undetectable_modes(F, C, *, discrete: bool = True) -> np.ndarray:
+    """Eigenvalues of ``F`` that are not stable and that ``C`` does not see (PBH test on ``(F', C')``)."""
+    F = check_square(as_matrix(F, "F"), "F")
+    C = as_matrix(C, "C", cols=F.shape[0], cols_what="the number of states, from F")
+    return unstabilizable_modes(F.T, C.T, discrete=discrete)
+
+
 def check_stabilizable(plant, name: str = "plant") -> None:
     """Raise :class:`~robustctl.errors.NotStabilizableError` if ``plant`` (a ``Plant``) is not stabilisable.
 
@@ -215,3 +223,18 @@ def check_stabilizable(plant, name: str = "plant") -> None:
         raise NotStabilizableError(
             f"{name} is not stabilisable: its mode lambda = {complex(stuck[0]):.6g} ({kind}) cannot be moved "
             "by the input G (PBH rank test), so no gain u = K x makes the loop stable")
+
+
+def check_detectable(plant, name: str = "plant") -> None:
+    """Raise :class:`~robustctl.errors.NotDetectableError` if ``plant`` (a ``Plant`` with outputs) is not detectable.
+
+    The estimators and the output-feedback syntheses call this first: no
+    observer gain makes the estimation error of such a plant converge.
+    ``name`` names the plant in the message.
+    """
+    hidden = plant.undetectable_modes  # cached on the plant
+    if hidden.size:
+        kind = "|lambda| >= 1" if plant.is_discrete else "Re(lambda) >= 0"
+        raise NotDetectableError(
+            f"{name} is not detectable: its mode lambda = {complex(hidden[0]):.6g} ({kind}) is not seen by the "
+            "outputs C (PBH rank test), so no observer makes the estimation error converge; measure that mode")

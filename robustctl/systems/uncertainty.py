@@ -8,7 +8,7 @@ state-space estimation with uncertain models", IEEE TAC 46(7).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -88,7 +88,7 @@ class NormBounded:
         if D.shape[0] != 1:
             raise ValueError(f"perturb takes one Delta; got {D.shape[0]} (use perturbed_matrices)")
         F, G = self.perturbed_matrices(plant, D[0])
-        return Plant(F[0], G[0], plant.dt)
+        return replace(plant, F=F[0], G=G[0])   # outputs and disturbance input kept
 
     def perturbed_matrices(self, plant: Plant, Deltas) -> tuple[np.ndarray, np.ndarray]:
         """Stacked perturbed matrices for S realisations ``Deltas`` of shape (S, p, l).

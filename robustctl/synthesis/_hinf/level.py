@@ -101,7 +101,7 @@ def solve_level(problem: Problem, data: Coordinates, *, z_scale: float = 1.0, pr
 
 
 def projected_form(problem: Problem, n: int) -> bool:
-    """Whether the level of ``problem`` is minimised over the projected blocks (:func:`._lmis.projected_blocks`).
+    """Whether the level of ``problem`` is minimised over the projected blocks (:func:`.lmis.projected_blocks`).
 
     The plain discrete problem (one plant, standard LMI, no input bound,
     pole region or uncertainty) with a backoff, up to ``PROJECTED_MAX_N``
@@ -111,13 +111,13 @@ def projected_form(problem: Problem, n: int) -> bool:
 
 
 def _solve_projected(problem: Problem, data: Coordinates, z_scale: float) -> Solved | None:
-    """The level over the projected blocks, with ``Y = K X`` from :func:`._lmis.projected_gain`; ``None`` on failure.
+    """The level over the projected blocks, with ``Y = K X`` from :func:`.lmis.projected_gain`; ``None`` on failure.
 
     The gain is the weighted least-squares one at the optimum ``(X, eta)``
     itself (``Phi`` floored where the optimum makes it singular): on the
     plants tried it is the gain ``Y X^-1`` of the full block's optimum to
     the accuracy of the solve, and like that one it is certified at the
-    backed-off level by :func:`._gains.optimum_certified`. A failure
+    backed-off level by :func:`.gains.optimum_certified`. A failure
     (solver, certificate or ``Phi``) leaves the decision to the full block.
     """
     import cvxpy as cp

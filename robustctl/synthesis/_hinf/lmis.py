@@ -3,7 +3,7 @@
 The blocks (each ``M >= margin I``, see :class:`robustctl._cvx.LMI`) are
 built from a :class:`Point`, which holds either cvxpy variables (to solve)
 or arrays (to evaluate a candidate's certificate with the very same code).
-The maths is in the docstring of :mod:`robustctl.synthesis.hinf`.
+The maths is in the docstring of ``robustctl.synthesis.hinf``.
 """
 
 from __future__ import annotations
@@ -102,7 +102,7 @@ def hinf_blocks(data: Coordinates, V: Point, level_sq, *, discrete: bool, margin
     variable); ``z_scale`` multiplies ``z``. The constant disturbance block
     ``I`` is eliminated by a Schur complement (``q`` rows smaller, still
     linear). With an uncertainty in ``data`` (and multipliers in ``V``) the
-    block is the robust one of :mod:`robustctl.synthesis.hinf` (S-procedure).
+    block is the robust one of ``robustctl.synthesis.hinf`` (S-procedure).
     """
     Ip = np.eye(data.p)
     Cz, Dzu, Dzw = z_scale * data.Cz, z_scale * data.Dzu, z_scale * data.Dzw
@@ -271,7 +271,7 @@ def region_blocks(regions, data: Coordinates, V: Point, margin=0.0) -> list[_cvx
 
 def blocks(problem, data: Coordinates, V: Point, level_sq, *, margin=0.0, z_scale: float = 1.0,
            x_bounds: tuple[Any, float] | None = None) -> list[_cvx.LMI]:
-    """Every LMI block of one H-infinity synthesis problem (a :class:`._problem.Problem`), named.
+    """Every LMI block of one H-infinity synthesis problem (a :class:`.problem.Problem`), named.
 
     The H-infinity and pole-region blocks get ``margin``. With ``x_bounds =
     (x_margin, x_upper)`` the Lyapunov (or slack) matrix is also bounded,

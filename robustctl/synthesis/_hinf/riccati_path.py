@@ -1,7 +1,7 @@
-"""The ``synthesis="riccati"`` fast path of :mod:`robustctl.synthesis.hinf` for the plain problem.
+"""The ``synthesis="riccati"`` fast path of ``robustctl.synthesis.hinf`` for the plain problem.
 
 One plant, no input bound, pole region or uncertainty (standard LMI, free
-level). In the balanced, unit-channel coordinates of :func:`._coordinates.normalised`:
+level). In the balanced, unit-channel coordinates of :func:`.coordinates.normalised`:
 
 1. the optimal level ``gamma_opt`` by bisection on the game Riccati equation
    (:func:`robustctl.synthesis.hinf_riccati.bisect_level`: the stabilising solution
@@ -10,10 +10,10 @@ level). In the balanced, unit-channel coordinates of :func:`._coordinates.normal
 2. the gain ``K`` of the saddle point at ``(1 + backoff / 2) gamma_opt``
    (well inside the feasible set, so ``K`` is moderate even where the
    optimum needs an unbounded gain);
-3. the LMI certificate of :mod:`robustctl.synthesis.hinf` at ``(1 + backoff)
+3. the LMI certificate of ``robustctl.synthesis.hinf`` at ``(1 + backoff)
    gamma_opt``: a strictly feasible ``(X, K X)`` built from the closed loop's
    bounded-real Riccati equation and accepted only on the eigenvalues of
-   every LMI block (:func:`._gains.riccati_certified`), the same check as the
+   every LMI block (:func:`.gains.riccati_certified`), the same check as the
    SDP path.
 
 If a step fails (a Riccati solve rejected by its checks, or no strictly
@@ -60,7 +60,7 @@ def riccati_synthesis(problem: Problem, data: Coordinates, lqr: Coordinates | No
     """Steps 1-3 of the module docstring on ``data`` (one plant; levels returned unscaled).
 
     The certificate is checked in the LQR coordinates ``lqr`` of ``data``
-    (:func:`._coordinates.lqr_coordinates`, where ``X ~ I`` as for the SDP;
+    (:func:`.coordinates.lqr_coordinates`, where ``X ~ I`` as for the SDP;
     shared with the SDP fallback), then in ``data`` itself.
 
     Raises InfeasibleError when no level up to ``GAMMA_MAX`` is feasible

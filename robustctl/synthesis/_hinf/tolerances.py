@@ -1,7 +1,7 @@
 """Every tolerance of the LMI state-feedback syntheses, in one place.
 
 Each constant says what it is relative to. The LMI data are normalised
-(:mod:`._coordinates`: ``||Bw~|| = 1``, ``||[Cz~ Dzu~ Dzw~]|| = 1``, level 1 or unit
+(:mod:`.coordinates`: ``||Bw~|| = 1``, ``||[Cz~ Dzu~ Dzw~]|| = 1``, level 1 or unit
 energy), so the absolute ones are on a known scale.
 """
 
@@ -25,7 +25,7 @@ LQR_REG = 1e-9
 #: Regularisation, relative to ``lambda_max``, of a Lyapunov matrix before it
 #: defines new coordinates (the recentred centring).
 RECENTRE_REG = 1e-3
-#: The same for the LQR coordinates of one plant (:func:`._coordinates.lqr_coordinates`):
+#: The same for the LQR coordinates of one plant (:func:`.coordinates.lqr_coordinates`):
 #: the inverse LQR solution may be conditioned up to ``1 / LQR_SHIFT``. With a
 #: rank-deficient weight the LQR solution has eigenvalues near ``LQR_REG``;
 #: keeping more of its shape than ``RECENTRE_REG`` would gives the level
@@ -45,10 +45,10 @@ LEVEL_TOL = 1e-8
 #: the level that the tighter one and its polish reach).
 LEVEL_TOL_GENERAL = 1e-10
 #: Largest number of states whose level is minimised over the projected
-#: blocks (:func:`._level.projected_form`): beyond it the full block solves
+#: blocks (:func:`.level.projected_form`): beyond it the full block solves
 #: faster (measured in the documentation, Validation: Benchmarks).
 PROJECTED_MAX_N = 40
-#: The gain of a projected-blocks optimum (:func:`._lmis.projected_gain`)
+#: The gain of a projected-blocks optimum (:func:`.lmis.projected_gain`)
 #: weighs with ``Phi`` lifted to at least ``PHI_FLOOR`` of its largest
 #: eigenvalue: at the optimum ``Phi`` can be singular, and eigenvalues below
 #: the accuracy of the level minimisation (``LEVEL_TOL``) are rounding noise

@@ -11,7 +11,7 @@ the batch; the kernel takes about 1 us per design and recursion step and
 
 Same arithmetic, same rules:
 
-* the step is the penalty/KKT form of :mod:`robustctl.synthesis.rlqr`, with the same
+* the step is the penalty/KKT form of ``robustctl.synthesis.rlqr``, with the same
   operations in the same order (``Pt = sym((I + P S)^-1 P)`` only when the
   batch is ``soft``, the KKT solve, ``L = (I + S P)^-1 Lc``,
   ``P = sym(Q + K'RK + lambda^-1 nu'nu + Lc' Pt Lc)``); only the rounding of

@@ -1,7 +1,7 @@
 """Steady state of the RLQR recursion for a batch.
 
 Doubling, Newton refinement, the plain recursion, and the acceptance test that every result
-passes (:mod:`robustctl.synthesis.rlqr`).
+passes (``robustctl.synthesis.rlqr``).
 """
 
 from __future__ import annotations

@@ -24,7 +24,7 @@ class Step(NamedTuple):
 
 
 def kkt_step(P: np.ndarray, d: Model) -> Step:
-    """The penalty/KKT form of the step (:mod:`robustctl.synthesis.rlqr`) for every design of ``d``."""
+    """The penalty/KKT form of the step (``robustctl.synthesis.rlqr``) for every design of ``d``."""
     n, m = d.G.shape
     l = d.EF.shape[1]
     eye = np.eye(n)
@@ -129,7 +129,7 @@ def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEF
 
 
 def rlqr_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_ALPHA):
-    """One RLQR step by the penalty/KKT form (:mod:`robustctl.synthesis.rlqr`). Returns ``(L, K, P)``.
+    """One RLQR step by the penalty/KKT form (``robustctl.synthesis.rlqr``). Returns ``(L, K, P)``.
 
     Same arguments as :func:`rlqr_step_block`; ``P_next`` and ``Q`` may be
     only positive semidefinite.
