@@ -10,9 +10,6 @@ from ..systems.plant import Plant, check_plant
 from ..systems.stability import UNSTABLE_TOL, immovable_modes
 from .estimator import FORMS
 
-__all__ = ["outputs", "noise_input", "covariance", "covariance_stack", "cross_covariance", "check_form",
-           "design_stack", "check_noise_reaches_boundary"]
-
 
 def outputs(plant, what: str) -> Plant:
     """``plant`` if it is a :class:`Plant` with measured outputs; else a ``TypeError``/``ValueError`` naming ``C``."""

@@ -26,8 +26,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FilterModel", "kalman_model", "robust_model", "RANK_TOL"]
-
 #: A row of ``[EF, EBw W^1/2]`` (``EC``) carries information when its singular value exceeds this times the largest.
 RANK_TOL = 1e-12
 

@@ -47,8 +47,6 @@ import scipy.linalg
 from .._kkt import solve, sym, weighted_lsq
 from ._model import FilterModel
 
-__all__ = ["Gains", "measurement", "prediction", "constraint", "step", "block_step"]
-
 
 def _T(a: np.ndarray) -> np.ndarray:
     return a.swapaxes(-1, -2)
