@@ -166,6 +166,8 @@ def test_bad_input_is_named():
     plant, W, V, _ = random_plant(11)
     with pytest.raises(ValueError, match="no output matrix C"):
         rc.kalman(rc.Plant(plant.F, plant.G, 0.1), W, V)
+    with pytest.raises(ValueError, match=r"C must have 4 columns"):
+        rc.Plant(plant.F, plant.G, 0.1, C=np.ones((2, 3)))
     with pytest.raises(ValueError, match="W must have 3 rows"):
         rc.kalman(plant, np.eye(2), V)
     with pytest.raises(ValueError, match="W must be symmetric"):

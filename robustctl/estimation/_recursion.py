@@ -57,7 +57,7 @@ def measurement(P: np.ndarray, d: FilterModel) -> tuple[np.ndarray, np.ndarray, 
     CP = d.C @ P
     Re = CP @ d.C.T + d.R
     Lf = _T(solve(Re, CP))
-    return sym(P - Lf @ Re @ _T(Lf)), Lf, Re
+    return sym(P - Lf @ CP), Lf, Re                      # Lf Re Lf' = Lf C P
 
 
 def prediction(Pf: np.ndarray, Lf: np.ndarray, Re: np.ndarray, d: FilterModel):

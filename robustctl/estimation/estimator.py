@@ -107,6 +107,23 @@ class Estimator:
         ``"kalman"`` or ``"robust_kalman"``.
     info : Mapping
         Design data (``W``, ``V``, ``Bw``, ...; see the function that made it).
+
+    Examples
+    --------
+    The steady-state recursion (:meth:`step`) is the time-varying filter
+    (:meth:`run`) started from the steady-state covariance:
+
+    >>> import numpy as np, robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1, C=[[1.0, 0.0]])
+    >>> est = rc.kalman(plant, np.diag([1e-4, 1e-2]), [[0.01]])
+    >>> rng = np.random.default_rng(0)
+    >>> u, y = rng.normal(size=(50, 1)), rng.normal(size=(50, 1))
+    >>> run = est.run(u, y)                      # x0 = 0, P0 = est.P
+    >>> xhat = np.zeros(2)
+    >>> for k in range(50):
+    ...     xhat, x_k = est.step(xhat, u[k], y[k])
+    >>> bool(np.allclose(x_k, run.x[-1])), bool(np.allclose(xhat, run.x_next))
+    (True, True)
     """
 
     L_filter: np.ndarray

@@ -15,7 +15,7 @@ stabilising solution of the filter Riccati equation
 and the gains are ``Lf = P C' (C P C' + V)^-1`` (filter) and ``Lp = (F P C'
 + Bw N)(C P C' + V)^-1 = F Lf + Bw N Re^-1`` (predictor). Both share the
 robust filter's recursion and steady-state solver
-(:mod:`robustctl.estimation._steady`: doubling, checked by one step of the
+(``robustctl.estimation._steady``: doubling, checked by one step of the
 recursion and the estimator's stability).
 """
 
@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from .._validation import check_int, check_positive_scalar
+from .._validation import check_int, check_positive_scalar, frozen
 from ..errors import ConvergenceError
 from ..systems.plant import Plant
 from ..systems.stability import check_detectable, is_stable, spectral_abscissa
@@ -62,9 +62,11 @@ def _failure(st: SteadyState, i: int, max_iter: int, tol: float, what: str) -> C
 
 def _estimator(st: SteadyState, i: int, plant: Plant, form: str, method: str, info: dict, model) -> Estimator:
     g = st.gains
-    Lf = g.Lf[i]
-    return Estimator(Lf, g.Fe[i] @ Lf + g.Je[i], st.P[i], g.Pf[i], form, g.Fe[i], g.Ge[i], g.Je[i], plant,
-                     method, info, model)
+    arrays = (g.Lf[i], g.Fe[i] @ g.Lf[i] + g.Je[i], st.P[i], g.Pf[i], g.Fe[i], g.Ge[i], g.Je[i])
+    for a in arrays:  # the result's arrays are read-only (the steady state's own arrays: no copies)
+        a.flags.writeable = False
+    Lf, Lp, P, Pf, Fe, Ge, Je = arrays
+    return Estimator(Lf, Lp, P, Pf, form, Fe, Ge, Je, plant, method, info, model)
 
 
 def _check_noise(plant: Plant, Bw, W, V, N) -> None:
@@ -102,7 +104,8 @@ def _continuous(plant: Plant, Bw, W, V, N, info: dict) -> Estimator:
             f"spectral abscissa of A - L C {spectral_abscissa(A - L @ C):.6g}); does the process noise reach every "
             "mode of F on the imaginary axis?")
     info.update(residual=residual, iterations=0)
-    return Estimator(L, L, P, P, "filter", np.array(A), np.array(plant.G), np.zeros_like(L), plant, "kalman", info)
+    L, P = frozen(L), frozen(P)
+    return Estimator(L, L, P, P, "filter", frozen(A), frozen(plant.G), frozen(np.zeros_like(L)), plant, "kalman", info)
 
 
 def kalman(plant: Plant, W, V, *, Bw=None, N=None, form: str = "filter", tol: float = DEFAULT_TOL,
@@ -169,7 +172,7 @@ def kalman(plant: Plant, W, V, *, Bw=None, N=None, form: str = "filter", tol: fl
         P = F P F' + B_w W B_w' - (F P C' + B_w N)(C P C' + V)^{-1}(F P C' + B_w N)'
 
     is solved by doubling on its standard form, without cross term
-    (:mod:`robustctl.estimation._steady`). The filter form updates
+    (``robustctl.estimation._steady``). The filter form updates
     ``x[k|k] = x[k|k-1] + Lf e`` with ``e = y[k] - C x[k|k-1] - D u[k]``, then
     ``x[k+1|k] = F x[k|k] + G u[k] + Bw N Re^-1 e``. Continuous time:
     ``A P + P A' - (P C' + Bw N) V^-1 (P C' + Bw N)' + Bw W Bw' = 0``
@@ -304,4 +307,5 @@ def batch_result(st: SteadyState, form: str) -> EstimatorBatch:
                      g.Je.copy())
     for a in (L, P, F, G, J):
         a[~ok] = np.nan
+        a.flags.writeable = False
     return EstimatorBatch(L, P, F, G, J, ok, st.reason, st.stable & ok, st.iterations, st.residual, form)

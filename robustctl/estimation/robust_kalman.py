@@ -10,11 +10,11 @@ Each step of the filter solves the regularised least-squares min-max
 problem of the step (Sayed 2001) with the penalty ``mu`` on the model's
 equations: for ``lambda = (1 + alpha) mu max(||H'H||, ||HC'HC||)`` it is a
 weighted least-squares problem, one KKT system (the block form,
-:func:`robustctl.estimation._recursion.block_step`), whose closed form
+``robustctl.estimation._recursion.block_step``), whose closed form
 is a Kalman filter with extra noise ``Phi1 = mu^-1 I - lambda^-1 H H'``,
 ``Phi2 = mu^-1 I - lambda^-1 HC HC'`` and the pseudo-measurements ``0 = EF
 x + EG u + EBw w`` and ``0 = EC x`` of noise ``lambda^-1 I``
-(:mod:`robustctl.estimation._recursion`). The estimator runs a modified model
+(``robustctl.estimation._recursion``). The estimator runs a modified model
 ``xhat+ = Fe x[k|k] + Ge u``, ``Fe = F - J EF``, ``Ge = G - J EG``. It is the
 estimation dual of the RLQR (:func:`robustctl.rlqr`): the same framework,
 the same ``mu``, ``alpha`` and ``lambda``; as ``mu -> inf`` the
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._kkt import DEFAULT_ALPHA, check_penalty, relchange
-from .._validation import as_matrix, check_bool, check_choice, check_int, check_positive_scalar
+from .._validation import as_matrix, check_bool, check_choice, check_int, check_positive_scalar, frozen
 from ..errors import ConvergenceError
 from ..systems.plant import Plant
 from ..systems.stability import check_detectable
@@ -247,7 +247,8 @@ def robust_kalman(plant: Plant, W, V, *, Bw=None, H, EF, EG=None, EBw=None, HC=N
             raise ConvergenceError(f"the block recursion did not reach a steady state in max_iter={max_iter} steps "
                                    f"(relative change of P {change:.3g}, tol={tol:g})")
         info.update(residual=float(change), iterations=it)
-        return Estimator(Lf, Fe @ Lf, P, Pf, form, Fe, Ge, np.zeros_like(Lf), plant, "robust_kalman", info, d)
+        return Estimator(*(frozen(a) for a in (Lf, Fe @ Lf, P, Pf)), form,
+                         *(frozen(a) for a in (Fe, Ge, np.zeros_like(Lf))), plant, "robust_kalman", info, d)
     st = steady_state(d, tol, max_iter, accelerate=accelerate)
     if st.reason[0] != "ok":
         raise _failure(st, 0, max_iter, tol, "robust filter's")
