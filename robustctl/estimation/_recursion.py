@@ -66,10 +66,11 @@ def prediction(Pf: np.ndarray, Lf: np.ndarray, Re: np.ndarray, d: FilterModel):
     P = FPf @ d.F.T + d.Q
     Je = np.zeros_like(Lf)
     if d.EF.shape[1]:
-        SE = sym(d.EF @ Pf @ _T(d.EF) + d.Y + d.ell[:, :, None] * np.eye(d.EF.shape[1]))
-        J = _T(solve(SE, _T(FPf @ _T(d.EF) + d.X)))
+        SE = d.EF @ Pf @ _T(d.EF) + d.Y + d.ell[:, :, None] * np.eye(d.EF.shape[1])
+        cross = FPf @ _T(d.EF) + d.X                                   # cov(x+, EF x + EBw w)
+        J = _T(solve(SE, _T(cross)))
         Fe, Ge = d.F - J @ d.EF, d.G - J @ d.EG
-        P = P - J @ SE @ _T(J)
+        P = P - J @ _T(cross)                                          # J SE J' = J cross'
     else:
         Fe, Ge = np.repeat(d.F[None], P.shape[0], axis=0), np.repeat(d.G[None], P.shape[0], axis=0)
     if d.S is not None:
@@ -85,9 +86,9 @@ def constraint(P: np.ndarray, d: FilterModel) -> tuple[np.ndarray, np.ndarray]:
     if not q2:
         return P, np.zeros((*P.shape[:2], 0))
     ECP = d.EC @ P
-    SC = sym(ECP @ _T(d.EC) + d.li[:, None, None] * np.eye(q2))
+    SC = ECP @ _T(d.EC) + d.li[:, None, None] * np.eye(q2)
     KE = _T(solve(SC, ECP))
-    return sym(P - KE @ SC @ _T(KE)), KE
+    return sym(P - KE @ ECP), KE                                       # KE SC KE' = KE EC P
 
 
 class Gains(NamedTuple):
