@@ -17,7 +17,7 @@
 
 ``--problem`` and ``--algorithm``/``--algorithms`` take a registry name or the
 import path ``package.module:factory`` of a user's problem or MOEA (see
-:mod:`moo._imports`: the problem factory is called with no argument, or with
+:mod:`moo.factories`: the problem factory is called with no argument, or with
 ``n_obj=`` given ``--n-obj``, and returns a pymoo Problem carrying
 ``hv_ref_point`` and ``molsp_ref_point``; the algorithm factory is called as
 ``factory(n_obj=M, pop_size=P)`` and returns a pymoo Algorithm). The module
@@ -439,12 +439,12 @@ def _vector(values) -> str:
 
 
 def _cmd_select(args) -> int:
-    from moo._imports import build_problem, check_algorithm_name, check_problem_name
-    from moo._validation import check_int
+    from moo.factories import build_problem, check_algorithm_name, check_problem_name
     from moo.record_selection import front_from_records, load_source, select_on_front
     from moo.runner import setup_name
     from moo.store import check_output_file, write_json_atomic
     from moo.tuning import TuningProblem
+    from moo.validation import check_int
 
     with _usage():
         out = None if args.out is None else check_output_file(args.out, "--out")

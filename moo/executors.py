@@ -49,8 +49,8 @@ from contextlib import AbstractContextManager, contextmanager
 from multiprocessing import get_context
 from typing import Any
 
-from moo._validation import check_choice, check_int
 from moo.store import DISK_ERRORS
+from moo.validation import check_choice, check_int
 
 __all__ = ["EXECUTORS", "POOL_RESTARTS", "PARENT_POLL", "SchedulerLostError", "open_executor"]
 
@@ -128,7 +128,7 @@ def open_executor(kind: str = "process", *, workers: int | None = None,
     return _dask(scheduler, workers or 1)
 
 
-class _RestartingPool(Executor):
+class RestartingPool(Executor):
     """A pool of ``workers`` spawned processes that :meth:`restart` replaces once it is broken."""
 
     def __init__(self, workers: int, restarts: int = POOL_RESTARTS):
@@ -160,7 +160,7 @@ def _process_pool(workers: int) -> Iterator[Executor | None]:
     if workers == 1:
         yield None
         return
-    pool = _RestartingPool(workers)
+    pool = RestartingPool(workers)
     try:
         yield pool
     except BaseException:

@@ -84,11 +84,10 @@ from pathlib import Path
 
 import numpy as np
 
-from moo._imports import build_problem, check_algorithm_name, check_problem_name
-from moo._validation import check_int
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
-from moo.executors import POOL_RESTARTS, _RestartingPool, open_executor
+from moo.executors import POOL_RESTARTS, RestartingPool, open_executor
+from moo.factories import build_problem, check_algorithm_name, check_problem_name
 from moo.store import (
     FAILED_SUFFIX,
     CorruptRecordError,
@@ -105,6 +104,7 @@ from moo.store import (
     write_json_atomic,
     write_settings,
 )
+from moo.validation import check_int
 
 __all__ = ["RunSpec", "ExperimentReport", "PreparedExperiment", "RunFailedError", "plan", "run_seeds",
            "prepare", "run_experiment", "load_records", "write_json_atomic", "problem_dir"]
@@ -203,7 +203,7 @@ def plan(problem: str, algorithms: str | Sequence[str], *, runs: int, evals: int
     ----------
     problem : str
         A name of :data:`moo.problems.PROBLEMS`, or the import path
-        ``package.module:factory`` of a user's problem (:mod:`moo._imports`).
+        ``package.module:factory`` of a user's problem (:mod:`moo.factories`).
     algorithms : str or sequence of str
         ``"all"``, a comma-separated string or a list of registry names or
         import paths of a user's algorithm factories.
@@ -396,7 +396,7 @@ def _run_on(executor: Executor, specs: Sequence[RunSpec], recorder: _Recorder) -
         lost, broken = _submit_and_record(executor, todo, recorder)
         if broken is None:
             return
-        if not isinstance(executor, _RestartingPool):
+        if not isinstance(executor, RestartingPool):
             raise broken
         if not executor.restart():
             raise BrokenProcessPool(f"a pool process died again after {POOL_RESTARTS} restarts of the pool "
@@ -572,10 +572,35 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
                    progress: bool | None = None, setup: str | None = None) -> ExperimentReport:
     """Run the grid of :func:`~moo.experiment.plan` into ``out``, skipping runs already recorded.
 
-    Parameters are those of :func:`~moo.experiment.plan`, plus:
+    Every cell (algorithm, variant) runs ``runs`` times with the seeds of
+    :func:`run_seeds`; each run is written as
+    ``out/<problem>/<algorithm>[+molsp]/seed_<s>.json`` as soon as it ends, so
+    a grid interrupted and started again runs only what is missing.
 
+    Parameters
+    ----------
+    problem : str
+        A name of :data:`moo.problems.PROBLEMS`, or the import path
+        ``package.module:factory`` of a user's problem (:mod:`moo.factories`).
+    algorithms : str or sequence of str
+        ``"all"``, a comma-separated string or a list of registry names or
+        import paths of a user's algorithm factories.
+    runs : int
+        Independent runs per algorithm and variant.
+    evals : int
+        Evaluation budget of each run.
     out : path-like
         Results directory (created if needed).
+    n_obj : int, optional
+        Number of objectives (DTLZ, WFG).
+    base_seed : int
+        Root of the seed sequence (see the module docstring).
+    pop_size : int
+        Population size (the paper's 92).
+    max_leaders : int, optional
+        MO-LSP's cap on candidates per generation (MO-LSP runs only).
+    variants : sequence of bool
+        Which variants to run: ``False`` plain, ``True`` with MO-LSP (default both).
     workers : int
         Without ``executor``: processes running the grid (1: in this process).
     executor : concurrent.futures.Executor, optional
@@ -588,10 +613,13 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
     progress : bool, optional
         Show ``runs done/total`` and an ETA on stderr; default: only when
         stderr is a terminal.
+    setup : str, optional
+        The problem's set-up (``applied`` only, see :func:`moo.runner.prepare`).
 
     Returns
     -------
     ExperimentReport
+        The grid's size, the runs skipped (already recorded) and run now, the failures.
 
     Raises
     ------
@@ -600,6 +628,27 @@ def run_experiment(problem: str, algorithms: str | Sequence[str], *, runs: int, 
         settings; raised before any run starts.
     RunFailedError
         A run raised (without ``keep_going``); the records written stay.
+
+    See Also
+    --------
+    plan : the grid as a list of runs.
+    load_records : read the records back.
+    moo.analyse : the statistics of a results directory.
+
+    Examples
+    --------
+    Three runs of NSGA-II and of NSGA-II with MO-LSP; started again, the
+    grid finds every run recorded:
+
+    >>> import tempfile
+    >>> import moo
+    >>> from moo.experiment import load_records
+    >>> with tempfile.TemporaryDirectory() as out:
+    ...     first = moo.run_experiment("zdt1", "nsga2", runs=3, evals=200, pop_size=20, out=out)
+    ...     again = moo.run_experiment("zdt1", "nsga2", runs=3, evals=200, pop_size=20, out=out)
+    ...     records = load_records(out)
+    >>> first.completed, again.skipped, len(records)
+    (6, 6, 6)
     """
     workers = check_int(workers, "workers", 1)
     if executor is not None and workers != 1:

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.distance import cdist
 
-from ._validation import as_matrix, check_positive_scalar
+from .validation import as_matrix, check_positive_scalar
 
 __all__ = ["igd", "igd_plus", "spacing", "hypervolume", "pure_diversity", "spread"]
 
@@ -95,10 +95,6 @@ def _nearest_neighbour(D: np.ndarray) -> np.ndarray:
 def igd(F: ArrayLike, ref_set: ArrayLike) -> float:
     r"""Inverted generational distance, the paper's Eqs. (igd) and (dk).
 
-    .. math::
-
-        IGD(P, P^*) = \frac{1}{|P^*|} \sum_{k \in P^*} \min_{i \in P} \lVert k - i \rVert_2
-
     Parameters
     ----------
     F : array_like, shape (n, m)
@@ -111,20 +107,43 @@ def igd(F: ArrayLike, ref_set: ArrayLike) -> float:
     float
         Mean Euclidean distance from each reference point to its nearest point of ``F``.
 
+    Raises
+    ------
+    TypeError, ValueError
+        ``F`` or ``ref_set`` not a finite 2-D array of numbers, empty, or with
+        other numbers of columns (the message names the argument and the shapes).
+
+    See Also
+    --------
+    igd_plus : the Pareto-compliant variant.
+    hypervolume : the other indicator of a front without a reference set.
+
+    Notes
+    -----
+    .. math::
+
+        IGD(P, P^*) = \frac{1}{|P^*|} \sum_{k \in P^*} \min_{i \in P} \lVert k - i \rVert_2 .
+
+    Computed by :func:`moocore.igd`.
+
     References
     ----------
-    C. A. Coello Coello and M. Reyes Sierra (2004), "A study of the parallelization
-    of a coevolutionary multi-objective evolutionary algorithm", MICAI 2004, LNCS 2972.
-    Computed by :func:`moocore.igd`.
+    .. [1] C. A. Coello Coello and M. Reyes Sierra, "A study of the
+       parallelization of a coevolutionary multi-objective evolutionary
+       algorithm", MICAI 2004, LNCS 2972, 2004.
 
     Examples
     --------
     The middle reference point is :math:`\sqrt{0.5}` from both points, the
     others lie on ``F``:
 
+    >>> import numpy as np
     >>> from moo.indicators import igd
-    >>> igd([[0, 1], [1, 0]], [[0, 1], [0.5, 0.5], [1, 0]])
+    >>> value = igd([[0, 1], [1, 0]], [[0, 1], [0.5, 0.5], [1, 0]])
+    >>> value
     0.2357
+    >>> bool(np.isclose(value, np.sqrt(0.5) / 3))
+    True
     """
     return _distance_to_reference(moocore.igd, F, ref_set)
 
@@ -215,28 +234,54 @@ def spacing(F: ArrayLike) -> float:
 def hypervolume(F: ArrayLike, ref_point: ArrayLike) -> float:
     r"""Hypervolume dominated by ``F`` and bounded by ``ref_point``, Eq. (hv).
 
+    Points that do not strictly dominate ``r`` contribute nothing. Exact in
+    any dimension (:func:`moocore.hypervolume`: dimension sweep in 2-D, HV3D+
+    and HV4D+ in 3-D/4-D, inclusion-exclusion or recursion above).
+
+    Parameters
+    ----------
+    F : array_like, shape (n, m)
+        The points (minimised objectives).
+    ref_point : array_like, shape (m,)
+        The reference point ``r``.
+
+    Returns
+    -------
+    float
+        The hypervolume (0 when no point strictly dominates ``r``).
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``F`` or ``ref_point`` not finite numbers, or of sizes that do not fit
+        (the message names the argument and the shapes).
+    OverflowError
+        A hypervolume beyond the float range (rescale the objectives).
+
+    See Also
+    --------
+    igd : distance to a reference set.
+    moo.run : records the hypervolume after every generation.
+
+    Notes
+    -----
     .. math::
 
         HV(P, r) = \Lambda_m\Big(\bigcup_{i \in P} [f(i), r]\Big),
 
     the Lebesgue measure of the union of the boxes between each point and ``r``.
-    Points that do not strictly dominate ``r`` contribute nothing. Exact in any
-    dimension (:func:`moocore.hypervolume`: dimension sweep in 2-D, HV3D+ and HV4D+
-    in 3-D/4-D, inclusion-exclusion or recursion above).
-
-    Parameters
-    ----------
-    F : array_like, shape (n, m)
-    ref_point : array_like, shape (m,)
 
     References
     ----------
-    L. While, P. Hingston, L. Barone and S. Huband (2006), "A faster algorithm for
-    calculating hypervolume", IEEE TEVC 10(1), 29-38; M. Lopez-Ibanez, moocore.
+    .. [1] L. While, P. Hingston, L. Barone and S. Huband, "A faster algorithm
+       for calculating hypervolume", IEEE TEVC 10(1), 29-38, 2006.
+    .. [2] M. Lopez-Ibanez, moocore: core algorithms for multi-objective
+       optimization.
 
     Examples
     --------
-    Two 2 x 1 boxes overlapping in a unit square:
+    Two 2 x 1 boxes overlapping in a unit square (inclusion-exclusion:
+    ``2 + 2 - 1``):
 
     >>> from moo.indicators import hypervolume
     >>> hypervolume([[1, 2], [2, 1]], ref_point=[3, 3])

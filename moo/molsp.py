@@ -95,8 +95,8 @@ from pymoo.core.termination import MultipleCriteria
 from pymoo.termination.max_eval import MaximumFunctionCallTermination
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from ._validation import as_matrix
-from .algorithms._base import objectives
+from .algorithms.base import objectives
+from .validation import as_matrix
 
 if TYPE_CHECKING:
     from pymoo.core.evaluator import Evaluator

@@ -43,10 +43,10 @@ import numpy as np
 
 import robustctl as rc
 
-from ._validation import check_int
 from .store import load_records, read_record, validate_record
 from .tuning import TuningProblem
 from .tuning.tune import design_plant
+from .validation import check_int
 
 __all__ = ["RecordFront", "RecordSelection", "load_source", "front_from_records", "select_from_records",
            "select_on_front"]
@@ -267,7 +267,7 @@ def select_from_records(records: list[dict], problem, *, problem_name: str, algo
     records : list of dict
         Validated run records (:func:`load_source`).
     problem : TuningProblem
-        The problem the records ran on, rebuilt (e.g. :func:`moo._imports.build_problem`).
+        The problem the records ran on, rebuilt (e.g. :func:`moo.factories.build_problem`).
     problem_name, algorithm, molsp
         Which records (:func:`front_from_records`).
     n_sims : int

@@ -4,7 +4,7 @@
 once (a bad argument raises ``ValueError``/``TypeError`` naming it, before any
 work); :meth:`PreparedRun.run` then runs it. :func:`run` does both. In detail,
 :func:`prepare` builds the problem (:func:`moo.problems.make_problem`, or a
-user's factory ``package.module:factory``, see :mod:`moo._imports`) and the
+user's factory ``package.module:factory``, see :mod:`moo.factories`) and the
 algorithm (:func:`moo.algorithms.make_algorithm`, or a user's factory), wraps it with MO-LSP
 (:func:`moo.molsp.molsp`, reference point ``problem.molsp_ref_point``) if
 asked, runs it with pymoo's ``("n_eval", evals)`` termination and records the
@@ -69,11 +69,11 @@ from pymoo.core.algorithm import Algorithm
 from pymoo.core.callback import Callback
 from pymoo.core.problem import Problem
 
-from moo._imports import build_algorithm, build_problem, check_algorithm_name, check_problem_name
-from moo._validation import check_int
 from moo.algorithms.operators import POP_SIZE
+from moo.factories import build_algorithm, build_problem, check_algorithm_name, check_problem_name
 from moo.indicators import hypervolume
 from moo.molsp import molsp as add_molsp
+from moo.validation import check_int
 
 __all__ = ["RunResult", "PreparedRun", "prepare", "prepare_on", "run", "check_budget", "setup_name"]
 
@@ -92,12 +92,14 @@ def _versions() -> dict[str, str]:
 class RunResult:
     """The record of one run (see :func:`run`); :meth:`~RunResult.to_dict` gives its JSON form.
 
+    The fields are the keys of the record, documented in the table of the
+    module docstring ("The record"), with ``wall_time`` for ``wall_time_s``.
     ``F``/``X`` are the objectives and decision vectors of the final
     non-dominated set (of the final population together with the algorithm's
     ``opt``, finite and feasible individuals only, duplicates in objective
     space removed); ``hv_history`` is an ``(n_gen, 2)`` array of
     (evaluations used, hypervolume) after each generation, the initial one
-    included.
+    included; ``hv`` its last hypervolume.
     """
 
     problem: str
@@ -262,7 +264,7 @@ def prepare(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int |
     problem : str
         A name of :data:`moo.problems.PROBLEMS`, or the import path
         ``package.module:factory`` of a user's problem factory
-        (:mod:`moo._imports`: called with no argument, or ``n_obj=``).
+        (:mod:`moo.factories`: called with no argument, or ``n_obj=``).
     algorithm : str
         A name of :data:`moo.algorithms.ALGORITHMS`, or the import path of a
         user's algorithm factory, called as ``factory(n_obj=M, pop_size=P)``.
@@ -341,12 +343,73 @@ def run(problem: str, algorithm: str, *, seed: int, evals: int, n_obj: int | Non
         progress: Callable[[int, int], None] | None = None, setup: str | None = None) -> RunResult:
     """Run one MOEA (optionally with MO-LSP) on one problem to an evaluation budget.
 
-    The arguments are those of :func:`prepare` (which checks them), plus
-    ``progress``, called as ``progress(n_evals, evals)`` after every generation.
+    :func:`prepare` checks the arguments and builds the problem and the
+    algorithm; :meth:`PreparedRun.run` runs it. This is the run
+    ``python -m moo run`` makes.
+
+    Parameters
+    ----------
+    problem : str
+        A name of :data:`moo.problems.PROBLEMS`, or the import path
+        ``package.module:factory`` of a user's problem factory
+        (:mod:`moo.factories`: called with no argument, or ``n_obj=``).
+    algorithm : str
+        A name of :data:`moo.algorithms.ALGORITHMS`, or the import path of a
+        user's algorithm factory, called as ``factory(n_obj=M, pop_size=P)``.
+    seed : int
+        Non-negative seed of the run's Generator (same arguments, same result).
+    evals : int
+        Evaluation budget; at least the population size.
+    n_obj : int, optional
+        Number of objectives (DTLZ, WFG; fixed for the others).
+    molsp : bool
+        Wrap the algorithm with MO-LSP (reference point ``problem.molsp_ref_point``).
+    pop_size : int
+        Population size (the paper's 92 by default; reference-direction
+        algorithms may enlarge it, the size used is recorded).
+    max_leaders : int, optional
+        MO-LSP's cap on candidates per generation (default: none, the paper's).
+    progress : callable, optional
+        Called as ``progress(n_evals, evals)`` after every generation.
+    setup : str, optional
+        The problem's set-up (``applied`` only: ``"ours"``, the default, or
+        ``"authors"``).
 
     Returns
     -------
     RunResult
+        The run's record; :meth:`RunResult.to_dict` is its JSON form (the
+        table of its keys is in the module docstring).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A bad argument (the message names it), raised before any work.
+    NotImplementedError
+        A registered problem or algorithm whose module is not available.
+
+    See Also
+    --------
+    prepare : check and build once, run several times.
+    moo.run_experiment : a resumable grid of runs.
+    moo.tune : a run on a :class:`~moo.tuning.TuningProblem`.
+
+    Notes
+    -----
+    pymoo stops at the end of the first generation whose evaluation count
+    reaches ``evals``; ``n_evals`` reports the evaluations used. The
+    hypervolume of the non-dominated set is recorded after every generation
+    (reference point ``problem.hv_ref_point``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import moo
+    >>> res = moo.run("dtlz2", "nsga2", n_obj=2, seed=0, evals=500, pop_size=20)
+    >>> res.n_evals, res.F.shape[1]
+    (500, 2)
+    >>> bool(np.isclose(res.hv, moo.hypervolume(res.F, res.hv_ref_point)))
+    True
     """
     return prepare(problem, algorithm, seed=seed, evals=evals, n_obj=n_obj, molsp=molsp, pop_size=pop_size,
                    max_leaders=max_leaders, setup=setup).run(progress)

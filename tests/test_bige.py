@@ -12,7 +12,7 @@ import pytest
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 
-from moo.algorithms._base import BinaryTournament
+from moo.algorithms.base import BinaryTournament
 from moo.algorithms.bige import (
     BiGESurvival,
     _bige_tournament,

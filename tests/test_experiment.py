@@ -398,14 +398,14 @@ def test_killed_pool_process_is_replaced_and_its_runs_recomputed(tmp_path, capsy
 
 
 def test_pool_restarts_are_bounded_and_other_executors_stop(tmp_path, capsys):
-    from moo.executors import POOL_RESTARTS, _RestartingPool
+    from moo.executors import POOL_RESTARTS, RestartingPool
 
     def broken(*args, **kwargs) -> Future:
         fut: Future = Future()
         fut.set_exception(BrokenProcessPool("a process in the pool was terminated abruptly"))
         return fut
 
-    class DiesEveryTime(_RestartingPool):
+    class DiesEveryTime(RestartingPool):
         """Every run loses its process (a thread pool stands in for the processes)."""
 
         pools = 0

@@ -185,10 +185,10 @@ def test_generic_core_does_not_import_robustctl(module):
 
 
 def test_objectives_by_attribute_equal_population_get():
-    """``moo.algorithms._base.objectives`` (read as ``Individual.F``) is ``Population.get("F")``, bit for bit."""
+    """``moo.algorithms.base.objectives`` (read as ``Individual.F``) is ``Population.get("F")``, bit for bit."""
     from pymoo.core.population import Population
 
-    from moo.algorithms._base import objectives
+    from moo.algorithms.base import objectives
 
     res = minimize(get_problem("dtlz2"), make_algorithm("nsga2", n_obj=3), ("n_eval", 400), seed=2)
     pop = Population.merge(res.pop, res.opt)

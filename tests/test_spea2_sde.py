@@ -20,7 +20,7 @@ from pymoo.problems import get_problem
 from pymoo.util.ref_dirs import get_reference_directions
 from scipy.spatial.distance import cdist
 
-from moo.algorithms._base import BinaryTournament
+from moo.algorithms.base import BinaryTournament
 from moo.algorithms.spea2_sde import (
     SPEA2SDESurvival,
     _sde_tournament,

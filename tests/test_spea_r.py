@@ -19,7 +19,7 @@ from pymoo.optimize import minimize
 from pymoo.problems import get_problem
 from pymoo.util.ref_dirs import get_reference_directions
 
-from moo.algorithms._normalize import HyperplaneNormalization, front_bounds
+from moo.algorithms.normalization import HyperplaneNormalization, front_bounds
 from moo.algorithms.spea_r import (
     NeighbourMatingSelection,
     SPEARSurvival,

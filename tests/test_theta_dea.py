@@ -1,4 +1,4 @@
-"""Tests of theta-DEA (moo.algorithms.theta_dea) and the shared normalisation (moo.algorithms._normalize).
+"""Tests of theta-DEA (moo.algorithms.theta_dea) and the shared normalisation (moo.algorithms.normalization).
 
 Expected values are worked out by hand in the comments (or by brute force /
 closed forms independent of the code under test).
@@ -18,7 +18,7 @@ from pymoo.optimize import minimize
 from pymoo.problems import get_problem
 from pymoo.util.ref_dirs import get_reference_directions
 
-from moo.algorithms._normalize import (
+from moo.algorithms.normalization import (
     HyperplaneNormalization,
     extreme_points,
     front_bounds,
@@ -72,7 +72,7 @@ def test_extreme_points_pick_axis_minimisers_of_asf():
 
 
 def test_a_poorly_converged_point_exactly_on_an_axis_is_replaced():
-    # The case behind the zero rule (module docstring of _normalize): an early point exactly on axis 1 at 1.03
+    # The case behind the zero rule (docstring of moo.algorithms.normalization): an early point on axis 1 at 1.03
     # against a converged one at 1.0 whose off-axis terms are 1e-5. As printed (zero_tol=0) the ASF of the
     # converged point is 1e-5 / 1e-6 = 10 > 1.03 and the early point stays the extreme point of axis 1.
     F = np.array([[1.03, 0.0, 0.0], [1.0, 1e-5, 1e-5], [1e-5, 1.0, 1e-5], [1e-5, 1e-5, 1.0]])

@@ -57,7 +57,7 @@ from pymoo.core.duplicate import NoDuplicateElimination  # noqa: E402
 from pymoo.optimize import minimize  # noqa: E402
 
 from benchmarks import bench_protocol as bp  # noqa: E402  (bench_protocol pins BLAS before numpy loads)
-from moo.algorithms._base import BinaryTournament  # noqa: E402
+from moo.algorithms.base import BinaryTournament  # noqa: E402
 from moo.algorithms.bige import bige_estimation, niche_radius  # noqa: E402
 from moo.algorithms.operators import OperatorSettings  # noqa: E402
 

@@ -54,13 +54,13 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting  # noqa: E4
 from scipy.stats import rankdata  # noqa: E402
 
 from benchmarks import bench_protocol as bp  # noqa: E402  (bench_protocol pins BLAS before numpy loads)
-from moo.algorithms._normalize import HyperplaneNormalization  # noqa: E402
 from moo.algorithms.maoea_ddfc import (  # noqa: E402
     DDFCMatingSelection,
     DDFCSurvival,
     favorable_convergence,
     tournament_winners,
 )
+from moo.algorithms.normalization import HyperplaneNormalization  # noqa: E402
 
 RESOLUTION = 1e-6
 WINDOW = (10, 200)

@@ -6,7 +6,7 @@ module's ``__all__`` (or, without ``__all__``, its public functions and
 classes) in an ``autosummary`` table; autosummary then writes one page per
 name. So a new module or a new name in an ``__all__`` appears in the docs
 without editing them. The shared helper modules that define an ``__all__``
-(``robustctl._cvx``, ``moo.algorithms._normalize``, ...) get pages too, under
+(``robustctl._cvx``, ``robustctl._validation``, ...) get pages too, under
 "Internals", since public docstrings refer to them.
 
 Each function or class is documented once, under its shortest public name:

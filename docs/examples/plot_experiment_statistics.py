@@ -27,7 +27,14 @@ tmp = tempfile.TemporaryDirectory(prefix="moo-example-")  # removed at the end
 out = Path(tmp.name)
 grid = dict(problem="zdt1", algorithms="nsga2,theta-dea", runs=8, evals=1500,
             out=out)
-print(run_experiment(**grid))
+
+
+def summary(report):
+    """What a grid run did, without its (temporary) directory and timing."""
+    return f"{report.total} runs, {report.skipped} already done, {report.completed} run now"
+
+
+print(summary(run_experiment(**grid)))
 files = sorted(str(p.relative_to(out)) for p in out.glob("*/*/*.json"))
 print(len(files), "records:", files[:2], "...")
 
@@ -35,11 +42,11 @@ print(len(files), "records:", files[:2], "...")
 # A rerun finds every record and runs nothing; a larger ``runs`` would run
 # only the new seeds, and another budget is refused (the store never mixes
 # settings).
-print(run_experiment(**grid))
+print(summary(run_experiment(**grid)))
 try:
     run_experiment(**{**grid, "evals": 3000})
 except ValueError as exc:
-    print("refused:", str(exc)[:110], "...")
+    print("refused:", str(exc).replace(str(out), "out")[:110], "...")
 
 # %%
 # The paper's table and the rank-sum tests

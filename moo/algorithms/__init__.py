@@ -29,14 +29,16 @@ Constructor shape (every entry of :data:`ALGORITHMS`; checked for each by
 * the returned algorithm passes its initial population through its survival
   before the first mating (``advance_after_initial_infill=True``), so the
   first mating sees ranked individuals, and its survival resets its state
-  when a run is set up.
+  when a run is set up (NSGA-II and NSGA-III are pymoo's; the other eight
+  are subclasses of :class:`moo.algorithms.base.MOEA`, which wires a survival
+  and a mating selection into pymoo's genetic algorithm this way).
 """
 
 from __future__ import annotations
 
 from importlib import import_module
 
-from ._base import MIN_POP_SIZE
+from .base import MIN_POP_SIZE
 from .operators import POP_SIZE
 
 __all__ = ["ALGORITHMS", "MIN_POP_SIZE", "POP_SIZE", "make_algorithm"]
@@ -58,10 +60,48 @@ ALGORITHMS: dict[str, str] = {
 def make_algorithm(name: str, *, n_obj: int, pop_size: int = POP_SIZE, **options):
     """A pymoo algorithm by registry name, configured with the paper's defaults.
 
-    ``options`` are the factory's keyword arguments (``operators``, ``ref_dirs``
-    and each algorithm's own parameters, documented in its module); the
-    arguments are checked by the factory (the shape above: ``pop_size`` at
-    least :data:`MIN_POP_SIZE`).
+    Parameters
+    ----------
+    name : str
+        A name of :data:`ALGORITHMS` (case-insensitive).
+    n_obj : int
+        Number of objectives (>= 2).
+    pop_size : int
+        Population size, at least :data:`MIN_POP_SIZE` (default
+        :data:`POP_SIZE`, the paper's 92; the reference-direction
+        algorithms may enlarge it to their number of directions).
+    **options
+        The factory's own keyword arguments: ``operators`` (``"paper"``,
+        ``"original"`` or an :class:`~moo.algorithms.operators.OperatorSettings`),
+        ``ref_dirs`` and each algorithm's parameters, documented in its module.
+
+    Returns
+    -------
+    pymoo.algorithms.base.genetic.GeneticAlgorithm
+        Not yet set up (``minimize`` or :func:`moo.run` sets it up).
+
+    Raises
+    ------
+    ValueError, TypeError
+        An unknown name (the message lists the valid ones), or a bad argument
+        of the factory (the shape of the module docstring).
+    NotImplementedError
+        A registered algorithm whose module is not available.
+
+    See Also
+    --------
+    moo.run : one run of a registered algorithm.
+    moo.algorithms.base.MOEA : the base of the package's own algorithms.
+
+    Examples
+    --------
+    theta-DEA for 3 objectives has the project's 91 directions and
+    population 92:
+
+    >>> from moo.algorithms import make_algorithm
+    >>> alg = make_algorithm("theta-dea", n_obj=3)
+    >>> type(alg).__name__, alg.pop_size, alg.ref_dirs.shape
+    ('ThetaDEA', 92, (91, 3))
     """
     key = name.lower() if isinstance(name, str) else name
     if key not in ALGORITHMS:

@@ -103,14 +103,12 @@ other implementations) is in the documentation's Validation pages,
 from __future__ import annotations
 
 import numpy as np
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
-from pymoo.termination.default import DefaultMultiObjectiveTermination
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
-from .._validation import as_objectives, check_int
-from ._base import BinaryTournament, factory_arguments, objectives, paper_operators
+from ..validation import as_objectives, check_int
+from .base import MOEA, BinaryTournament, factory_arguments, objectives
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = ["BiGE", "BiGESurvival", "bige_estimation", "make_bige", "niche_radius", "ORIGINAL_OPERATORS"]
@@ -251,7 +249,7 @@ def _bige_tournament(pop, P, random_state=None, **kwargs):
     return winner[:, None].astype(int)
 
 
-class BiGE(GeneticAlgorithm):
+class BiGE(MOEA):
     """BiGE as a pymoo algorithm.
 
     Parameters
@@ -267,15 +265,9 @@ class BiGE(GeneticAlgorithm):
 
     def __init__(self, *, pop_size: int = POP_SIZE, sampling=None, crossover=None, mutation=None,
                  eliminate_duplicates: bool = True, output=None):
-        super().__init__(
-            pop_size=pop_size,
-            **paper_operators(sampling, crossover, mutation, output),
-            selection=BinaryTournament(_bige_tournament),
-            survival=BiGESurvival(),
-            eliminate_duplicates=eliminate_duplicates,
-            advance_after_initial_infill=True,
-        )
-        self.termination = DefaultMultiObjectiveTermination()
+        super().__init__(BiGESurvival(), BinaryTournament(_bige_tournament), pop_size=pop_size, sampling=sampling,
+                         crossover=crossover, mutation=mutation, eliminate_duplicates=eliminate_duplicates,
+                         output=output)
 
 
 def make_bige(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper") -> BiGE:

@@ -14,7 +14,7 @@ into ``S`` and ``N`` survivors are chosen from ``S`` as follows.
    objective) and the nadir estimate ``z^nad`` from the intercepts of the
    hyperplane through the ``M`` extreme points (NSGA-III's procedure as the
    same authors use it in theta-DEA; the project's
-   :class:`moo.algorithms._normalize.HyperplaneNormalization`, extreme points
+   :class:`moo.algorithms.normalization.HyperplaneNormalization`, extreme points
    kept across generations, with its fall-backs when the hyperplane is
    degenerate)::
 
@@ -79,14 +79,13 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 import numpy as np
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.operators.selection.rnd import RandomSelection
 
-from .._validation import as_matrix, check_choice, check_int, check_real
-from ._base import NormalizationForwarding, factory_arguments, factory_ref_dirs, objectives, paper_operators
-from ._normalize import HyperplaneNormalization
+from ..validation import as_matrix, check_choice, check_int, check_real
+from .base import MOEA, NormalizationForwarding, factory_arguments, factory_ref_dirs, objectives
+from .normalization import HyperplaneNormalization
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = ["EFRRR", "EFRRRSurvival", "maximum_ranking", "make_efr_rr", "ORIGINAL_OPERATORS"]
@@ -229,7 +228,7 @@ class RankTournament(Selection):
         return winner.reshape(n_select, n_parents)
 
 
-class EFRRR(GeneticAlgorithm):
+class EFRRR(MOEA):
     """EFR-RR as a pymoo genetic algorithm (see the module docstring).
 
     Parameters
@@ -259,7 +258,6 @@ class EFRRR(GeneticAlgorithm):
             raise ValueError(f"ref_dirs must have >= 2 columns (objectives), got shape {ref_dirs.shape}")
         if np.any(ref_dirs < 0) or np.any(ref_dirs.sum(axis=1) <= 0):
             raise ValueError("ref_dirs must be non-negative with a positive sum in every row")
-        pop_size = check_int(pop_size, "pop_size", 2)
         n_neighbors = check_int(n_neighbors, "n_neighbors", 1)
         if n_neighbors > len(ref_dirs):
             raise ValueError(f"n_neighbors must be <= the number of weight vectors "
@@ -267,23 +265,11 @@ class EFRRR(GeneticAlgorithm):
         scalarizing = check_choice(scalarizing, "scalarizing", _SCALARIZINGS)
         theta = check_real(theta, "theta", positive=True)
         mating = check_choice(mating, "mating", _MATINGS)
-        self.ref_dirs = ref_dirs
         self.n_neighbors = n_neighbors
-        super().__init__(
-            pop_size=pop_size,
-            **paper_operators(sampling, crossover, mutation, output),
-            selection=RandomSelection() if mating == "random" else RankTournament(),
-            survival=EFRRRSurvival(ref_dirs, n_neighbors=n_neighbors,
-                                   scalarizing=scalarizing, theta=theta),
-            eliminate_duplicates=eliminate_duplicates,
-            advance_after_initial_infill=True,
-        )
-
-    def _setup(self, problem, **kwargs):
-        if self.ref_dirs.shape[1] != problem.n_obj:
-            raise ValueError(f"ref_dirs must have {problem.n_obj} columns (the problem's objectives), "
-                             f"got shape {self.ref_dirs.shape}")
-        self.survival.reset()
+        survival = EFRRRSurvival(ref_dirs, n_neighbors=n_neighbors, scalarizing=scalarizing, theta=theta)
+        super().__init__(survival, RandomSelection() if mating == "random" else RankTournament(), pop_size=pop_size,
+                         ref_dirs=ref_dirs, sampling=sampling, crossover=crossover, mutation=mutation,
+                         eliminate_duplicates=eliminate_duplicates, output=output)
 
 
 def make_efr_rr(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

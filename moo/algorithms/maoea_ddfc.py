@@ -10,7 +10,7 @@ Objectives are normalised with the ideal point ``z*`` (best value seen so far)
 and the nadir estimate ``z^nad`` from the intercepts of the hyperplane through
 the extreme points found among the non-dominated solutions (NSGA-III's
 procedure; the project's
-:class:`moo.algorithms._normalize.HyperplaneNormalization`)::
+:class:`moo.algorithms.normalization.HyperplaneNormalization`)::
 
     f~_i(x) = (f_i(x) - z*_i) / (z^nad_i - z*_i).
 
@@ -97,15 +97,14 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 import numpy as np
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.selection import Selection
 from pymoo.core.survival import Survival
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
-from .._validation import as_matrix, check_choice, check_int
-from ._base import NormalizationForwarding, factory_arguments, objectives, paper_operators
-from ._normalize import HyperplaneNormalization
+from ..validation import as_matrix, check_choice, check_int
+from .base import MOEA, NormalizationForwarding, factory_arguments, objectives
+from .normalization import HyperplaneNormalization
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -318,7 +317,7 @@ class DDFCMatingSelection(Selection):
         return tournament_winners(F, fc, a, b).reshape(n_select, n_parents)
 
 
-class MaOEADDFC(GeneticAlgorithm):
+class MaOEADDFC(MOEA):
     """MaOEA-DDFC as a pymoo genetic algorithm (see the module docstring).
 
     Parameters
@@ -341,24 +340,18 @@ class MaOEADDFC(GeneticAlgorithm):
                  n_candidates: int = 3, candidate_choice: _CandidateChoice = "roulette", sampling=None,
                  crossover=None, mutation=None, eliminate_duplicates: bool = True, output=None):
         self.n_obj = check_int(n_obj, "n_obj", 2)
-        pop_size = check_int(pop_size, "pop_size", 2)
         n_neighbors = check_int(n_neighbors, "n_neighbors", 1)
         n_candidates = check_int(n_candidates, "n_candidates", 1)
         candidate_choice = check_choice(candidate_choice, "candidate_choice", _CHOICES)
-        super().__init__(
-            pop_size=pop_size,
-            **paper_operators(sampling, crossover, mutation, output),
-            selection=DDFCMatingSelection(),
-            survival=DDFCSurvival(self.n_obj, n_neighbors=n_neighbors, n_candidates=n_candidates,
-                                  candidate_choice=candidate_choice),
-            eliminate_duplicates=eliminate_duplicates,
-            advance_after_initial_infill=True,
-        )
+        survival = DDFCSurvival(self.n_obj, n_neighbors=n_neighbors, n_candidates=n_candidates,
+                                candidate_choice=candidate_choice)
+        super().__init__(survival, DDFCMatingSelection(), pop_size=pop_size, sampling=sampling, crossover=crossover,
+                         mutation=mutation, eliminate_duplicates=eliminate_duplicates, output=output)
 
     def _setup(self, problem, **kwargs):
         if problem.n_obj != self.n_obj:
             raise ValueError(f"n_obj is {self.n_obj} but the problem has {problem.n_obj} objectives")
-        self.survival.reset()
+        super()._setup(problem, **kwargs)
 
 
 def make_maoea_ddfc(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

@@ -75,15 +75,14 @@ from __future__ import annotations
 
 import numpy as np
 from moocore import is_nondominated
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.population import Population
 from pymoo.core.survival import Survival
 from pymoo.operators.selection.rnd import RandomSelection
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 from scipy.spatial.distance import cdist
 
-from .._validation import check_int
-from ._base import factory_arguments, objectives, paper_operators
+from ..validation import check_int
+from .base import MOEA, factory_arguments, objectives
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -339,7 +338,7 @@ class IGDNSSurvival(Survival):
         return pop[np.concatenate(selected)]
 
 
-class MOEAIGDNS(GeneticAlgorithm):
+class MOEAIGDNS(MOEA):
     """MOEA/IGD-NS (Tian, Zhang, Cheng & Jin, CEC 2016) as a pymoo algorithm.
 
     Parameters
@@ -356,21 +355,11 @@ class MOEAIGDNS(GeneticAlgorithm):
     """
 
     def __init__(self, *, pop_size: int = POP_SIZE, archive_size: int | None = None, sampling=None,
-                 crossover=None, mutation=None, eliminate_duplicates: bool = True) -> None:
+                 crossover=None, mutation=None, eliminate_duplicates: bool = True, output=None) -> None:
         pop_size = check_int(pop_size, "pop_size", 2)
-        if archive_size is None:
-            archive_size = 5 * pop_size
-        super().__init__(
-            pop_size=pop_size,
-            **paper_operators(sampling, crossover, mutation),
-            selection=RandomSelection(),
-            survival=IGDNSSurvival(archive_size),
-            eliminate_duplicates=eliminate_duplicates,
-            advance_after_initial_infill=True,
-        )
-
-    def _setup(self, problem, **kwargs) -> None:
-        self.survival.reset()
+        survival = IGDNSSurvival(5 * pop_size if archive_size is None else archive_size)
+        super().__init__(survival, RandomSelection(), pop_size=pop_size, sampling=sampling, crossover=crossover,
+                         mutation=mutation, eliminate_duplicates=eliminate_duplicates, output=output)
 
 
 def make_moea_igd_ns(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

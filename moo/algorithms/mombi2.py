@@ -107,12 +107,11 @@ other implementations) is in the documentation's Validation pages,
 from __future__ import annotations
 
 import numpy as np
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
 from pymoo.operators.selection.tournament import TournamentSelection
 
-from .._validation import check_directions, check_int, check_real
-from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, float_column, objectives, paper_operators
+from ..validation import check_directions, check_int, check_real
+from .base import MOEA, factory_arguments, factory_ref_dirs, float_column, objectives
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -366,7 +365,7 @@ def _compare_in_population(pop, P, random_state=None, **kwargs) -> np.ndarray:
                          float_column(pop.get("r2_norm"), np.inf), random_state)
 
 
-class MOMBI2(GeneticAlgorithm):
+class MOMBI2(MOEA):
     """MOMBI-II (Hernandez Gomez & Coello Coello, GECCO 2015) as a pymoo algorithm.
 
     Parameters
@@ -386,24 +385,12 @@ class MOMBI2(GeneticAlgorithm):
 
     def __init__(self, ref_dirs: np.ndarray, *, pop_size: int | None = None, alpha: float = 0.5,
                  epsilon: float = 1e-3, record_size: int = 5, sampling=None, crossover=None,
-                 mutation=None, eliminate_duplicates: bool = True) -> None:
+                 mutation=None, eliminate_duplicates: bool = True, output=None) -> None:
         ref_dirs = check_directions(ref_dirs)
-        if pop_size is None:
-            pop_size = len(ref_dirs)
-        pop_size = check_int(pop_size, "pop_size", 2)
-        self.ref_dirs = ref_dirs
-        super().__init__(
-            pop_size=pop_size,
-            **paper_operators(sampling, crossover, mutation),
-            selection=TournamentSelection(func_comp=_compare_in_population),
-            survival=R2RankingSurvival(ref_dirs, alpha=alpha, epsilon=epsilon, record_size=record_size),
-            eliminate_duplicates=eliminate_duplicates,
-            advance_after_initial_infill=True,
-        )
-
-    def _setup(self, problem, **kwargs) -> None:
-        check_ref_dirs_fit(self.ref_dirs, problem)
-        self.survival.reset()
+        survival = R2RankingSurvival(ref_dirs, alpha=alpha, epsilon=epsilon, record_size=record_size)
+        super().__init__(survival, TournamentSelection(func_comp=_compare_in_population), pop_size=pop_size,
+                         ref_dirs=ref_dirs, sampling=sampling, crossover=crossover, mutation=mutation,
+                         eliminate_duplicates=eliminate_duplicates, output=output)
 
 
 def make_mombi2(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

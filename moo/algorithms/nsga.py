@@ -10,7 +10,7 @@ import numpy as np
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.algorithms.moo.nsga3 import NSGA3
 
-from ._base import factory_arguments, factory_ref_dirs
+from .base import factory_arguments, factory_ref_dirs
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = ["make_nsga2", "make_nsga3", "NSGA2_ORIGINAL_OPERATORS", "NSGA3_ORIGINAL_OPERATORS"]

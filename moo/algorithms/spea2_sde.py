@@ -72,12 +72,10 @@ other implementations) is in the documentation's Validation pages,
 from __future__ import annotations
 
 import numpy as np
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.survival import Survival
-from pymoo.termination.default import DefaultMultiObjectiveTermination
 
-from .._validation import as_float_array, as_objectives
-from ._base import BinaryTournament, factory_arguments, float_column, objectives, paper_operators
+from ..validation import as_float_array, as_objectives
+from .base import MOEA, BinaryTournament, factory_arguments, float_column, objectives
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -345,7 +343,7 @@ def _sde_tournament(pop, P, random_state=None, **kwargs):
     return winner[:, None].astype(int)
 
 
-class SPEA2SDE(GeneticAlgorithm):
+class SPEA2SDE(MOEA):
     """SPEA2+SDE as a pymoo algorithm (archive = ``pop``, offspring = population).
 
     Parameters
@@ -363,15 +361,10 @@ class SPEA2SDE(GeneticAlgorithm):
 
     def __init__(self, *, pop_size: int = POP_SIZE, sampling=None, crossover=None, mutation=None,
                  normalize: bool = True, eliminate_duplicates: bool = True, output=None):
-        super().__init__(
-            pop_size=pop_size,
-            **paper_operators(sampling, crossover, mutation, output),
-            selection=BinaryTournament(_sde_tournament),   # with replacement (Zitzler et al. 2001, Step 5)
-            survival=SPEA2SDESurvival(normalize=normalize),
-            eliminate_duplicates=eliminate_duplicates,
-            advance_after_initial_infill=True,
-        )
-        self.termination = DefaultMultiObjectiveTermination()
+        super().__init__(SPEA2SDESurvival(normalize=normalize),
+                         BinaryTournament(_sde_tournament),   # with replacement (Zitzler et al. 2001, Step 5)
+                         pop_size=pop_size, sampling=sampling, crossover=crossover, mutation=mutation,
+                         eliminate_duplicates=eliminate_duplicates, output=output)
 
 
 def make_spea2_sde(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

@@ -13,9 +13,9 @@ union ``Q = P u P'`` of parents and offspring:
 1. *Normalisation* (Sec. III-A): ``f~ = (f - z_min) / (z_max - z_min)``. The
    paper's reading (``normalization="front"``) takes ``z_min``, ``z_max`` as
    the minimum and maximum of each objective over the non-dominated members
-   of ``Q`` (:func:`moo.algorithms._normalize.front_bounds`); the default
+   of ``Q`` (:func:`moo.algorithms.normalization.front_bounds`); the default
    (``"hyperplane"``) takes the shared ideal point and hyperplane nadir of
-   :class:`moo.algorithms._normalize.HyperplaneNormalization` (see
+   :class:`moo.algorithms.normalization.HyperplaneNormalization` (see
    "Readings").
 2. *Space partition* (Sec. III-A): ``x`` belongs to the subregion
    ``Omega_j`` of the reference direction with the smallest acute angle
@@ -103,7 +103,6 @@ from __future__ import annotations
 
 import numpy as np
 from moocore import is_nondominated
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.crossover import Crossover
 from pymoo.core.mutation import Mutation
 from pymoo.core.sampling import Sampling
@@ -112,9 +111,9 @@ from pymoo.core.survival import Survival
 from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 
-from .._validation import check_choice, check_directions, check_int
-from ._base import check_ref_dirs_fit, factory_arguments, factory_ref_dirs, objectives, paper_operators
-from ._normalize import HyperplaneNormalization, front_bounds
+from ..validation import check_choice, check_directions, check_int
+from .base import MOEA, factory_arguments, factory_ref_dirs, objectives
+from .normalization import HyperplaneNormalization, front_bounds
 from .operators import POP_SIZE, OperatorSettings
 from .theta_dea import finite_first, select_by_fronts, theta_nondominated_ranks
 
@@ -299,7 +298,7 @@ class NeighbourMatingSelection(Selection):
         return np.stack([first, mate], axis=1)
 
 
-class SPEAR(GeneticAlgorithm):
+class SPEAR(MOEA):
     """SPEA/R as a pymoo algorithm (see the module docstring).
 
     Parameters
@@ -326,21 +325,10 @@ class SPEAR(GeneticAlgorithm):
                  eliminate_duplicates: bool = True, n_offsprings: int | None = None,
                  output: Output | None = None):
         ref_dirs = check_directions(ref_dirs)
-        pop_size = check_int(len(ref_dirs) if pop_size is None else pop_size, "pop_size", 2)
-        self.ref_dirs = ref_dirs
-        super().__init__(
-            pop_size=pop_size,
-            selection=NeighbourMatingSelection(check_int(k_mating, "k_mating", 1)),
-            survival=SPEARSurvival(ref_dirs, normalization=normalization),
-            eliminate_duplicates=eliminate_duplicates,
-            n_offsprings=n_offsprings,
-            advance_after_initial_infill=True,
-            **paper_operators(sampling, crossover, mutation, output),
-        )
-
-    def _setup(self, problem, **kwargs):
-        check_ref_dirs_fit(self.ref_dirs, problem)
-        self.survival.reset()
+        selection = NeighbourMatingSelection(check_int(k_mating, "k_mating", 1))
+        super().__init__(SPEARSurvival(ref_dirs, normalization=normalization), selection, pop_size=pop_size,
+                         ref_dirs=ref_dirs, sampling=sampling, crossover=crossover, mutation=mutation,
+                         eliminate_duplicates=eliminate_duplicates, n_offsprings=n_offsprings, output=output)
 
 
 def make_spea_r(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

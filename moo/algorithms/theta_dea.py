@@ -13,7 +13,7 @@ One generation (the paper's Algorithm 1):
 3. *Normalize* ``S`` (Sec. III-C): running ideal point ``z*``, extreme points
    by the achievement scalarising function, nadir ``z_nad`` from the
    hyperplane intercepts (falling back to the worst of ``F_1``), then
-   ``f~ = (f - z*) / (z_nad - z*)``; see :mod:`moo.algorithms._normalize`.
+   ``f~ = (f - z*) / (z_nad - z*)``; see :mod:`moo.algorithms.normalization`.
 4. *Clustering* (Sec. III-D): each ``x`` in ``S`` joins the cluster ``C_j`` of
    the reference direction ``w_j`` with the smallest perpendicular distance
 
@@ -47,7 +47,7 @@ code (Yuan Yuan, github.com/yyxhdy/ManyEAs, ``ThetaDEA.java``,
   compute the ASF exactly as printed; the shared normalisation reads terms
   below 1e-3 of the scale as zero, which keeps a poorly converged point lying
   exactly on an axis from staying the extreme point for the whole run
-  (``moo.algorithms._normalize``, "Readings"; measured:
+  (``moo.algorithms.normalization``, "Readings"; measured:
   :ref:`validation-theta-dea`).
 * Operators: ``operators="original"`` gives the authors' settings
   (``ThetaDEA_main.java``: SBX probability 1.0, distribution index 30;
@@ -70,13 +70,12 @@ code (Yuan Yuan, github.com/yyxhdy/ManyEAs, ``ThetaDEA.java``,
 * Individuals with a NaN or infinite objective rank behind all others
   (:func:`finite_first`); the paper assumes finite objectives.
 * Degenerate normalisation ranges are repaired as documented in
-  :mod:`moo.algorithms._normalize` (the paper has no such case).
+  :mod:`moo.algorithms.normalization` (the paper has no such case).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from pymoo.algorithms.base.genetic import GeneticAlgorithm
 from pymoo.core.crossover import Crossover
 from pymoo.core.mutation import Mutation
 from pymoo.core.population import Population
@@ -87,16 +86,9 @@ from pymoo.util.display.output import Output
 from pymoo.util.misc import random_permutations
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from .._validation import check_directions, check_int, check_real
-from ._base import (
-    NormalizationForwarding,
-    check_ref_dirs_fit,
-    factory_arguments,
-    factory_ref_dirs,
-    objectives,
-    paper_operators,
-)
-from ._normalize import HyperplaneNormalization
+from ..validation import check_directions, check_real
+from .base import MOEA, NormalizationForwarding, factory_arguments, factory_ref_dirs, objectives
+from .normalization import HyperplaneNormalization
 from .operators import POP_SIZE, OperatorSettings
 
 __all__ = [
@@ -233,7 +225,7 @@ class RandomFeasibleSelection(Selection):
 class ThetaSurvival(NormalizationForwarding, Survival):
     """theta-DEA environmental selection (steps 2-6 of the module docstring).
 
-    Keeps its own :class:`~moo.algorithms._normalize.HyperplaneNormalization`
+    Keeps its own :class:`~moo.algorithms.normalization.HyperplaneNormalization`
     (ideal point, extreme points, nadir; exposed as ``ideal_point``,
     ``nadir_point``, ``normalize`` and ``reset``) across calls, so it may be called
     any number of times per generation on populations of any size.
@@ -269,7 +261,7 @@ class ThetaSurvival(NormalizationForwarding, Survival):
         return survivors
 
 
-class ThetaDEA(GeneticAlgorithm):
+class ThetaDEA(MOEA):
     """theta-DEA as a pymoo algorithm (see the module docstring).
 
     Parameters
@@ -295,22 +287,10 @@ class ThetaDEA(GeneticAlgorithm):
                  mutation: Mutation | None = None, eliminate_duplicates: bool = True,
                  n_offsprings: int | None = None, output: Output | None = None):
         ref_dirs = check_directions(ref_dirs)
-        pop_size = check_int(len(ref_dirs) if pop_size is None else pop_size, "pop_size", 2)
-        self.ref_dirs = ref_dirs
         self.theta = check_real(theta, "theta", positive=False)
-        super().__init__(
-            pop_size=pop_size,
-            selection=RandomFeasibleSelection(),
-            survival=ThetaSurvival(ref_dirs, theta=self.theta),
-            eliminate_duplicates=eliminate_duplicates,
-            n_offsprings=n_offsprings,
-            advance_after_initial_infill=True,
-            **paper_operators(sampling, crossover, mutation, output),
-        )
-
-    def _setup(self, problem, **kwargs):
-        check_ref_dirs_fit(self.ref_dirs, problem)
-        self.survival.reset()
+        super().__init__(ThetaSurvival(ref_dirs, theta=self.theta), RandomFeasibleSelection(), pop_size=pop_size,
+                         ref_dirs=ref_dirs, sampling=sampling, crossover=crossover, mutation=mutation,
+                         eliminate_duplicates=eliminate_duplicates, n_offsprings=n_offsprings, output=output)
 
 
 def make_theta_dea(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

@@ -74,7 +74,37 @@ REF_MARGIN = 0.1
 
 
 class ZDT5Real(zdt.ZDT5):
-    """ZDT5 on [0, 1]^80 read as bits ``x >= 0.5`` (pymoo's normalised objectives)."""
+    r"""ZDT5 on [0, 1]^80 read as bits ``x >= 0.5`` (pymoo's normalised objectives).
+
+    ZDT5 is a binary problem; this real-coded relaxation lets the
+    real-coded operators of the registry run on it. Its objectives are
+    those of pymoo's ZDT5 at the bits :math:`b_i = [x_i \ge 0.5]`.
+
+    Parameters
+    ----------
+    m, n, normalize
+        As pymoo's ZDT5: ``m`` groups of bits (11), the first of 30 bits and
+        the others of ``n`` (5); ``normalize`` the objectives (True).
+
+    See Also
+    --------
+    make_problem : ``make_problem("zdt5")`` returns it, with reference points.
+
+    References
+    ----------
+    .. [1] E. Zitzler, K. Deb and L. Thiele, "Comparison of multiobjective
+       evolutionary algorithms: empirical results", Evol. Comput. 8(2),
+       173-195, 2000.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pymoo.problems.multi.zdt import ZDT5
+    >>> from moo.problems import ZDT5Real
+    >>> x = np.random.default_rng(0).random((4, 80))
+    >>> np.allclose(ZDT5Real().evaluate(x), ZDT5().evaluate((x >= 0.5).astype(float)))
+    True
+    """
 
     def _evaluate(self, x, out, *args, **kwargs):
         super()._evaluate((np.asarray(x) >= 0.5).astype(float), out, *args, **kwargs)
@@ -88,16 +118,66 @@ def _dtlz7_hump() -> tuple[float, float]:
 
 
 def true_front_bounds(name: str, n_obj: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Ideal and nadir points of the true Pareto front of a ZDT/DTLZ/WFG problem (closed forms).
+    r"""Ideal and nadir points of the true Pareto front of a ZDT/DTLZ/WFG problem (closed forms).
 
+    Parameters
+    ----------
+    name : str
+        ``zdt1`` ... ``zdt6``, ``dtlz1`` ... ``dtlz7``, ``wfg1`` ... ``wfg9``
+        (case-insensitive).
+    n_obj : int, optional
+        Number of objectives (DTLZ and WFG; default 3).
+
+    Returns
+    -------
+    ideal, nadir : (n_obj,) ndarray
+        The smallest and largest value of each objective on the true front.
+
+    Raises
+    ------
+    ValueError
+        A name that is not a ZDT, DTLZ or WFG problem.
+
+    See Also
+    --------
+    make_problem : sets the reference points from these bounds.
+
+    Notes
+    -----
     ZDT1/2/4/5: [0, 0], [1, 1] (ZDT5 normalised as in pymoo); ZDT3: f1 in
     [0, 0.8518], f2 in [-0.7734, 1]; ZDT6: f1 in [0.2808, 1] (the minimum of
     ``1 - exp(-4 x) sin^6(6 pi x)``), f2 = 1 - f1^2 in [0, 0.9212]. DTLZ1: 0 and 0.5;
     DTLZ2-4: 0 and 1; DTLZ5/6 (a curve): nadir
     ``[c^(M-2), c^(M-2), c^(M-3), ..., c, 1]``, ``c = 1/sqrt(2)``; DTLZ7: f_i
     (i < M) in [0, x*], f_M in [2 (M - (M-1) h(x*)), 2M], with x* ~ 0.8594 the
-    maximiser of ``h(x) = x/2 (1 + sin 3 pi x)`` on the front's last segment.
-    WFG: 0 and ``2 m`` (WFG3: the line's ends, see the module docstring).
+    maximiser of
+
+    .. math::
+
+        h(x) = \tfrac{x}{2} \big(1 + \sin 3 \pi x\big)
+
+    on the front's last segment. WFG: 0 and ``2 m`` (WFG3: the line's ends,
+    see the module docstring).
+
+    References
+    ----------
+    .. [1] K. Deb, L. Thiele, M. Laumanns and E. Zitzler, "Scalable test
+       problems for evolutionary multiobjective optimization", in Evolutionary
+       Multiobjective Optimization, Springer, 105-145, 2005.
+    .. [2] S. Huband, P. Hingston, L. Barone and L. While, "A review of
+       multiobjective test problems and a scalable test problem toolkit",
+       IEEE TEVC 10(5), 477-506, 2006.
+
+    Examples
+    --------
+    The bounds of DTLZ2's front are those of pymoo's sampled front:
+
+    >>> import numpy as np
+    >>> from moo.problems import make_problem, true_front_bounds
+    >>> ideal, nadir = true_front_bounds("dtlz2", 3)
+    >>> front = make_problem("dtlz2", 3).pareto_front()
+    >>> np.allclose(front.min(axis=0), ideal), np.allclose(front.max(axis=0), nadir)
+    (True, True)
     """
     key = name.lower()
     if key in _WFG:
@@ -139,7 +219,7 @@ def true_front_bounds(name: str, n_obj: int | None = None) -> tuple[np.ndarray, 
 
 
 def make_problem(name: str, n_obj: int | None = None, *, setup: str | None = None) -> Problem:
-    """A problem by name, with ``hv_ref_point`` and ``molsp_ref_point`` attributes.
+    r"""A problem by name, with ``hv_ref_point`` and ``molsp_ref_point`` attributes.
 
     Parameters
     ----------
@@ -154,12 +234,47 @@ def make_problem(name: str, n_obj: int | None = None, *, setup: str | None = Non
         ``applied`` only: ``"ours"`` (default) or ``"authors"``
         (:class:`~moo.problems.applied.AppliedRLQRProblem`).
 
+    Returns
+    -------
+    pymoo.core.problem.Problem
+        The problem, with the two reference points (module docstring).
+
     Raises
     ------
+    TypeError
+        ``name`` not a string, ``n_obj`` not an integer.
     ValueError
-        Unknown name or an ``n_obj`` the problem does not have.
+        Unknown name or an ``n_obj`` the problem does not have, a ``setup``
+        for a problem other than ``applied``.
     NotImplementedError
         ``generic``/``applied`` when their module is not available.
+
+    See Also
+    --------
+    true_front_bounds : the benchmarks' ideal and nadir points.
+    moo.run : one run on a problem by name.
+
+    Notes
+    -----
+    For the benchmarks both reference points are
+
+    .. math::
+
+        r = z^{nad} + 0.1\, (z^{nad} - z^*)
+
+    from the true front's ideal :math:`z^*` and nadir :math:`z^{nad}`
+    (:func:`true_front_bounds`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from moo.problems import make_problem, true_front_bounds
+    >>> problem = make_problem("dtlz2", n_obj=3)
+    >>> problem.n_var, problem.n_obj
+    (12, 3)
+    >>> ideal, nadir = true_front_bounds("dtlz2", 3)
+    >>> np.allclose(problem.hv_ref_point, nadir + 0.1 * (nadir - ideal))
+    True
     """
     if not isinstance(name, str):
         raise TypeError(f"name must be a string, got {type(name).__name__}")

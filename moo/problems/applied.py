@@ -41,8 +41,8 @@ from robustctl.sim.simulator import DEFAULT_BOUND
 from robustctl.validation import check_positive_scalar
 
 from ..tuning import RLQRFamily, TuningProblem
-from ._errors import ErrorColumn, ScenarioErrors
 from .generic import positive_ref_point
+from .scenario_errors import ErrorColumn, ScenarioErrors
 
 __all__ = ["AppliedRLQRProblem", "PathFollowingErrors", "PathFollowingError"]
 
@@ -58,7 +58,7 @@ class PathFollowingErrors(ScenarioErrors):
     calling with gains ``K`` (B, 2, 4) returns the MSEs (B, 4) combined over the
     scenarios (``mean`` or ``max``); the last population's result is
     memoised, so the four goals :class:`PathFollowingError` of one population
-    cost one simulation (:class:`~moo.problems._errors.ScenarioErrors`). The
+    cost one simulation (:class:`~moo.problems.scenario_errors.ScenarioErrors`). The
     simulator is built for the problem's payloads: other plant lists are
     refused (``ValueError``).
 

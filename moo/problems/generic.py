@@ -40,9 +40,9 @@ import numpy as np
 import robustctl as rc
 from robustctl.sim.simulator import LinearSimulator
 
-from .._validation import as_matrix, check_int
 from ..tuning import RLQRFamily, TuningProblem
-from ._errors import ErrorColumn, ScenarioErrors
+from ..validation import as_matrix, check_int
+from .scenario_errors import ErrorColumn, ScenarioErrors
 
 __all__ = ["GenericRLQRProblem", "RegulationErrors", "RegulationError", "positive_ref_point"]
 
@@ -75,7 +75,7 @@ class RegulationErrors(ScenarioErrors):
     initial state ``x_{0,i}`` gives ``e_{j,s} = sum_i sum_{k=0}^{N} x_j^{(s,i)}[k]^2``,
     combined over the plants with ``mean`` or ``max``; the last population's
     result is memoised, so the three goals :class:`RegulationError` of one
-    population cost one simulation (:class:`~moo.problems._errors.ScenarioErrors`).
+    population cost one simulation (:class:`~moo.problems.scenario_errors.ScenarioErrors`).
 
     Parameters
     ----------

@@ -70,9 +70,9 @@ from robustctl.models.path import ReferencePath, default_route
 from robustctl.models.pathfollow import PathFollowing, PathFollowingSetup
 from robustctl.sim.simulator import check_gains
 
-from .._validation import as_matrix, check_int
 from ..tuning import TuningProblem
 from ..tuning.selection import SelectionResult, check_weights, default_weights, draw_errors, monte_carlo_selection
+from ..validation import as_matrix, check_int
 from .applied import AppliedRLQRProblem
 from .generic import GenericRLQRProblem
 

@@ -37,16 +37,20 @@ import numpy as np
 import robustctl as rc
 from robustctl.validation import check_plant, check_positive_scalar
 
-from .._validation import as_float_array, as_matrix, check_int
+from ..validation import as_float_array, as_matrix, check_int
 
 __all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
 class FamilyGains:
-    """Gains of a population of designs.
+    """Gains of a population of designs, with the designs that failed flagged.
 
-    Attributes
+    What a :class:`DesignFamily`'s ``gains`` returns: a failed design is a flagged row,
+    never an exception for the whole population. The fields are attributes
+    of the same names.
+
+    Parameters
     ----------
     K : (B, m, n) ndarray
         Gains ``u = K x`` for the scenario plants (NaN rows where ``ok`` is False).
@@ -54,6 +58,21 @@ class FamilyGains:
         The design was computed.
     reason : (B,) object ndarray of str
         ``""`` where ``ok``, otherwise why not (e.g. ``"not converged"``, ``"rank"``).
+
+    See Also
+    --------
+    DesignFamily : the protocol whose ``gains`` returns this.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from moo.tuning import FamilyGains
+    >>> K = np.array([[[-1.0, -2.0]], [[np.nan, np.nan]]])
+    >>> fg = FamilyGains(K, ok=np.array([True, False]), reason=np.array(["", "not converged"], dtype=object))
+    >>> fg
+    FamilyGains(B=2, m=1, n=2, failed=1)
+    >>> fg.reason[~fg.ok].tolist()
+    ['not converged']
     """
 
     K: np.ndarray
@@ -84,19 +103,31 @@ class DesignFamily(Protocol):
         ``Z`` (B, n_var) -> :class:`FamilyGains`; a design that cannot be
         computed is flagged (``ok`` False, NaN row), never raised.
 
+    See Also
+    --------
+    RLQRFamily, LQRFamily : the two families provided.
+    moo.tuning.TuningProblem : what uses a family.
+
     Examples
     --------
-    A family that searches a gain directly, ``K = z.reshape(m, n)``::
+    A family that searches a gain directly, ``K = z.reshape(m, n)``:
 
-        class DirectGain:
-            def __init__(self, n, m, bound=5.0):
-                self.n_states, self.n_inputs, self.n_var = n, m, n * m
-                self.xl, self.xu = np.full(n * m, -bound), np.full(n * m, bound)
-
-            def gains(self, Z):
-                B = Z.shape[0]
-                return FamilyGains(Z.reshape(B, self.n_inputs, self.n_states),
-                                   np.ones(B, bool), np.full(B, "", object))
+    >>> import numpy as np
+    >>> from moo.tuning import DesignFamily, FamilyGains
+    >>> class DirectGain:
+    ...     def __init__(self, n, m, bound=5.0):
+    ...         self.n_states, self.n_inputs, self.n_var = n, m, n * m
+    ...         self.xl, self.xu = np.full(n * m, -bound), np.full(n * m, bound)
+    ...
+    ...     def gains(self, Z):
+    ...         B = Z.shape[0]
+    ...         return FamilyGains(Z.reshape(B, self.n_inputs, self.n_states),
+    ...                            np.ones(B, bool), np.full(B, "", object))
+    >>> fam = DirectGain(n=2, m=1)
+    >>> isinstance(fam, DesignFamily)
+    True
+    >>> fam.gains(np.array([[-1.0, -2.0]])).K
+    array([[[-1., -2.]]])
     """
 
     n_var: int
@@ -118,7 +149,7 @@ def _input_map(input_map, plant: rc.Plant) -> tuple[np.ndarray | None, rc.Plant]
     return M, rc.Plant(plant.F, plant.G @ M, dt=plant.dt)
 
 
-def _bounds(value, name: str, default: np.ndarray) -> np.ndarray:
+def bound_vector(value, name: str, default: np.ndarray) -> np.ndarray:
     if value is None:
         return default.copy()
     arr = as_float_array(value, name)
@@ -162,17 +193,11 @@ def _reasons(ok: np.ndarray, reason) -> np.ndarray:
 class RLQRFamily:
     r"""The paper's RLQR design family, for any plant size and uncertainty rank.
 
-    .. math::
-
-        z = \big(\operatorname{vec}_r E_F\ (l n),\ \operatorname{vec}_r E_G\ (l m),\
-        (\log_{10}\mu)^2\big), \qquad
-        K(z) = \text{steady-state RLQR of } (F, G M; H, E_F, E_G, \mu; Q, R),
-
-    ``vec_r`` row by row, ``mu = 10**sqrt(z[-1])``, ``l`` the number of
-    columns of ``H`` (``Delta`` is ``l x l``). The gains of a whole population
-    come from one call of :func:`robustctl.rlqr_gains`; designs it flags
-    (rank condition, not converged, diverged) are flagged here too. With an
-    ``input_map`` ``M`` the returned gain is ``M K_d``.
+    A decision vector ``z`` is a candidate uncertainty model ``(E_F, E_G)``
+    and penalty ``mu``; its gain is the steady-state robust LQR of that model
+    (Notes). The gains of a whole population come from one call of
+    :func:`robustctl.rlqr_gains`; designs it flags (rank condition, not
+    converged, diverged) are flagged here too.
 
     Parameters
     ----------
@@ -209,6 +234,57 @@ class RLQRFamily:
         Default bounds (``[0, e_bound]`` and ``[0, log_mu_bound]``).
     design_plant : robustctl.Plant
         ``(F, G M)`` (the plant itself without an input map).
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``plant`` not a discrete-time :class:`robustctl.Plant`; ``H``, ``Q``,
+        ``R`` or ``input_map`` of the wrong shape (the message names it and
+        the shapes); a non-positive ``alpha``, ``e_bound`` or
+        ``log_mu_bound``; an unknown ``fallback``.
+
+    See Also
+    --------
+    robustctl.rlqr_gains : the batched RLQR every population goes through.
+    robustctl.rlqr : one RLQR design.
+    LQRFamily : diagonal LQR weights as the decision vector.
+
+    Notes
+    -----
+    With ``l`` the number of columns of ``H`` (``Delta`` is ``l x l``) and
+    :math:`\operatorname{vec}_r` the entries row by row,
+
+    .. math::
+
+        z = \big(\operatorname{vec}_r E_F\ (l n),\ \operatorname{vec}_r E_G\ (l m),\
+        (\log_{10}\mu)^2\big), \qquad
+        K(z) = \text{steady-state RLQR of } (F, G M;\ H, E_F, E_G, \mu;\ Q, R),
+
+    so :math:`\mu = 10^{\sqrt{z_{-1}}}`. With an ``input_map`` ``M`` the
+    returned gain is :math:`M K_d`.
+
+    References
+    ----------
+    .. [1] D. C. Morais et al., "Robust path-following control design of heavy
+       vehicles based on multiobjective evolutionary optimization", Expert
+       Systems with Applications 192 (2022) 116304, Section 3.1.
+
+    Examples
+    --------
+    The gain of ``z = (E_F, E_G, (log10 mu)^2) = (0.1, 0.2, 0.05, 4)`` is the
+    RLQR design of that model with ``mu = 100``:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo.tuning import RLQRFamily
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> fam = RLQRFamily(plant)
+    >>> fam.n_var                                   # l (n + m) + 1, l = 1
+    4
+    >>> fg = fam.gains(np.array([[0.1, 0.2, 0.05, 4.0]]))
+    >>> ctrl = rc.rlqr(plant, [[0.1, 0.2]], [[0.05]], 100.0, H=np.ones((2, 1)))
+    >>> bool(fg.ok[0]), np.allclose(fg.K[0], ctrl.K)
+    (True, True)
     """
 
     def __init__(self, plant: rc.Plant, *, H=None, Q=None, R=None, alpha: float = 0.1, max_iter: int = 500,
@@ -308,9 +384,47 @@ def dlqr_gains(F, G, Q, R, *, tol: float = 1e-12, max_iter: int = 100) -> tuple[
     Returns
     -------
     K : (B, m, n) ndarray
+        The gains, ``u = K x``.
     X : (B, n, n) ndarray
+        The Riccati solutions.
     ok : (B,) bool ndarray
-        Converged, finite, and ``F + G K`` Schur-stable.
+        Converged, finite, and ``F + G K`` Schur-stable; a design that is not
+        is flagged here, never raised.
+
+    See Also
+    --------
+    LQRFamily : the family built on it.
+    scipy.linalg.solve_discrete_are : one DARE, by the Schur method.
+
+    Notes
+    -----
+    The arguments are not checked (the families pass checked arrays).
+    Vectorised over the designs, the doubling steps of a population cost a
+    few batched ``(B, n, n)`` solves each, against one Schur decomposition
+    per design for :func:`scipy.linalg.solve_discrete_are`.
+
+    References
+    ----------
+    .. [1] E. K.-W. Chu, H.-Y. Fan, W.-W. Lin, C.-S. Wang, "Structure-preserving
+       algorithms for periodic discrete-time algebraic Riccati equations",
+       Int. J. Control 77(8) (2004) 767-788.
+
+    Examples
+    --------
+    Two designs at once; the second Riccati solution satisfies the DARE as
+    :func:`scipy.linalg.solve_discrete_are` computes it:
+
+    >>> import numpy as np
+    >>> from scipy.linalg import solve_discrete_are
+    >>> from moo.tuning import dlqr_gains
+    >>> F, G = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
+    >>> Q = np.stack([np.eye(2), np.diag([1.0, 10.0])])
+    >>> R = np.stack([np.eye(1), 0.1 * np.eye(1)])
+    >>> K, X, ok = dlqr_gains(F, G, Q, R)
+    >>> K.shape, ok
+    ((2, 1, 2), array([ True,  True]))
+    >>> np.allclose(X[1], solve_discrete_are(F, G, Q[1], R[1]))
+    True
     """
     B, n = Q.shape[0], F.shape[0]
     A = np.broadcast_to(F, (B, n, n)).copy()
@@ -343,13 +457,9 @@ def dlqr_gains(F, G, Q, R, *, tol: float = 1e-12, max_iter: int = 100) -> tuple[
 class LQRFamily:
     r"""LQR designs of diagonal weights: ``z = (log10 diag Q (n), log10 diag R (m))``.
 
-    .. math::
-
-        K(z) = \text{DLQR}\big(F, G M;\ \operatorname{diag}(10^{z_{1..n}}),\
-        \operatorname{diag}(10^{z_{n+1..n+m}})\big),
-
-    all designs of a population solved together (:func:`dlqr_gains`). The
-    sign convention is ``u = K x`` (python-control's ``dlqr`` returns ``-K``).
+    All designs of a population are solved together (:func:`dlqr_gains`).
+    The sign convention is ``u = K x`` (python-control's ``dlqr`` returns
+    ``-K``).
 
     Parameters
     ----------
@@ -360,12 +470,54 @@ class LQRFamily:
     log_bound : float
         Default bounds ``[-log_bound, log_bound]`` of every variable (default 4:
         weights from ``1e-4`` to ``1e4``).
+    tol, max_iter
+        Stopping rule of :func:`dlqr_gains` (relative step ``1e-12``, at most
+        100 doubling steps).
 
     Attributes
     ----------
     n_var : int
         ``n + m``.
     xl, xu : (n_var,) ndarray
+        Default bounds of ``z``.
+    design_plant : robustctl.Plant
+        ``(F, G M)`` (the plant itself without an input map).
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``plant`` not a discrete-time :class:`robustctl.Plant`, an
+        ``input_map`` of the wrong shape, a design plant that is not
+        stabilisable, a non-positive ``log_bound`` or ``tol``.
+
+    See Also
+    --------
+    dlqr_gains : the batched Riccati solver.
+    robustctl.lqr : one LQR design.
+    RLQRFamily : the paper's robust family.
+
+    Notes
+    -----
+    .. math::
+
+        K(z) = \text{DLQR}\big(F, G M;\ \operatorname{diag}(10^{z_{1..n}}),\
+        \operatorname{diag}(10^{z_{n+1..n+m}})\big).
+
+    Examples
+    --------
+    ``z = (0, 1, -1)`` is ``Q = diag(1, 10)``, ``R = 0.1``; the gain equals
+    :func:`robustctl.lqr`'s:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo.tuning import LQRFamily
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> fam = LQRFamily(plant)
+    >>> fam.n_var, fam.xl, fam.xu
+    (3, array([-4., -4., -4.]), array([4., 4., 4.]))
+    >>> K = fam.gains(np.array([[0.0, 1.0, -1.0]])).K[0]
+    >>> np.allclose(K, rc.lqr(plant, Q=np.diag([1.0, 10.0]), R=[[0.1]]).K)
+    True
     """
 
     def __init__(self, plant: rc.Plant, *, input_map=None, log_bound: float = 4.0, tol: float = 1e-12,

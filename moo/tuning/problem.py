@@ -39,9 +39,9 @@ from pymoo.core.problem import Problem
 import robustctl as rc
 from robustctl.validation import check_positive_scalar
 
-from .._validation import as_float_array, as_matrix, check_int
-from .families import DesignFamily, FamilyGains, _bounds, check_bounds, population
-from .goals import _stacks, check_scenarios
+from ..validation import as_float_array, as_matrix, check_int
+from .families import DesignFamily, FamilyGains, bound_vector, check_bounds, population
+from .goals import check_scenarios, plant_stacks
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
 
@@ -50,13 +50,62 @@ Goal = Callable[[np.ndarray, list[rc.Plant]], Any]
 
 
 def penalise(J: np.ndarray, ok: np.ndarray, stable: np.ndarray, rho: np.ndarray, penalty: float) -> np.ndarray:
-    """Apply the penalty rule (module docstring) to raw objectives ``J`` (B, M).
+    r"""Apply the penalty rule (module docstring) to raw objectives ``J`` (B, M).
 
-    ``ok`` (B,): the design was computed; ``stable`` (B,): its closed loops are
-    Schur-stable in every scenario; ``rho`` (B,): the largest closed-loop
-    spectral radius over the scenarios (read only where ``ok & ~stable``).
-    Non-finite entries of ``J`` become ``penalty``. Every returned value is
-    finite and the penalised ones are ``>= penalty``.
+    Parameters
+    ----------
+    J : (B, M) ndarray
+        Raw objective values (NaN or inf where a goal gave no number).
+    ok : (B,) bool ndarray
+        The design was computed.
+    stable : (B,) bool ndarray
+        Its closed loops are Schur-stable in every scenario.
+    rho : (B,) ndarray
+        The largest closed-loop spectral radius over the scenarios (read only
+        where ``ok & ~stable``; NaN there counts as 2).
+    penalty : float
+        The penalty ``p``.
+
+    Returns
+    -------
+    (B, M) ndarray
+        Every value finite; the penalised ones ``>= penalty``.
+
+    See Also
+    --------
+    TuningProblem : applies it to every population.
+
+    Notes
+    -----
+    Row by row,
+
+    .. math::
+
+        f_{b} = \begin{cases}
+            2 p & \text{design } b \text{ not computed}, \\
+            p \min(\rho_b, 2) & \text{computed, unstable in some scenario}, \\
+            \min(J_{b}, p) & \text{otherwise (non-finite entries: } p).
+        \end{cases}
+
+    References
+    ----------
+    .. [1] D. C. Morais et al., "Robust path-following control design of heavy
+       vehicles based on multiobjective evolutionary optimization", Expert
+       Systems with Applications 192 (2022) 116304, Section 3.1.
+
+    Examples
+    --------
+    A stable design keeps its values, an unstable one (``rho = 1.5``) gets
+    ``1.5 p``, a failed one ``2 p``:
+
+    >>> import numpy as np
+    >>> from moo.tuning import penalise
+    >>> J = np.array([[1.0, 2.0], [3.0, 4.0], [5.0, 6.0]])
+    >>> penalise(J, ok=np.array([True, True, False]), stable=np.array([True, False, True]),
+    ...          rho=np.array([np.nan, 1.5, np.nan]), penalty=10.0)
+    array([[ 1.,  2.],
+           [15., 15.],
+           [20., 20.]])
     """
     out = np.where(np.isfinite(J), np.minimum(J, penalty), penalty)
     unstable = ok & ~stable
@@ -137,8 +186,11 @@ class TuningProblem(Problem):
     Attributes
     ----------
     scenarios : list of robustctl.Plant
+        The checked scenario list.
     objectives, constraints : list of callables
+        The goals.
     objective_names, constraint_names : list of str
+        Their labels (a goal's ``name``, a function's name, or ``objectives[i]``).
     last_flags : (B,) object ndarray
         Why each design of the last evaluated population was penalised
         (``""`` for none): the family's reason, ``"unstable"``, or
@@ -146,12 +198,56 @@ class TuningProblem(Problem):
 
     Raises
     ------
+    TypeError
+        A family that lacks a member of the :class:`~moo.tuning.DesignFamily`
+        protocol, a goal that is not callable.
     ValueError
         Scenarios of different sizes (naming ``scenarios``), a family whose
         gain size does not fit them, inverted bounds (naming ``xl``/``xu``),
         a goal's ``check`` failing, a reference point of the wrong length.
         During evaluation: a goal that returns anything but ``(B,)`` numbers
         (naming the goal).
+
+    See Also
+    --------
+    moo.tuning.tune : run a MOEA on it.
+    penalise : the penalty rule.
+    moo.tuning.select : pick one design of a front.
+
+    Notes
+    -----
+    For a population :math:`z_1, \dots, z_B` with gains :math:`K_b` and the
+    scenarios :math:`(F_s, G_s)`, a design is acceptable when it is computed
+    and :math:`\rho(F_s + G_s K_b) < 1` for every :math:`s`; its objectives
+    are then :math:`f_j(K_b, \{P_s\})`, and the others are ranked by the
+    penalty rule (:func:`penalise`).
+
+    References
+    ----------
+    .. [1] D. C. Morais et al., "Robust path-following control design of heavy
+       vehicles based on multiobjective evolutionary optimization", Expert
+       Systems with Applications 192 (2022) 116304, Section 3.1.
+
+    Examples
+    --------
+    An LQR family on a double integrator whose input gain is known to 20 %,
+    scored by the mean squared error and the peak input of a response:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo import tuning
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> scenarios = [rc.Plant(plant.F, plant.G * s, dt=0.1) for s in (0.8, 1.0, 1.2)]
+    >>> response = tuning.Response(x0=[1.0, 0.0], steps=50)
+    >>> prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios,
+    ...                             [response.error(), response.peak_input()])
+    >>> prob
+    TuningProblem(family=LQRFamily(n=2, m=1, n_var=3), S=3, n_var=3, objectives=['mse(x)', 'peak |u|'], constraints=[])
+    >>> Z = np.zeros((1, 3))                        # Q = I, R = 1
+    >>> F = prob.evaluate(Z)
+    >>> K = prob.gains(Z).K
+    >>> np.allclose(F, [[goal(K, scenarios)[0] for goal in prob.objectives]])
+    True
     """
 
     def __init__(self, family: DesignFamily, scenarios: Sequence[rc.Plant], objectives: Sequence[Goal],
@@ -176,14 +272,14 @@ class TuningProblem(Problem):
             if callable(check):
                 check(self.scenarios)
         n_var = int(family.n_var)
-        lo = _bounds(family.xl if xl is None else xl, "xl", np.zeros(n_var))
-        hi = _bounds(family.xu if xu is None else xu, "xu", np.zeros(n_var))
+        lo = bound_vector(family.xl if xl is None else xl, "xl", np.zeros(n_var))
+        hi = bound_vector(family.xu if xu is None else xu, "xu", np.zeros(n_var))
         check_bounds(lo, hi)
         self.penalty = check_positive_scalar(penalty, "penalty")
         n_obj = len(self.objectives)
         self.hv_ref_point = _ref_point(hv_ref_point, "hv_ref_point", np.full(n_obj, self.penalty))
         self.molsp_ref_point = _ref_point(molsp_ref_point, "molsp_ref_point", self.hv_ref_point)
-        self._F_s, self._G_s = _stacks(self.scenarios)
+        self._F_s, self._G_s = plant_stacks(self.scenarios)
         self.last_flags = np.zeros(0, dtype=object)
         super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=len(self.constraints), xl=lo, xu=hi, vtype=float)
 
@@ -228,7 +324,7 @@ class TuningProblem(Problem):
         if scenarios is None:
             F_s, G_s = self._F_s, self._G_s
         else:
-            F_s, G_s = _stacks(check_scenarios(scenarios, "scenarios"))
+            F_s, G_s = plant_stacks(check_scenarios(scenarios, "scenarios"))
         return F_s[None] + G_s[None] @ K[:, None]
 
     def closed_loop_radius(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:

@@ -41,7 +41,7 @@ import numpy as np
 
 import robustctl as rc
 
-from .._validation import as_float_array, check_int
+from ..validation import as_float_array, check_int
 
 __all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "scenario_errors", "draw_errors",
            "check_weights", "default_weights"]
@@ -51,7 +51,10 @@ __all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "s
 class SelectionResult:
     """Outcome of :func:`monte_carlo_selection` on ``D`` designs and ``S`` simulations.
 
-    Attributes
+    The fields are attributes of the same names; ``n_designs``,
+    ``n_simulations``, ``n_no_winner`` and :meth:`ranking` are derived.
+
+    Parameters
     ----------
     winners : (S,) int ndarray
         Index of the design with the least error in each simulation (ties: the
@@ -60,6 +63,27 @@ class SelectionResult:
         Number of simulations each design won; ``counts.sum() == S - n_no_winner``.
     best : int
         The most frequent winner (ties: the lowest index), the selected design.
+
+    See Also
+    --------
+    monte_carlo_selection : makes it.
+    Selection : the result of the whole selection on a tuning problem.
+
+    Examples
+    --------
+    Design 2 wins simulation 0, design 1 simulations 1 and 2; in simulation 3
+    every design is unstable (no winner):
+
+    >>> import numpy as np
+    >>> from moo.tuning import monte_carlo_selection
+    >>> E = np.array([[1.0, 3.0, 2.0, np.inf],      # design 0 in simulations 0 to 3
+    ...               [2.0, 1.0, 1.0, np.inf],      # design 1
+    ...               [0.5, 2.0, 3.0, np.inf]])     # design 2
+    >>> res = monte_carlo_selection(E)
+    >>> res
+    SelectionResult(D=3, S=4, best=1, wins=2, no_winner=1)
+    >>> bool(res.counts.sum() == res.n_simulations - res.n_no_winner)
+    True
     """
 
     winners: np.ndarray
@@ -107,7 +131,34 @@ def _as_errors(errors) -> np.ndarray:
 def monte_carlo_selection(errors) -> SelectionResult:
     r"""Count how often each design has the least cumulative error; select the most frequent winner.
 
-    With ``E[d, s]`` the cumulative error of design ``d`` in simulation ``s``,
+    Parameters
+    ----------
+    errors : (D, S) array_like
+        Cumulative errors of ``D`` designs in ``S`` simulations, lower is
+        better; finite or ``+inf`` (a design that cannot win, e.g. unstable
+        there).
+
+    Returns
+    -------
+    SelectionResult
+        The winner of each simulation, the win counts and the selected design.
+
+    Raises
+    ------
+    TypeError
+        ``errors`` not an array of real numbers.
+    ValueError
+        ``errors`` not 2-D or empty, containing NaN or ``-inf``, or no
+        simulation has a winner.
+
+    See Also
+    --------
+    select : the whole selection on a tuning problem (draws, errors, count).
+
+    Notes
+    -----
+    With :math:`E[d, s]` the cumulative error of design :math:`d` in
+    simulation :math:`s`,
 
     .. math::
 
@@ -116,30 +167,31 @@ def monte_carlo_selection(errors) -> SelectionResult:
         d^* = \min \arg\max_d c_d,
 
     i.e. ties within a simulation go to the lowest design index, and so do ties
-    between win counts. ``+inf`` marks a design that cannot win a simulation
-    (e.g. unstable there); a simulation in which every design is ``+inf`` has
-    no winner (``winners[s] = -1``) and counts for nobody.
-
-    Parameters
-    ----------
-    errors : (D, S) array_like
-        Cumulative errors, lower is better; finite or ``+inf``.
-
-    Returns
-    -------
-    SelectionResult
-
-    Raises
-    ------
-    ValueError
-        ``errors`` not 2-D or empty, containing NaN or ``-inf``, or no
-        simulation has a winner.
+    between win counts. A simulation in which every design is ``+inf`` has no
+    winner (``winners[s] = -1``) and counts for nobody.
 
     References
     ----------
-    Morais et al. (2022), Section 4.4.1: "The control design with less
-    cumulative error is assigned as the winner for each simulation [...] the
-    selection criterium is to choose [...] the most frequent individual".
+    .. [1] D. C. Morais et al., "Robust path-following control design of heavy
+       vehicles based on multiobjective evolutionary optimization", Expert
+       Systems with Applications 192 (2022) 116304, Section 4.4.1: "The control
+       design with less cumulative error is assigned as the winner for each
+       simulation [...] the selection criterium is to choose [...] the most
+       frequent individual".
+
+    Examples
+    --------
+    Design 2 wins simulation 0, design 1 simulations 1 and 2; in simulation 3
+    every design is unstable (no winner):
+
+    >>> import numpy as np
+    >>> from moo.tuning import monte_carlo_selection
+    >>> E = np.array([[1.0, 3.0, 2.0, np.inf],      # design 0 in simulations 0 to 3
+    ...               [2.0, 1.0, 1.0, np.inf],      # design 1
+    ...               [0.5, 2.0, 3.0, np.inf]])     # design 2
+    >>> res = monte_carlo_selection(E)
+    >>> res.winners, res.counts, res.best
+    (array([ 2,  1,  1, -1]), array([0, 2, 1]), 1)
     """
     E = _as_errors(errors)
     D = E.shape[0]
@@ -212,7 +264,10 @@ def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights) -> np.ndarr
 class Selection:
     """The design chosen by :func:`select`, with the evidence.
 
-    Attributes
+    The fields are attributes of the same names; :attr:`result` is the
+    counting result as a :class:`SelectionResult`.
+
+    Parameters
     ----------
     index : int
         Row of the chosen design in the candidate gains.
@@ -230,6 +285,27 @@ class Selection:
         Scenario drawn by each simulation (-1 where a sampler drew the plant).
     weights : (n_obj,) ndarray
         Weights of the objectives in the cumulative error.
+
+    See Also
+    --------
+    select : makes it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo import tuning
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> scenarios = [rc.Plant(plant.F, plant.G * s, dt=0.1) for s in (0.8, 1.0, 1.2)]
+    >>> response = tuning.Response(x0=[1.0, 0.0], steps=50)
+    >>> prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios,
+    ...                             [response.error(), response.peak_input()])
+    >>> K = prob.gains([[0.0, 0.0, 0.0], [0.0, 0.0, -2.0]]).K
+    >>> sel = tuning.select(prob, K, n_sims=30, seed=0)
+    >>> sel.errors.shape, sel.draws.shape
+    ((2, 30), (30,))
+    >>> bool(np.all(sel.winners == np.argmin(sel.errors, axis=0)))   # the least error wins
+    True
     """
 
     index: int
@@ -261,11 +337,12 @@ def _rng(seed) -> np.random.Generator:
 def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
            sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None,
            plant: rc.Plant | None = None, method: str = "tuned") -> Selection:
-    """The paper's Monte Carlo selection, for any tuning problem (module docstring).
+    r"""The paper's Monte Carlo selection, for any tuning problem (module docstring).
 
     Parameters
     ----------
     problem : TuningProblem
+        The problem whose objectives make the cumulative error.
     K : (D, m, n) array_like
         Candidate gains (e.g. a front's, ``TuningResult.gains``).
     F : (D, n_obj) array_like, optional
@@ -284,6 +361,63 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
         The plant of the returned :class:`~robustctl.Controller` (default: the first scenario).
     method : str
         The controller's ``method``.
+
+    Returns
+    -------
+    Selection
+        The chosen design, its controller and the evidence (errors, draws, wins).
+
+    Raises
+    ------
+    TypeError, ValueError
+        Gains of the wrong shape, ``n_sims`` not a positive integer, a bad
+        seed, weights not ``n_obj`` non-negative numbers, a sampler that is
+        not callable or does not return a plant, no design with a finite
+        error in any simulation.
+
+    See Also
+    --------
+    monte_carlo_selection : the counting step.
+    moo.tuning.TuningResult.select : the same on a tuning run's front.
+
+    Notes
+    -----
+    Simulation :math:`s` draws a plant :math:`P_s`; every design :math:`d`
+    gets the cumulative error
+
+    .. math::
+
+        E[d, s] = \sum_j w_j\, f_j(K_d, [P_s]), \qquad
+        w_j = 1 / \big(\max_d F_{dj} - \min_d F_{dj}\big) \text{ (default)},
+
+    ``+inf`` where the design is unstable on :math:`P_s` or a goal is not
+    finite; :func:`monte_carlo_selection` then picks the most frequent winner.
+
+    References
+    ----------
+    .. [1] D. C. Morais et al., "Robust path-following control design of heavy
+       vehicles based on multiobjective evolutionary optimization", Expert
+       Systems with Applications 192 (2022) 116304, Sections 4.4.1, 4.5.1.
+
+    Examples
+    --------
+    Between two LQR designs (``R = 1`` and ``R = 0.01``), on draws of the
+    problem's scenarios:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo import tuning
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> scenarios = [rc.Plant(plant.F, plant.G * s, dt=0.1) for s in (0.8, 1.0, 1.2)]
+    >>> response = tuning.Response(x0=[1.0, 0.0], steps=50)
+    >>> prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios,
+    ...                             [response.error(), response.peak_input()])
+    >>> K = prob.gains([[0.0, 0.0, 0.0], [0.0, 0.0, -2.0]]).K
+    >>> sel = tuning.select(prob, K, n_sims=30, seed=0)
+    >>> sel.controller.method, int(sel.counts.sum())
+    ('tuned', 30)
+    >>> sel.index == int(np.argmax(np.bincount(np.argmin(sel.errors, axis=0))))
+    True
     """
     Kc = problem.check_gains(K)
     n_sims = check_int(n_sims, "n_sims", 1)

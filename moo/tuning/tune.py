@@ -17,9 +17,9 @@ import numpy as np
 
 import robustctl as rc
 
-from .._validation import check_int
 from ..algorithms.operators import POP_SIZE
 from ..runner import RunResult, prepare_on
+from ..validation import check_int
 from .problem import TuningProblem
 from .selection import Selection, select
 
@@ -50,6 +50,7 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
     Parameters
     ----------
     problem : TuningProblem
+        The problem the front belongs to.
     X : (N, n_var) array_like
         Decision vectors of the front (N >= 1).
     F : (N, n_obj) array_like, optional
@@ -61,6 +62,37 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
     -------
     Selection
         Its ``index`` is a row of ``X``.
+
+    Raises
+    ------
+    TypeError
+        ``problem`` not a :class:`TuningProblem`.
+    ValueError
+        An empty front, ``X`` of the wrong shape, bad selection arguments.
+
+    See Also
+    --------
+    moo.tuning.select : the selection itself, on gains.
+    TuningResult.select : the same on a tuning run's front.
+
+    Examples
+    --------
+    Two LQR designs (``Q = I``, ``R = 1`` and ``R = 0.01``):
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo import tuning
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> scenarios = [rc.Plant(plant.F, plant.G * s, dt=0.1) for s in (0.8, 1.0, 1.2)]
+    >>> response = tuning.Response(x0=[1.0, 0.0], steps=50)
+    >>> prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios,
+    ...                             [response.error(), response.peak_input()])
+    >>> sel = tuning.select_front(prob, [[0.0, 0.0, 0.0], [0.0, 0.0, -2.0]], n_sims=20, seed=0)
+    >>> sel.controller.method, int(sel.counts.sum())
+    ('lqr', 20)
+    >>> R = [1.0, 0.01][sel.index]                  # the chosen row's weight
+    >>> np.allclose(sel.K, rc.lqr(plant, Q=np.eye(2), R=[[R]]).K)
+    True
     """
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"problem must be a moo.tuning.TuningProblem, got {type(problem).__name__}")
@@ -73,17 +105,45 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
 
 @dataclass(frozen=True, eq=False, repr=False)
 class TuningResult:
-    """The front of a tuning run.
+    """The front of a tuning run (what :func:`tune` returns).
 
-    Attributes
+    Parameters
     ----------
     problem : TuningProblem
+        The problem tuned.
     X : (N, n_var) ndarray
         Decision vectors of the final non-dominated set.
     F : (N, n_obj) ndarray
         Their objectives.
     run : moo.runner.RunResult
         The run's record (hypervolume history, evaluations, wall time; ``run.to_dict()`` is JSON).
+
+    Attributes
+    ----------
+    gains : (N, m, n) ndarray
+        The front's gains (designed once, on first use).
+
+    See Also
+    --------
+    tune : makes it.
+    select_front : the selection behind :meth:`select`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo import tuning
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> scenarios = [rc.Plant(plant.F, plant.G * s, dt=0.1) for s in (0.8, 1.0, 1.2)]
+    >>> response = tuning.Response(x0=[1.0, 0.0], steps=50)
+    >>> prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios,
+    ...                             [response.error(), response.peak_input()])
+    >>> res = tuning.tune(prob, evals=400, seed=1, pop_size=20)
+    >>> res
+    TuningResult(front=..., n_obj=2, evaluations=400, hv=...)
+    >>> stable, _ = prob.stability(res.gains)        # every front design stabilises every scenario
+    >>> bool(stable.all())
+    True
     """
 
     problem: TuningProblem
@@ -175,10 +235,16 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
          progress: Callable[[int, int], None] | None = None) -> TuningResult:
     """Tune: one MOEA run on ``problem``, optionally with MO-LSP; the final non-dominated set.
 
+    The run is the one ``python -m moo run`` makes (:mod:`moo.runner`), on a
+    :class:`TuningProblem` recorded as ``"tuning"``. Other pymoo problems run
+    through :func:`moo.runner.prepare_on` (any problem carrying
+    ``hv_ref_point`` and ``molsp_ref_point``) or :func:`moo.run` (a
+    registered name or a factory's import path); their front has no gains.
+
     Parameters
     ----------
     problem : TuningProblem
-        (Any pymoo problem with ``hv_ref_point``/``molsp_ref_point`` runs, but the result's gains need a TuningProblem.)
+        The problem to tune.
     algorithm : str
         A name of :data:`moo.algorithms.ALGORITHMS` (default ``"nsga2"``).
     molsp : bool
@@ -197,6 +263,45 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
     Returns
     -------
     TuningResult
+        The front (``X``, ``F``, ``gains``) and the run's record.
+
+    Raises
+    ------
+    TypeError
+        ``problem`` not a :class:`TuningProblem`, or a run argument of the
+        wrong type (the message names it).
+    ValueError
+        A bad run argument (the message names it): an unknown algorithm, a
+        budget below the population size, a negative seed, ...
+
+    See Also
+    --------
+    TuningProblem : the problem.
+    TuningResult.select : pick one design of the front.
+    moo.run : a run on a problem by name.
+
+    References
+    ----------
+    .. [1] D. C. Morais et al., "Robust path-following control design of heavy
+       vehicles based on multiobjective evolutionary optimization", Expert
+       Systems with Applications 192 (2022) 116304.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo import tuning
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> scenarios = [rc.Plant(plant.F, plant.G * s, dt=0.1) for s in (0.8, 1.0, 1.2)]
+    >>> response = tuning.Response(x0=[1.0, 0.0], steps=50)
+    >>> prob = tuning.TuningProblem(tuning.LQRFamily(plant), scenarios,
+    ...                             [response.error(), response.peak_input()])
+    >>> res = tuning.tune(prob, "nsga2", evals=400, seed=1, pop_size=20)
+    >>> res.run.n_evals, res.gains.shape[1:]
+    (400, (1, 2))
+    >>> sel = res.select(n_sims=50, seed=0)
+    >>> bool(np.all(np.abs(np.linalg.eigvals(plant.F + plant.G @ sel.K)) < 1))
+    True
     """
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"problem must be a moo.tuning.TuningProblem, got {type(problem).__name__}")

@@ -161,7 +161,8 @@ class Controller:
             object.__setattr__(self, "K", frozen(K))
         else:
             if any(M is None for M in matrices):
-                raise ValueError("a controller needs K (state feedback) or all of Ac, Bc, Cc, Dc (output feedback)")
+                raise ValueError(f"K must be a gain ({self.plant.m}, {self.plant.n}) for a state feedback, or None "
+                                 "with all of Ac, Bc, Cc, Dc for an output feedback (Controller.dynamic)")
             for name, M in zip(("Ac", "Bc", "Cc", "Dc"),
                                _controller_matrices(self.plant, *matrices, batch=False), strict=True):
                 object.__setattr__(self, name, frozen(M))
@@ -328,7 +329,7 @@ class ControllerBatch:
     r"""A stack of ``B`` controllers of one plant: ``xc+ = Ac[b] xc + Bc[b] y``, ``u = Cc[b] xc + Dc[b] y``.
 
     What a population of a tuning family is, and what the batched analyses
-    (:func:`robustctl.robust_stability`, :func:`robustctl.loop_margins`, ...)
+    (:func:`robustctl.robust_stability`, ``robustctl.loop_margins``, ...)
     take. A stack of state feedbacks ``u = K[b] x`` is
     :meth:`ControllerBatch.from_gains`; ``(plant, K)`` always means state feedback.
 

@@ -1,5 +1,8 @@
 """Problems and algorithms by name or by import path: the one place where the commands resolve them.
 
+Package-internal: the runner, the experiment grid and the command line import
+it; :mod:`moo` does not re-export it.
+
 Every entry point (:func:`moo.runner.prepare`, :func:`moo.experiment.plan` and
 :func:`~moo.experiment.prepare`, the workers of a process pool or a Dask
 cluster, ``python -m moo run | experiment``) builds its problem with

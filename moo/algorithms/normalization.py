@@ -1,5 +1,8 @@
 r"""Objective normalisation for reference-direction MOEAs: ideal point, extreme points, intercepts.
 
+Package-internal: the algorithm modules share it; :mod:`moo.algorithms` does
+not re-export it.
+
 Many-objective algorithms that compare solutions against reference directions
 (NSGA-III, theta-DEA, SPEA/R, ...) first map the objectives to a common scale
 

@@ -1,5 +1,8 @@
 """Argument checks shared by the ``moo`` modules.
 
+Package-internal: the modules of :mod:`moo` import it; the package does not
+re-export it.
+
 Each helper raises ``TypeError`` for a value of the wrong kind and
 ``ValueError`` for one out of range or of the wrong shape; both messages name
 the argument (and the shape), e.g. ``"pop_size must be >= 2, got 1"``.

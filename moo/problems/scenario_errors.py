@@ -1,5 +1,8 @@
 r"""Errors of a population of gains on a set of scenarios, computed once and read column by column.
 
+Package-internal: :mod:`moo.problems.generic` and :mod:`moo.problems.applied`
+share it; :mod:`moo.problems` does not re-export it.
+
 The objectives of the paper's two MOPs (:mod:`moo.problems.generic`,
 :mod:`moo.problems.applied`) are the ``k`` columns of one array: the errors
 ``e`` (B, S, k) of ``B`` gains on ``S`` scenario plants, combined over the
@@ -26,8 +29,8 @@ import numpy as np
 import robustctl as rc
 from robustctl.sim.simulator import BACKENDS
 
-from .._validation import check_choice
 from ..tuning.goals import OVER
+from ..validation import check_choice
 
 __all__ = ["ScenarioErrors", "ErrorColumn"]
 

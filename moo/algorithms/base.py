@@ -1,9 +1,16 @@
-"""Pieces shared by the pymoo algorithm classes of :mod:`moo.algorithms`.
+"""The base of the MOEAs of :mod:`moo.algorithms` and the pieces their modules share.
 
+Package-internal: the algorithm modules import it; :mod:`moo.algorithms` does
+not re-export it (only :data:`MIN_POP_SIZE`).
+
+- :class:`MOEA`: a pymoo ``GeneticAlgorithm`` wired as every MOEA of the
+  package (a survival and a mating selection injected, the paper's operators
+  by default, the initial population ranked by the survival, reference
+  directions checked and the survival's state reset when a run is set up).
 - :func:`paper_operators`: the paper's default variation operators and
   output, filled in where a constructor argument is ``None``.
 - :class:`NormalizationForwarding`: a survival's public view of the
-  :class:`~moo.algorithms._normalize.HyperplaneNormalization` it holds.
+  :class:`~moo.algorithms.normalization.HyperplaneNormalization` it holds.
 - :class:`BinaryTournament`: binary tournament *with replacement*, decided by
   a comparison function.
 - :func:`check_ref_dirs_fit`: reference directions must match the problem's
@@ -21,11 +28,17 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
+from pymoo.algorithms.base.genetic import GeneticAlgorithm
+from pymoo.core.crossover import Crossover
+from pymoo.core.mutation import Mutation
+from pymoo.core.sampling import Sampling
 from pymoo.core.selection import Selection
+from pymoo.core.survival import Survival
 from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.util.display.multi import MultiObjectiveOutput
+from pymoo.util.display.output import Output
 
-from .._validation import check_choice, check_directions, check_int
+from ..validation import check_choice, check_directions, check_int
 from .operators import (
     OPERATOR_CHOICES,
     PAPER_OPERATORS,
@@ -37,10 +50,10 @@ from .operators import (
 )
 
 if TYPE_CHECKING:
-    from ._normalize import HyperplaneNormalization
+    from .normalization import HyperplaneNormalization
 
-__all__ = ["BinaryTournament", "MIN_POP_SIZE", "NormalizationForwarding", "check_ref_dirs_fit", "factory_arguments",
-           "factory_ref_dirs", "float_column", "objectives", "paper_operators"]
+__all__ = ["MOEA", "BinaryTournament", "MIN_POP_SIZE", "NormalizationForwarding", "check_ref_dirs_fit",
+           "factory_arguments", "factory_ref_dirs", "float_column", "objectives", "paper_operators"]
 
 #: Smallest population a registry factory accepts.
 MIN_POP_SIZE = 4
@@ -118,7 +131,7 @@ def objectives(pop) -> np.ndarray:
 
 
 class NormalizationForwarding:
-    """Mixin for a survival holding a :class:`~moo.algorithms._normalize.HyperplaneNormalization` in ``self.norm``.
+    """Mixin for a survival holding a :class:`~moo.algorithms.normalization.HyperplaneNormalization` in ``self.norm``.
 
     Exposes its ideal and nadir estimates, its ``normalize`` and its ``reset``.
     """
@@ -127,10 +140,12 @@ class NormalizationForwarding:
 
     @property
     def ideal_point(self) -> np.ndarray:
+        """The ideal point ``z*`` estimated so far."""
         return self.norm.ideal_point
 
     @property
     def nadir_point(self) -> np.ndarray | None:
+        """The nadir estimate ``z^nad`` (None before the first update)."""
         return self.norm.nadir_point
 
     def normalize(self, F: np.ndarray) -> np.ndarray:
@@ -161,3 +176,96 @@ class BinaryTournament(Selection):
         rng = random_state if random_state is not None else np.random.default_rng()
         P = rng.integers(0, len(pop), size=(n_select * n_parents, 2))
         return self.compare(pop, P, random_state=rng).reshape(n_select, n_parents)
+
+
+class MOEA(GeneticAlgorithm):
+    """A pymoo ``GeneticAlgorithm`` wired as every MOEA of :mod:`moo.algorithms`.
+
+    An algorithm of the package is its survival (environmental selection) and
+    its mating selection; this base wires them into pymoo's genetic algorithm
+    the same way for all (pymoo's ``NSGA2`` over ``GeneticAlgorithm`` is the
+    model):
+
+    * ``sampling``, ``crossover``, ``mutation`` and ``output`` left ``None``
+      become the paper's (:func:`paper_operators`);
+    * the initial population goes through the survival before the first
+      mating (``advance_after_initial_infill``), so the first mating sees
+      ranked individuals;
+    * when a run is set up, ``ref_dirs`` (if given) must have one column per
+      objective of the problem, and the survival's ``reset()`` (if it has
+      one) forgets the state of a previous run.
+
+    Parameters
+    ----------
+    survival : pymoo Survival
+        The environmental selection.
+    selection : pymoo Selection
+        The mating selection.
+    pop_size : int, optional
+        Population size (at least 2); default ``len(ref_dirs)``.
+    ref_dirs : ndarray, shape (K, M), optional
+        The algorithm's reference directions (or weight vectors), kept as
+        ``self.ref_dirs`` and checked against the problem at set-up.
+    sampling, crossover, mutation : pymoo operators, optional
+        Default: uniform random sampling in the box and the paper's SBX and
+        polynomial mutation (:func:`paper_operators`).
+    eliminate_duplicates : bool
+        Remove duplicate offspring (pymoo's mechanism); default True.
+    n_offsprings : int, optional
+        Offspring per generation (default ``pop_size``).
+    output : pymoo Output, optional
+        Progress display (default pymoo's multi-objective output).
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``pop_size`` not an integer >= 2, or neither it nor ``ref_dirs``
+        given; at set-up, ``ref_dirs`` whose columns are not the problem's
+        objectives.
+
+    See Also
+    --------
+    moo.algorithms.make_algorithm : the registry's factories, which build the subclasses.
+
+    Examples
+    --------
+    A MOEA from pymoo's rank-and-crowding survival and a random mating,
+    run on ZDT1:
+
+    >>> from pymoo.algorithms.moo.nsga2 import RankAndCrowding
+    >>> from pymoo.operators.selection.rnd import RandomSelection
+    >>> from pymoo.optimize import minimize
+    >>> from moo.problems import make_problem
+    >>> alg = MOEA(RankAndCrowding(), RandomSelection(), pop_size=20)
+    >>> type(alg.mating.crossover).__name__, type(alg.mating.mutation).__name__   # the paper's operators
+    ('SBX', 'PaperPM')
+    >>> res = minimize(make_problem("zdt1"), alg, ("n_gen", 5), seed=1)
+    >>> res.F.shape[1], alg.advance_after_initial_infill
+    (2, True)
+    """
+
+    def __init__(self, survival: Survival, selection: Selection, *, pop_size: int | None = None,
+                 ref_dirs: np.ndarray | None = None, sampling: Sampling | None = None,
+                 crossover: Crossover | None = None, mutation: Mutation | None = None,
+                 eliminate_duplicates: bool = True, n_offsprings: int | None = None, output: Output | None = None):
+        if pop_size is None:
+            if ref_dirs is None:
+                raise TypeError("pop_size is required when there are no ref_dirs")
+            pop_size = len(ref_dirs)
+        self.ref_dirs = ref_dirs
+        super().__init__(
+            pop_size=check_int(pop_size, "pop_size", 2),
+            selection=selection,
+            survival=survival,
+            eliminate_duplicates=eliminate_duplicates,
+            n_offsprings=n_offsprings,
+            advance_after_initial_infill=True,
+            **paper_operators(sampling, crossover, mutation, output),
+        )
+
+    def _setup(self, problem, **kwargs) -> None:
+        if self.ref_dirs is not None:
+            check_ref_dirs_fit(self.ref_dirs, problem)
+        reset = getattr(self.survival, "reset", None)
+        if callable(reset):
+            reset()

@@ -11,7 +11,7 @@ plant:
 2. the uncertainty: scenario plants over the parameter range
    (:func:`robustctl.sample_plants`) and a norm-bounded model that contains
    them (:meth:`robustctl.NormBounded.from_plants`);
-3. the goals (:mod:`moo.tuning.goals`): ride comfort, suspension travel
+3. the goals (:mod:`moo.tuning`): ride comfort, suspension travel
    after a bump and peak actuator force as objectives, a certified robust
    margin as a constraint;
 4. tuning with a MOEA and MO-LSP (:func:`moo.tuning.tune`, a small budget
@@ -32,7 +32,6 @@ import numpy as np
 
 import robustctl as rc
 from moo import tuning
-from moo.tuning.goals import H2Norm, Response, RobustMargin, at_least
 
 M_WHEEL, K_SPRING, C_DAMPER, K_TYRE = 40.0, 16.0e3, 1.0e3, 160.0e3   # kg, N/m, Ns/m, N/m
 DT = 0.01                                                            # s
@@ -72,7 +71,6 @@ print(samples)
 print(uncertainty)
 
 
-
 def inside(plant):
     """``(||Delta||, residual)`` of the least-squares ``Delta`` reproducing ``plant``'s deviation."""
     D = np.hstack([plant.F - nominal.F, plant.G - nominal.G])
@@ -99,13 +97,13 @@ print("ms = 300 kg: ||Delta|| = {:.3f}, residual {:.1e}".format(*inside(quarter_
 # The two time-domain goals share one batched simulation per population.
 A, B, Bw = matrices(350.0)
 Bw_d = rc.Plant.from_continuous(A, Bw, dt=DT).G          # road input, same hold
-bump = Response(x0=[0.0, 0.0, -0.05, 0.0], steps=150, u_limit=1.5)
+bump = tuning.Response(x0=[0.0, 0.0, -0.05, 0.0], steps=150, u_limit=1.5)
 objectives = [
-    H2Norm(Bw_d, A[1], B[1], name="body acceleration (H2)"),
+    tuning.H2Norm(Bw_d, A[1], B[1], name="body acceleration (H2)"),
     bump.error(states=[0], measure="ise", name="suspension travel (ISE)"),
     bump.peak_input(name="peak force [kN]"),
 ]
-constraints = [at_least(RobustMargin(uncertainty, nominal=nominal), 1.0)]
+constraints = [tuning.at_least(tuning.RobustMargin(uncertainty, nominal=nominal), 1.0)]
 
 # %%
 # Tuning
