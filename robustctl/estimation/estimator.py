@@ -47,6 +47,11 @@ class FilterRun:
 
     ``N`` trajectories of ``T`` steps (no leading axis when one trajectory was given).
 
+    Parameters
+    ----------
+    x_prior, x_filtered, x_next, P_prior, P_filtered, L, form :
+        The attributes below (built by :meth:`Estimator.run`).
+
     Attributes
     ----------
     x_prior : (N, T, n) ndarray
@@ -60,6 +65,19 @@ class FilterRun:
     L : (T, n, p) ndarray
         The gain of the estimator's form at each step.
     form : str
+
+    Examples
+    --------
+    From a wide prior the time-varying gain settles to the steady-state one:
+
+    >>> import numpy as np, robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1, C=[[1.0, 0.0]])
+    >>> est = rc.kalman(plant, np.diag([1e-4, 1e-2]), [[0.01]])
+    >>> run = est.run(np.zeros((300, 1)), np.zeros((300, 1)), P0=100 * np.eye(2))
+    >>> run
+    FilterRun(form='filter', x shape (300, 2))
+    >>> bool(np.allclose(run.L[-1], est.L)), bool(np.allclose(run.P_prior[-1], est.P))
+    (True, True)
     """
 
     x_prior: np.ndarray
@@ -84,6 +102,11 @@ class Estimator:
     r"""A steady-state estimator of a plant's state from its inputs and measured outputs.
 
     Made by :func:`robustctl.kalman` and :func:`robustctl.robust_kalman`.
+
+    Parameters
+    ----------
+    L_filter, L_predictor, P, P_filtered, form, F, G, J, plant, method, info :
+        The attributes below (built by the functions above).
 
     Attributes
     ----------
@@ -277,7 +300,16 @@ class Estimator:
 class EstimatorBatch:
     """Steady-state estimators of one plant for a batch of ``B`` designs.
 
-    Made by :func:`robustctl.kalman_gains` and :func:`robustctl.robust_kalman_gains`.
+    Made by :func:`robustctl.kalman_gains` and :func:`robustctl.robust_kalman_gains`:
+    design ``b`` is the estimator that :func:`robustctl.kalman` (or
+    :func:`robustctl.robust_kalman`) makes of the ``b``-th covariances (or
+    uncertainty), as entries of stacked arrays; a design that fails is
+    flagged in ``ok`` and ``reason``, never raised for the batch.
+
+    Parameters
+    ----------
+    L, P, F, G, J, ok, reason, stable, iterations, residual, form :
+        The attributes below.
 
     Attributes
     ----------
@@ -290,8 +322,17 @@ class EstimatorBatch:
     ok : (B,) bool ndarray
         The design converged to a stabilising steady state.
     reason : (B,) str ndarray
-        ``"ok"``, ``"undetectable"`` (``(C, F)`` is not detectable: every
-        design), ``"not converged"`` or ``"diverged"``.
+        Why a design failed (``"ok"`` where it did not):
+
+        ====================  ==================================================
+        ``reason``            meaning
+        ====================  ==================================================
+        ``"ok"``              a stabilising steady state
+        ``"undetectable"``    ``(C, F)`` is not detectable (every design)
+        ``"not converged"``   no stabilising fixed point within ``max_iter``
+                              steps (or one more step still moves ``P``)
+        ``"diverged"``        ``P`` grows without bound
+        ====================  ==================================================
     stable : (B,) bool ndarray
         The estimator's own loop ``F - L_predictor C`` is stable (always True where ``ok``).
     iterations : (B,) int ndarray
@@ -299,6 +340,21 @@ class EstimatorBatch:
     residual : (B,) ndarray
         Relative change of ``P`` in one more step of the recursion.
     form : str
+
+    Examples
+    --------
+    Two measurement noise levels at once; a plant that measures only the
+    velocity cannot see the position (an integrator: ``(C, F)`` is not
+    detectable), and every design is flagged:
+
+    >>> import numpy as np, robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1, C=[[1.0, 0.0]])
+    >>> batch = rc.kalman_gains(plant, np.diag([1e-4, 1e-2]), [[[0.01]], [[0.1]]])
+    >>> batch.ok.tolist(), batch.L.shape
+    ([True, True], (2, 2, 1))
+    >>> blind = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1, C=[[0.0, 1.0]])
+    >>> rc.kalman_gains(blind, np.diag([1e-4, 1e-2]), [[0.01]]).reason.tolist()
+    ['undetectable']
     """
 
     L: np.ndarray
