@@ -247,8 +247,8 @@ def robust_kalman(plant: Plant, W, V, *, Bw=None, H, EF, EG=None, EBw=None, HC=N
             raise ConvergenceError(f"the block recursion did not reach a steady state in max_iter={max_iter} steps "
                                    f"(relative change of P {change:.3g}, tol={tol:g})")
         info.update(residual=float(change), iterations=it)
-        return Estimator(*(frozen(a) for a in (Lf, Fe @ Lf, P, Pf)), form,
-                         *(frozen(a) for a in (Fe, Ge, np.zeros_like(Lf))), plant, "robust_kalman", info, d)
+        Lf, Lp, P, Pf, Fe, Ge, Je = (frozen(a) for a in (Lf, Fe @ Lf, P, Pf, Fe, Ge, np.zeros_like(Lf)))
+        return Estimator(Lf, Lp, P, Pf, form, Fe, Ge, Je, plant, "robust_kalman", info, d)
     st = steady_state(d, tol, max_iter, accelerate=accelerate)
     if st.reason[0] != "ok":
         raise _failure(st, 0, max_iter, tol, "robust filter's")
