@@ -16,6 +16,8 @@ METHODS = {
     "hinf": "robustctl.synthesis.hinf:hinf",
     "h2": "robustctl.synthesis.h2:h2",
     "h2hinf": "robustctl.synthesis.h2hinf:h2hinf",
+    "lqg": "robustctl.synthesis.lqg:lqg",
+    "rlqg": "robustctl.synthesis.lqg:rlqg",
 }
 
 
@@ -57,12 +59,14 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     "hinf"      :func:`robustctl.hinf` (H-infinity, LMI or Riccati)    state or output feedback
     "h2"        :func:`robustctl.h2` (H2, LMI)                         state or output feedback
     "h2hinf"    :func:`robustctl.h2hinf` (mixed H2/H-infinity, LMI)    state or output feedback
+    "lqg"       :func:`robustctl.lqg` (LQR and Kalman filter)          output feedback
+    "rlqg"      :func:`robustctl.rlqg` (robust LQR and robust filter)  output feedback
     ==========  =====================================================  ===========================
 
-    The last three return a full-order dynamic controller ``u = K(z) y``
-    (``ctrl.Ac``, ``Bc``, ``Cc``, ``Dc``) when the plant declares measured
-    outputs (``Plant(..., C=...)``), a state feedback otherwise or with
-    ``feedback="state"``.
+    ``hinf``, ``h2`` and ``h2hinf`` return a full-order dynamic controller
+    ``u = K(z) y`` (``ctrl.Ac``, ``Bc``, ``Cc``, ``Dc``) when the plant
+    declares measured outputs (``Plant(..., C=...)``), a state feedback
+    otherwise or with ``feedback="state"``.
 
     Examples
     --------
@@ -76,10 +80,10 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     >>> ctrl = design("lqr", plant, Q=np.eye(4), R=[[1.0]])
     >>> ctrl.method, bool(np.array_equal(ctrl.K, lqr(plant, Q=np.eye(4), R=[[1.0]]).K))
     ('lqr', True)
-    >>> design("lqg", plant)
+    >>> design("lqq", plant)
     Traceback (most recent call last):
         ...
-    ValueError: method must name a design: unknown design method 'lqg'; valid: h2, h2hinf, hinf, lqr, rlqr
+    ValueError: method must name a design: unknown design method 'lqq'; valid: h2, h2hinf, hinf, lqg, lqr, rlqg, rlqr
     """
     if not isinstance(method, str) or method.lower() not in METHODS:
         raise ValueError(f"method must name a design: unknown design method {method!r}; "

@@ -117,12 +117,13 @@ from typing import Any
 
 import numpy as np
 
+from .._kkt import DEFAULT_ALPHA
 from .._validation import as_matrix, check_bool, check_choice, check_int, check_positive_scalar, check_spd, frozen
 from ..errors import ConvergenceError, NotStabilizingError
 from ..systems.controller import Controller
 from ..systems.plant import Plant
 from ..systems.stability import STABILITY_MARGIN, check_stabilizable, is_schur_stable, spectral_radius
-from ._rlqr.model import DEFAULT_ALPHA, Model, build
+from ._rlqr.model import Model, build
 from ._rlqr.steady import DEFAULT_MAX_ITER, DEFAULT_TOL, steady_state
 from ._rlqr.step import block_steps, kkt_step, rlqr_step, rlqr_step_block
 
@@ -243,7 +244,7 @@ class RLQRSchedule:
     plant : Plant
         The nominal plant.
     info : Mapping
-        ``"mu"``, ``"alpha"``, ``"lambda"`` and ``"implementation"`` (as in
+        ``"mu"``, ``"alpha"``, ``"lambda"``, ``"H"`` and ``"implementation"`` (as in
         :func:`rlqr`'s table).
 
     See Also
@@ -309,7 +310,8 @@ def _start(P, name: str, d: Model, definite: bool) -> np.ndarray:
 
 
 def _info(d: Model, implementation: str) -> dict:
-    return {"mu": float(d.mu[0]), "alpha": d.alpha, "lambda": float(d.lam()[0]), "implementation": implementation}
+    return {"mu": float(d.mu[0]), "alpha": d.alpha, "lambda": float(d.lam()[0]), "H": frozen(d.H),
+            "implementation": implementation}
 
 
 def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None,
@@ -516,6 +518,7 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
         ``"mu"``                the penalty
         ``"alpha"``             the margin of ``lambda``
         ``"lambda"``            ``(1 + alpha) ||mu H'H||`` (0 without uncertainty)
+        ``"H"``                 (n, p) the ``H`` used (its default filled in)
         ``"implementation"``    ``"kkt"`` or ``"block"``
         ``"iterations"``        doubling (or recursion) steps
         ``"residual"``          relative change of ``P`` in one more recursion step
