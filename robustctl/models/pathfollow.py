@@ -898,7 +898,7 @@ class PathFollowing:
         >>> est = rc.kalman(truck.sensor_plant(0.0), [[0.01]], truck.TruckSensors().covariance(0.1),
         ...                 Bw=truck.truck_plant(0.0).G)
         >>> Q, R = truck.lqr_weights()
-    >>> K = rc.lqr(truck.truck_plant(0.0), Q=Q, R=R).K
+        >>> K = rc.lqr(truck.truck_plant(0.0), Q=Q, R=R).K
         >>> runs = PathFollowing(ReferencePath.from_curvature(np.full(200, 1 / 300.0)), 0.0)
         >>> sensed = runs.run_estimated(K, est, V=np.zeros((3, 3)), xhat0=runs.setup.x0, backend="numpy")
         >>> exact = runs.run(K, backend="numpy")
