@@ -260,3 +260,46 @@ def test_bad_arguments_are_named():
         runs.run_estimated(K, est, xhat0=[0.0, 1.0])
     with pytest.raises(ValueError, match="4 columns"):
         runs.run_estimated(np.ones((1, 3)), est)
+
+
+# -- the paper's table with sensors (paper_repro/mse_table_sensors.py) ----------------------------------------
+def test_script_writes_the_table_beside_the_full_state_one(tmp_path):
+    import csv
+
+    import mse_table
+    import mse_table_sensors
+    from mse_designs import get_table_setup
+    from paper_values import CONTROLLERS, OBJECTIVES, OVERLOADS
+
+    assert mse_table_sensors.main(["--out", str(tmp_path), "--duration", "20", "--draws", "2",
+                                   "--no-figures"]) == 0
+    rows = list(csv.DictReader((tmp_path / "mse_sensors.csv").open()))
+    assert len(rows) == len(mse_table_sensors.ESTIMATORS) * len(CONTROLLERS) * len(OBJECTIVES) * len(OVERLOADS)
+    full = mse_table.table_for(get_table_setup("authors"), duration=20)
+    for r in rows:
+        assert np.isfinite(float(r["mse"])) and float(r["mse"]) >= 0
+        if r["estimator"] == "full_state":                   # mse_table.py's numbers, to the digits written
+            assert float(r["mse"]) == pytest.approx(full[r["objective"]][r["controller"]][
+                OVERLOADS.index(int(r["overload"]))], rel=1e-10)
+        else:
+            assert r["draws"] == "2"
+    mu = list(csv.DictReader((tmp_path / "mse_sensors_mu.csv").open()))
+    chosen = [r for r in mu if r["chosen"] == "True"]
+    assert len(mu) == 10 and len(chosen) == 1
+    assert float(chosen[0]["worst_spectral_radius"]) == min(float(r["worst_spectral_radius"]) for r in mu)
+    assert "robust_paper_mu" in (tmp_path / "mse_sensors.md").read_text()
+
+
+def test_docs_render_the_committed_result_files():
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("papertables", root / "docs" / "_ext" / "papertables.py")
+    papertables = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(papertables)
+    results = root / "paper_repro" / "results"
+    tables = papertables.sensor_tables(results / "mse_sensors.csv")
+    assert list(tables) == ["f1", "f2", "f3", "f4"]
+    assert all(text.count("   * - ") == 1 + 16 for text in tables.values())     # header + 4 controllers x 4
+    assert papertables.mu_table(results / "mse_sensors_mu.csv").count("yes") == 1
