@@ -31,7 +31,8 @@ Every estimator sees the same noise sequences (``--draws`` per overload,
 seed ``--seed``). Writes ``DIR/mse_sensors.csv``
 (``estimator,controller,objective,overload,mse,std,draws,diverged``: the
 mean and the standard deviation over the draws, the draws that left the
-divergence bound), ``DIR/mse_sensors_mu.csv`` (the penalty's choice),
+divergence bound), ``DIR/mse_sensors_mu.csv`` (the penalty's choice), ``DIR/mse_sensors_radius.csv``
+(``estimator,controller,overload,spectral_radius``: the linear loops' spectral radii),
 ``DIR/mse_sensors.md`` (the tables, the sensors, the filters and the run)
 and, unless ``--no-figures``, ``DIR/mse_sensors.png``. The files kept in
 ``paper_repro/results/`` are ``--out paper_repro/results --no-figures``;
@@ -76,16 +77,21 @@ def filters(path, designs, mu: float | None = None) -> tuple[dict[str, rc.Estima
     def robust(m: float) -> rc.Estimator:
         return rc.robust_kalman(plant, W, V, Bw=Bw, H=unc.H, EF=unc.EF, EG=unc.EG, mu=m)
 
-    sensed = [truck.sensor_plant(float(ov)) for ov in OVERLOADS]
-
-    def worst_radius(est: rc.Estimator) -> float:
-        return max(rc.spectral_radius(rc.observer_controller(d.K_steer, est).closed_loop(p))
-                   for d in designs for p in sensed)
-
-    radii = [(m, worst_radius(robust(m))) for m in MU_GRID]
+    radii = [(m, float(loop_radii(robust(m), designs).max())) for m in MU_GRID]
     chosen = min(radii, key=lambda r: r[1])[0] if mu is None else mu
     ests = {"kalman": rc.kalman(plant, W, V, Bw=Bw), "robust": robust(chosen), "robust_paper_mu": robust(PAPER_MU)}
     return ests, radii
+
+
+def loop_radii(est: rc.Estimator | None, designs) -> np.ndarray:
+    """Spectral radius (B, S) of the linear loop of each controller on ``est`` (None: the state) at each overload."""
+    def radius(d, ov: float) -> float:
+        if est is None:
+            p = truck.truck_plant(ov)
+            return rc.spectral_radius(p.F + p.G @ d.K_steer)
+        return rc.spectral_radius(rc.observer_controller(d.K_steer, est).closed_loop(truck.sensor_plant(ov)))
+
+    return np.array([[radius(d, float(ov)) for ov in OVERLOADS] for d in designs])
 
 
 def simulate(ts, path, designs, ests: dict, draws: int, seed: int, keep: bool) -> dict:
@@ -110,7 +116,7 @@ def rows(results: dict, designs) -> list[list]:
             for s, ov in enumerate(OVERLOADS)]
 
 
-def markdown(results: dict, designs, ests: dict, radii, header: str) -> str:
+def markdown(results: dict, designs, ests: dict, radii, radii_of: dict, header: str) -> str:
     """The tables of ``mse_sensors.md``: one per objective (controller x estimator), then the penalty's choice."""
     parts = [header]
     for j, obj in enumerate(OBJECTIVES):
@@ -122,6 +128,11 @@ def markdown(results: dict, designs, ests: dict, radii, header: str) -> str:
         parts.append(f"**{obj}**, {label} [{_squared(unit)}]\n\n"
                      + markdown_table(["controller", "estimator", *(f"{ov} %" for ov in OVERLOADS)], body,
                                       align="ll" + "r" * len(OVERLOADS)))
+    body = [[d.name, e, *(f"{r:.4f}" for r in radii_of[e][b])] for b, d in enumerate(designs) for e in ESTIMATORS]
+    parts.append("Spectral radius of the linear loop (truck at the overload, controller and filter of the nominal "
+                 "model; no saturation, no noise; above 1: unstable)\n\n"
+                 + markdown_table(["controller", "estimator", *(f"{ov} %" for ov in OVERLOADS)], body,
+                                  align="ll" + "r" * len(OVERLOADS)))
     chosen = ests["robust"].info["mu"]
     parts.append("Penalty of the robust filter: the largest closed-loop spectral radius over the four controllers "
                  "and the four payloads (linear loop, no saturation)\n\n"
@@ -189,6 +200,10 @@ def run(out: Path, *, setup: str = DEFAULT_SETUP, draws: int = 20, seed: int = 0
     chosen = ests["robust"].info["mu"]
     write_csv(["mu", "worst_spectral_radius", "chosen"], ([f"{m:.0e}", f"{r:.6f}", m == chosen] for m, r in radii),
               out / "mse_sensors_mu.csv", lineterminator="\r\n")
+    radii_of = {e: loop_radii(ests.get(e), designs) for e in ESTIMATORS}
+    write_csv(["estimator", "controller", "overload", "spectral_radius"],
+              ([e, d.name, ov, f"{radii_of[e][b, s]:.6f}"] for e in ESTIMATORS for b, d in enumerate(designs)
+               for s, ov in enumerate(OVERLOADS)), out / "mse_sensors_radius.csv", lineterminator="\r\n")
     s_gyro, s_rho, s_theta = truck.TruckSensors().std(truck.PAPER_PARAMETERS.dt)
     W = morais2022.sensor_filter_noise(ts.path())[1]
     header = (
@@ -202,7 +217,7 @@ def run(out: Path, *, setup: str = DEFAULT_SETUP, draws: int = 20, seed: int = 0
         f"sigma = {np.sqrt(W[0, 0]):.3g} rad; robust filter with the appendix's printed H, EF, EG at mu = "
         f"{chosen:.0e} (robust) and {PAPER_MU:.0e} (robust_paper_mu). MSE: mean over the draws (tracking errors; "
         "`div.`: draws that left the divergence bound).")
-    text = markdown(results, designs, ests, radii, header)
+    text = markdown(results, designs, ests, radii, radii_of, header)
     (out / "mse_sensors.md").write_text(text)
     log(text)
     if figures:

@@ -288,6 +288,12 @@ def test_script_writes_the_table_beside_the_full_state_one(tmp_path):
     assert len(mu) == 10 and len(chosen) == 1
     assert float(chosen[0]["worst_spectral_radius"]) == min(float(r["worst_spectral_radius"]) for r in mu)
     assert "robust_paper_mu" in (tmp_path / "mse_sensors.md").read_text()
+    radius = {(r["estimator"], r["controller"], int(r["overload"])): float(r["spectral_radius"])
+              for r in csv.DictReader((tmp_path / "mse_sensors_radius.csv").open())}
+    K = rc.lqr(truck.truck_plant(0.0), Q=np.diag([1.0, 1.0, 25000.0, 100.0]), R=[[33535.0]]).K   # the LQR row
+    p300 = truck.truck_plant(300.0)
+    assert radius["full_state", "LQR", 300] == pytest.approx(np.abs(np.linalg.eigvals(p300.F + p300.G @ K)).max(),
+                                                             rel=1e-6)
 
 
 def test_docs_render_the_committed_result_files():
@@ -303,3 +309,4 @@ def test_docs_render_the_committed_result_files():
     assert list(tables) == ["f1", "f2", "f3", "f4"]
     assert all(text.count("   * - ") == 1 + 16 for text in tables.values())     # header + 4 controllers x 4
     assert papertables.mu_table(results / "mse_sensors_mu.csv").count("yes") == 1
+    assert papertables.radius_table(results / "mse_sensors_radius.csv").count("   * - ") == 1 + 16

@@ -7,11 +7,13 @@ At ``config-inited`` it writes into ``_generated/``:
   Each cell is ``paper / ours``: the sign of mean(MO-LSP) - mean(plain)
   (down or up arrow), ``*`` when significant at 95 %, then ``=`` (direction
   and significance agree), ``~`` (direction only) or ``x`` (direction differs);
-* ``mse_sensors_<objective>.rst`` and ``mse_sensors_mu.rst`` from
-  ``mse_sensors.csv`` and ``mse_sensors_mu.csv`` (``paper_repro/mse_table_sensors.py``):
-  the MSE table with the truck's sensors, one list-table per objective
-  (controllers x estimators, the overloads as columns), and the choice of the
-  robust filter's penalty; ``validation/sensors.rst`` includes them.
+* ``mse_sensors_<objective>.rst``, ``mse_sensors_radius.rst`` and
+  ``mse_sensors_mu.rst`` from ``mse_sensors.csv``, ``mse_sensors_radius.csv`` and
+  ``mse_sensors_mu.csv`` (``paper_repro/mse_table_sensors.py``): the MSE table
+  with the truck's sensors, one list-table per objective (controllers x
+  estimators, the overloads as columns), the linear loops' spectral radii in
+  the same layout, and the choice of the robust filter's penalty;
+  ``validation/sensors.rst`` includes them.
 """
 
 from __future__ import annotations
@@ -51,28 +53,39 @@ ESTIMATOR_LABELS = {"full_state": "full state", "kalman": "Kalman filter", "robu
                     "robust_paper_mu": "robust filter, paper's mu"}
 
 
-def sensor_tables(path: Path) -> dict[str, str]:
-    """``{objective: list-table}`` of ``mse_sensors.csv``: mean (± std over the draws) per overload."""
-    rows = list(csv.DictReader(path.open()))
+def _by_overload(rows: list[dict], cell) -> str:
+    """A list-table of ``rows`` (controller, estimator, overload): one row per controller and estimator."""
     overloads = list(dict.fromkeys(r["overload"] for r in rows))
-    cells: dict[tuple[str, str, str], dict[str, str]] = {}
+    cells: dict[tuple[str, str], dict[str, str]] = {}
     for r in rows:
-        text = f"{float(r['mse']):.3e}"
-        if int(r["draws"]) > 1:
-            text += f" ± {float(r['std']):.1e}"
-        if int(r["diverged"]):
-            text += f" ({r['diverged']} of {r['draws']} diverged)"
-        cells.setdefault((r["objective"], r["controller"], r["estimator"]), {})[r["overload"]] = text
-    out = {}
-    for obj in dict.fromkeys(r["objective"] for r in rows):
-        lines = [".. list-table::", "   :header-rows: 1", "", "   * - controller", "     - estimator",
-                 *(f"     - {ov} %" for ov in overloads)]
-        for (o, controller, estimator), by in cells.items():
-            if o == obj:
-                lines += [f"   * - {controller}", f"     - {ESTIMATOR_LABELS.get(estimator, estimator)}",
-                          *(f"     - {by[ov]}" for ov in overloads)]
-        out[obj] = "\n".join(lines) + "\n"
-    return out
+        cells.setdefault((r["controller"], r["estimator"]), {})[r["overload"]] = cell(r)
+    lines = [".. list-table::", "   :header-rows: 1", "", "   * - controller", "     - estimator",
+             *(f"     - {ov} %" for ov in overloads)]
+    for (controller, estimator), by in cells.items():
+        lines += [f"   * - {controller}", f"     - {ESTIMATOR_LABELS.get(estimator, estimator)}",
+                  *(f"     - {by[ov]}" for ov in overloads)]
+    return "\n".join(lines) + "\n"
+
+
+def _mse_cell(r: dict) -> str:
+    text = f"{float(r['mse']):.3e}"
+    if int(r["draws"]) > 1:
+        text += f" ± {float(r['std']):.1e}"
+    if int(r["diverged"]):
+        text += f" ({r['diverged']} of {r['draws']} diverged)"
+    return text
+
+
+def sensor_tables(path: Path) -> dict[str, str]:
+    """``{objective: list-table}`` of ``mse_sensors.csv``: the mean (± std over the draws) per overload."""
+    rows = list(csv.DictReader(path.open()))
+    return {obj: _by_overload([r for r in rows if r["objective"] == obj], _mse_cell)
+            for obj in dict.fromkeys(r["objective"] for r in rows)}
+
+
+def radius_table(path: Path) -> str:
+    """``mse_sensors_radius.csv`` as a list-table."""
+    return _by_overload(list(csv.DictReader(path.open())), lambda r: f"{float(r['spectral_radius']):.4f}")
 
 
 def mu_table(path: Path) -> str:
@@ -100,6 +113,7 @@ def _config_inited(app, config) -> None:
     if (results / "mse_sensors.csv").exists():
         for obj, text in sensor_tables(results / "mse_sensors.csv").items():
             _write(out / f"mse_sensors_{obj}.rst", text)
+        _write(out / "mse_sensors_radius.rst", radius_table(results / "mse_sensors_radius.csv"))
         _write(out / "mse_sensors_mu.rst", mu_table(results / "mse_sensors_mu.csv"))
 
 
