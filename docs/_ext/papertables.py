@@ -54,16 +54,20 @@ ESTIMATOR_LABELS = {"full_state": "full state", "kalman": "Kalman filter", "robu
 
 
 def _by_overload(rows: list[dict], cell) -> str:
-    """A list-table of ``rows`` (controller, estimator, overload): one row per controller and estimator."""
+    """A list-table of ``rows`` (controller, estimator, overload): one row per controller and estimator (every pair)."""
     overloads = list(dict.fromkeys(r["overload"] for r in rows))
     cells: dict[tuple[str, str], dict[str, str]] = {}
     for r in rows:
         cells.setdefault((r["controller"], r["estimator"]), {})[r["overload"]] = cell(r)
     lines = [".. list-table::", "   :header-rows: 1", "", "   * - controller", "     - estimator",
              *(f"     - {ov} %" for ov in overloads)]
-    for (controller, estimator), by in cells.items():
-        lines += [f"   * - {controller}", f"     - {ESTIMATOR_LABELS.get(estimator, estimator)}",
-                  *(f"     - {by[ov]}" for ov in overloads)]
+    controllers = dict.fromkeys(c for c, _ in cells)
+    estimators = dict.fromkeys(e for _, e in cells)
+    for controller in controllers:                     # grouped by controller, the estimators in the file's order
+        for estimator in estimators:
+            by = cells[controller, estimator]
+            lines += [f"   * - {controller}", f"     - {ESTIMATOR_LABELS.get(estimator, estimator)}",
+                      *(f"     - {by[ov]}" for ov in overloads)]
     return "\n".join(lines) + "\n"
 
 
