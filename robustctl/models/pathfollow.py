@@ -36,6 +36,11 @@ its authors' code are in :mod:`robustctl.models.morais2022`.
 
 :class:`PathFollowing` discretises the scenarios and builds the reference
 once (an optimiser's problem keeps one); :func:`simulate` is the one-call form.
+:meth:`PathFollowing.run_estimated` closes the loop on an estimate of the
+state instead: a Kalman or robust filter (:mod:`robustctl.estimation`) of the
+nominal model fed with noisy measurements ``y = C x + v`` (the truck's
+sensors: :func:`robustctl.models.truck.sensor_plant`) and the applied
+steering angle.
 The simulation itself, the divergence rule and the backends are those of
 :mod:`robustctl.sim.simulator`. A law that also feeds back the previous steering
 angle (``K_input``, e.g. :mod:`robustctl.synthesis.hinf_game`'s delayed
@@ -340,7 +345,6 @@ class PathFollowingResult(SimulationResult):
         return X, Y, psi
 
 
-
 @dataclass(frozen=True, eq=False, repr=False)
 class EstimatedPathFollowingResult(PathFollowingResult):
     """A :class:`PathFollowingResult` of the loop on an estimate (:meth:`PathFollowing.run_estimated`).
@@ -445,7 +449,6 @@ def _scenarios(overloads, T: int) -> tuple:
                                  f"(the path's samples), got {a.shape}")
             out.append(a)
     return tuple(out)
-
 
 
 def _measurement_noise(noise, V, draws, rng, est: Estimator, T: int, p: int) -> np.ndarray:

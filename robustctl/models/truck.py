@@ -26,6 +26,14 @@ Eq. 1 also has ``theta' = psidot`` with no path term: the path enters here as
 the known disturbance ``-v kappa`` on ``theta'`` (``E = [0, 0, 0, -v]^T``),
 which is zero on a straight path, so Eq. 1 is recovered there.
 
+Sensors
+-------
+The paper's controllers feed back the whole state. The truck with sensors
+(:func:`sensor_plant`) measures its yaw rate (a MEMS gyroscope) and its
+lateral displacement and orientation error (RTK GNSS with dual-antenna
+heading, against the map of the path), not its lateral velocity; the noise
+levels, from data sheets, are :class:`TruckSensors`'.
+
 Mass and inertia at an overload
 -------------------------------
 The parameter table lists the vehicle mass ``m = 16030 kg`` and, separately,
