@@ -191,6 +191,9 @@ def run(out: Path, *, setup: str = DEFAULT_SETUP, draws: int = 20, seed: int = 0
     ts = get_table_setup(setup)
     path = ts.path(duration)
     designs = mse_designs.design_controllers(ts, controllers=list(CONTROLLERS))
+    if any(d.K_input is not None for d in designs):
+        raise ValueError("the estimated loop takes static steering laws; this set-up's H-infinity law feeds back "
+                         "the previous steering angle")
     ests, radii = filters(ts.path(), designs, mu)                # the whole course's tightest bend sizes W
     results = simulate(ts, path, designs, ests, draws, seed, keep=figures)
     elapsed = time.perf_counter() - t0
