@@ -60,9 +60,9 @@ _LOOP_COLUMNS = ("disk margin", "disk gains", "disk phase [deg]", "gain margin",
 
 @dataclass(frozen=True, eq=False, repr=False)
 class MarginsReport:
-    """Result of :func:`margins_report`: one certificate per controller and model.
+    """Result of :func:`margins_report`: one certificate per controller and model, and each controller's loop margins.
 
-    Attributes
+    Parameters
     ----------
     controllers : tuple of str
         Row names, in the order given.
@@ -71,9 +71,34 @@ class MarginsReport:
     results : Mapping
         ``results[controller][model]``: the :class:`~robustctl.RobustStability`,
         or a string ``"n/a (reason)"`` where the analysis raised.
-    loops : Mapping
+    loops : Mapping, optional
         ``loops[controller]``: the :class:`~robustctl.LoopMargins` of its
         nominal loop at the plant input, or ``"n/a (reason)"``.
+
+    Attributes
+    ----------
+    margin : (controllers, models) ndarray
+        The robust-stability margins (NaN where not available).
+    certified : (controllers, models) bool ndarray
+        ``margin >= 1`` certified.
+
+    See Also
+    --------
+    margins_report : makes it.
+
+    Examples
+    --------
+    One gain ``u = -0.6 x`` of a scalar plant ``x+ = 1.1 x + u`` with an
+    uncertainty ``dF = 0.5 Delta``: the closed loop is ``a = 0.5`` and the
+    margin the small-gain value ``1 / max |0.5 / (z - a)| = (1 - a) / 0.5 = 1``
+    (at ``z = 1``); its loop ``L = 0.6 / (z - 1.1)`` crosses the negative
+    real axis at ``z = -1`` with ``L = -0.6 / 2.1``, a gain margin of 3.5:
+
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.1]], [[1.0]], 0.1)
+    >>> report = rc.margins_report(plant, {"K": [[-0.6]]}, {"dF": rc.NormBounded([[0.5]], [[1.0]], [[0.0]])})
+    >>> round(float(report.margin[0, 0]), 6), round(report.loops["K"].gain_margin, 6)
+    (1.0, 3.5)
     """
 
     controllers: tuple[str, ...]
