@@ -31,7 +31,7 @@ import numpy as np
 from ._jit import jit
 from ._validation import as_float_array
 
-__all__ = ["solve", "sym", "weighted_lsq", "doubling", "stein", "relchange", "healthy", "check_penalty",
+__all__ = ["solve", "sym", "weighted_lsq", "fixed_point", "doubling", "stein", "relchange", "healthy", "check_penalty",
            "DIVERGED", "DEFAULT_ALPHA", "MU_MIN"]
 
 #: Default margin of ``lambda = (1 + alpha) mu ||H'H||`` (Sayed's approximation of the optimal ``lambda``).
@@ -119,6 +119,29 @@ def relchange(new: np.ndarray, old: np.ndarray) -> np.ndarray:
 def healthy(P: np.ndarray, bound: float = DIVERGED) -> np.ndarray:
     """Per matrix of a stack: every entry finite and below ``bound`` in magnitude."""
     return np.abs(P).max(axis=(1, 2)) < bound
+
+
+def fixed_point(advance, P0: np.ndarray, size: int, tol: float, max_iter: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The plain Riccati recursion of a stack: ``P <- advance(P[active], active)`` until each design settles.
+
+    A design stops when one step changes ``P`` by less than ``tol`` (:func:`relchange`) or ``P`` stops being
+    :func:`healthy`, after at most ``max_iter`` steps. Returns ``(P, iterations, active)``; ``active`` is True
+    where a design was still moving when ``max_iter`` ran out.
+    """
+    P = np.broadcast_to(P0, (size, *P0.shape[-2:])).copy()
+    iterations = np.zeros(size, dtype=int)
+    active = np.ones(size, dtype=bool)
+    for it in range(1, max_iter + 1):
+        idx = np.flatnonzero(active)
+        P_new = advance(P[idx], active)
+        change = relchange(P_new, P[idx])
+        P[idx] = P_new
+        iterations[idx] = it
+        active[idx[(change < tol) | ~healthy(P_new)]] = False      # converged, or diverging
+        if not active.any():
+            break
+    return P, iterations, active
 
 
 @jit

@@ -37,7 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._kkt import DIVERGED, doubling, healthy, relchange, solve, stein, sym
+from .._kkt import DIVERGED, doubling, fixed_point, healthy, relchange, solve, stein, sym
 from ..systems.stability import is_schur_stable, stability_of_eigenvalues
 from ._model import FilterModel
 from ._recursion import Gains, constraint, step
@@ -186,20 +186,9 @@ def newton(ev: Evaluation, d: FilterModel, tol: float) -> tuple[Evaluation, np.n
 
 def recursion(d: FilterModel, P0: np.ndarray, tol: float, max_iter: int) -> tuple[np.ndarray, np.ndarray]:
     """The plain recursion from ``P0`` until one step changes ``P`` by less than ``tol``: ``(P, iterations)``."""
-    B = d.size
-    P = np.broadcast_to(P0, (B, *P0.shape[-2:])).copy()
-    iterations = np.zeros(B, dtype=int)
-    active = np.ones(B, dtype=bool)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        for it in range(1, max_iter + 1):
-            idx = np.flatnonzero(active)
-            P_new = step(P[idx], d.select(idx)).P_next
-            change = relchange(P_new, P[idx])
-            P[idx] = P_new
-            iterations[idx] = it
-            active[idx[(change < tol) | ~healthy(P_new)]] = False
-            if not active.any():
-                break
+        P, iterations, _ = fixed_point(lambda P, active: step(P, d.select(active)).P_next, P0, d.size, tol,
+                                       max_iter)
     return P, iterations
 
 

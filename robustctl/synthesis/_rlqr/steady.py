@@ -88,19 +88,8 @@ def recursion(d: Model, step: StepFunction, P0: np.ndarray, tol: float, max_iter
     Returns ``(P, iterations, settled)``; ``settled`` False where it blew up or
     was still moving after ``max_iter`` steps.
     """
-    B = d.size
-    P = np.broadcast_to(P0, (B, *P0.shape[-2:])).copy()
-    iterations = np.zeros(B, dtype=int)
-    active = np.ones(B, dtype=bool)
-    for it in range(1, max_iter + 1):
-        idx = np.flatnonzero(active)
-        P_new = step(P[idx], d.select(active)).P
-        change = relchange(P_new, P[idx])
-        P[idx] = P_new
-        iterations[idx] = it
-        active[idx[(change < tol) | ~healthy(P_new)]] = False  # converged, or diverging
-        if not active.any():
-            break
+    P, iterations, active = _kkt.fixed_point(lambda P, active: step(P, d.select(active)).P, P0, d.size, tol,
+                                             max_iter)
     return P, iterations, ~active & healthy(P)
 
 
