@@ -84,7 +84,7 @@ from contextlib import contextmanager, nullcontext
 from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
 from moo.problems import PROBLEMS
-from moo.store import DISK_ERRORS
+from moo.store import DISK_ERRORS, SettingsMismatchError
 
 __all__ = ["main"]
 
@@ -216,11 +216,24 @@ def _flagged(message: str) -> str:
     return message.replace("molsp=True", "--molsp")
 
 
+#: The settings of a results directory (:mod:`moo.store`) by the flags that set them.
+_SETTING_FLAGS = {"budget": "--evals", "pop_size": "--pop-size", "max_leaders": "--max-leaders",
+                  "base_seed": "--seed", "seed": "--seed", "problem": "--problem", "n_obj": "--n-obj",
+                  "setup": "--setup", "algorithm": "--algorithms", "molsp": "the MO-LSP variant"}
+
+
+def _settings_message(exc: SettingsMismatchError) -> str:
+    """A settings mismatch with the settings named by their flags (``--evals 40 (this grid: 60)``)."""
+    return exc.message(_SETTING_FLAGS)
+
+
 @contextmanager
 def _usage() -> Iterator[None]:
     """Turn the library's argument errors (raised before any work) into usage errors."""
     try:
         yield
+    except SettingsMismatchError as exc:
+        raise _UsageError(_settings_message(exc)) from None
     except (ValueError, TypeError, NotImplementedError) as exc:
         raise _UsageError(_flagged(str(exc))) from None
 
@@ -312,7 +325,7 @@ def _keep_elsewhere(record: dict, out) -> str:
 def _cmd_experiment(args) -> int:
     from moo.executors import open_executor
     from moo.experiment import RunFailedError, prepare
-    from moo.store import ResultsDirBusyError, SettingsMismatchError
+    from moo.store import ResultsDirBusyError
 
     if args.molsp_max_leaders is not None:
         if args.max_leaders is not None:
@@ -343,7 +356,7 @@ def _cmd_experiment(args) -> int:
     except ResultsDirBusyError as exc:
         return _error(str(exc), 2)
     except SettingsMismatchError as exc:
-        return _error(_flagged(str(exc)), 2)
+        return _error(_settings_message(exc), 2)
     except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
     print(report, file=sys.stderr)

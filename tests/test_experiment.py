@@ -271,7 +271,7 @@ def test_cli_rerun_with_other_evals_is_a_one_line_usage_error(tmp_path, fake_run
     capsys.readouterr()
     assert main([*args, "--evals", "400"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "holds runs with other settings: budget 300 (this grid: 400)" in err
+    assert err.count("\n") == 1 and "holds runs with other settings: --evals 300 (this grid: 400)" in err
     assert "settings.json" in err and "Traceback" not in err
 
 

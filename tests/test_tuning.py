@@ -109,8 +109,11 @@ def test_problem_penalty_rule_and_reference_points():
     fam = tuning.RLQRFamily(plants[1])
     prob = tuning.TuningProblem(fam, plants, [effort, radius], penalty=1e3)
     assert (prob.n_var, prob.n_obj, prob.n_ieq_constr) == (fam.n_var, 2, 0)
-    np.testing.assert_array_equal(prob.hv_ref_point, [1e3, 1e3])
-    np.testing.assert_array_equal(prob.molsp_ref_point, prob.hv_ref_point)
+    # the default reference points: from 500 designs sampled within the bounds (seed 0), not the penalty
+    hv, ms = prob.sample_reference_points(500, seed=0)
+    np.testing.assert_array_equal(prob.hv_ref_point, hv)
+    np.testing.assert_array_equal(prob.molsp_ref_point, ms)
+    assert prob.hv_ref_source == "sampled designs" and np.all(hv < 1e3)
     Z = np.random.default_rng(3).uniform(0.0, 200.0, (30, fam.n_var))
     F = prob.evaluate(Z)
     K = fam.gains(Z).K

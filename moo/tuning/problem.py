@@ -172,16 +172,20 @@ class TuningProblem(Problem):
         ``p`` of the penalty rule; it must exceed every goal value of an
         acceptable design (values above it are clipped to it). Default ``1e6``.
     hv_ref_point : (n_obj,) array_like, optional
-        Hypervolume reference point of the runs' records. Default: ``penalty``
-        on every objective, which every design that is computed, stabilises
-        every scenario and scores below ``p`` dominates. It is always
-        valid but on a scale far above good designs, so the hypervolume
-        differences of good fronts are tiny: give a point just beyond the
-        values you accept (e.g. a front's nadir enlarged by 10-30 %,
-        :meth:`sample_reference_points`) to compare runs.
+        Hypervolume reference point of the runs' records. Default: from
+        ``reference_samples`` designs drawn uniformly within the bounds
+        (:meth:`sample_reference_points`, seed 0, computed when first needed):
+        the nadir of their acceptable non-dominated designs enlarged by 25 %
+        of the front's extent, a point on the scale of good designs. If none
+        of the sampled designs is acceptable, ``penalty`` on every objective
+        (valid, but far above good designs). :attr:`hv_ref_source` says which.
     molsp_ref_point : (n_obj,) array_like, optional
-        MO-LSP's leader reference point; default ``hv_ref_point`` (MO-LSP
-        chooses its leaders among the designs that dominate it).
+        MO-LSP's leader reference point (MO-LSP chooses its leaders among the
+        designs that dominate it); default the sampled one of
+        :meth:`sample_reference_points` (every acceptable sampled design
+        dominates it), or ``hv_ref_point`` when that is given.
+    reference_samples : int
+        Designs sampled for the default reference points (default 500).
 
     Attributes
     ----------
@@ -191,6 +195,11 @@ class TuningProblem(Problem):
         The goals.
     objective_names, constraint_names : list of str
         Their labels (a goal's ``name``, a function's name, or ``objectives[i]``).
+    hv_ref_point, molsp_ref_point : (n_obj,) ndarray
+        The reference points (the defaults are sampled on first access).
+    hv_ref_source : str
+        Where ``hv_ref_point`` comes from: ``"given"``, ``"sampled designs"``
+        or ``"penalty"`` (no sampled design was acceptable).
     last_flags : (B,) object ndarray
         Why each design of the last evaluated population was penalised
         (``""`` for none): the family's reason, ``"unstable"``, or
@@ -252,7 +261,7 @@ class TuningProblem(Problem):
 
     def __init__(self, family: DesignFamily, scenarios: Sequence[rc.Plant], objectives: Sequence[Goal],
                  constraints: Sequence[Goal] = (), *, xl=None, xu=None, penalty: float = 1e6,
-                 hv_ref_point=None, molsp_ref_point=None):
+                 hv_ref_point=None, molsp_ref_point=None, reference_samples: int = 500):
         for attr in ("n_var", "xl", "xu", "n_states", "n_inputs", "gains"):
             if not hasattr(family, attr):
                 raise TypeError(f"family must follow the DesignFamily protocol (missing {attr!r}), "
@@ -263,6 +272,10 @@ class TuningProblem(Problem):
         if (family.n_states, family.n_inputs) != (n, m):
             raise ValueError(f"family gives gains of shape ({family.n_inputs}, {family.n_states}), but the scenarios "
                              f"have m={m} inputs and n={n} states")
+        plant = getattr(family, "plant", None)
+        if isinstance(plant, rc.Plant) and plant.dt != self.scenarios[0].dt:
+            raise ValueError(f"family.plant has dt={plant.dt} but the scenarios have dt={self.scenarios[0].dt}: "
+                             "design the family on a plant of the scenarios' sampling time")
         self.objectives, self.objective_names = _goals(objectives, "objectives")
         if not self.objectives:
             raise ValueError("objectives must not be empty")
@@ -277,11 +290,56 @@ class TuningProblem(Problem):
         check_bounds(lo, hi)
         self.penalty = check_positive_scalar(penalty, "penalty")
         n_obj = len(self.objectives)
-        self.hv_ref_point = _ref_point(hv_ref_point, "hv_ref_point", np.full(n_obj, self.penalty))
-        self.molsp_ref_point = _ref_point(molsp_ref_point, "molsp_ref_point", self.hv_ref_point)
+        self._hv_ref = None if hv_ref_point is None else _ref_point(hv_ref_point, "hv_ref_point", np.zeros(n_obj))
+        self._molsp_ref = None if molsp_ref_point is None else \
+            _ref_point(molsp_ref_point, "molsp_ref_point", np.zeros(n_obj))
+        if self._molsp_ref is None and self._hv_ref is not None:
+            self._molsp_ref = self._hv_ref.copy()
+        self.hv_ref_source = "given" if self._hv_ref is not None else "sampled designs (not yet drawn)"
+        self.reference_samples = check_int(reference_samples, "reference_samples", 2)
         self._F_s, self._G_s = plant_stacks(self.scenarios)
+        self._plants = tuple(self.scenarios)               # what the goals get (immutable)
         self.last_flags = np.zeros(0, dtype=object)
         super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=len(self.constraints), xl=lo, xu=hi, vtype=float)
+
+    # -- reference points ------------------------------------------------------------
+    @property
+    def hv_ref_point(self) -> np.ndarray:
+        """The hypervolume reference point (the default is sampled on first access; see the class docstring)."""
+        if self._hv_ref is None:
+            self._sample_defaults()
+        assert self._hv_ref is not None
+        return self._hv_ref
+
+    @hv_ref_point.setter
+    def hv_ref_point(self, value) -> None:
+        self._hv_ref = _ref_point(value, "hv_ref_point", np.zeros(self.n_obj))
+        self.hv_ref_source = "given"
+
+    @property
+    def molsp_ref_point(self) -> np.ndarray:
+        """MO-LSP's reference point (the default is sampled on first access)."""
+        if self._molsp_ref is None:
+            self._sample_defaults()
+        assert self._molsp_ref is not None
+        return self._molsp_ref
+
+    @molsp_ref_point.setter
+    def molsp_ref_point(self, value) -> None:
+        self._molsp_ref = _ref_point(value, "molsp_ref_point", np.zeros(self.n_obj))
+
+    def _sample_defaults(self) -> None:
+        """Fill the reference points not given from :meth:`sample_reference_points` (else the penalty)."""
+        try:
+            hv, molsp = self.sample_reference_points(self.reference_samples, seed=0)
+            source = "sampled designs"
+        except ValueError:
+            hv = molsp = np.full(self.n_obj, self.penalty)
+            source = f"penalty: none of {self.reference_samples} sampled designs was acceptable"
+        if self._hv_ref is None:
+            self._hv_ref, self.hv_ref_source = hv, source
+        if self._molsp_ref is None:
+            self._molsp_ref = molsp
 
     # -- gains and closed loops ----------------------------------------------------
     @property
@@ -347,13 +405,17 @@ class TuningProblem(Problem):
         return stable, rho
 
     # -- goals ---------------------------------------------------------------------
-    def _call(self, goal, name: str, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+    def _call(self, goal, name: str, K: np.ndarray, plants: tuple[rc.Plant, ...]) -> np.ndarray:
+        """``goal(K, plants)``, its value checked (``K`` read-only and ``plants`` a tuple: see :meth:`_goals_of`)."""
         value = goal(K, plants)
-        try:
-            arr = np.asarray(value, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise ValueError(f"goal {name!r} must return a ({K.shape[0]},) array of numbers (one per design), "
-                             f"got {type(value).__name__}") from None
+        arr = np.asarray(value)
+        real = arr.dtype.kind in "biuf" or (arr.dtype.kind == "O" and all(
+            isinstance(v, (int, float, np.integer, np.floating)) for v in arr.ravel()))
+        if not real:
+            kind = {"c": "complex", "U": "str", "S": "bytes"}.get(arr.dtype.kind, "objects")
+            raise ValueError(f"goal {name!r} must return real numbers ({K.shape[0]}, one per design), got "
+                             f"{type(value).__name__} of {kind} (dtype {arr.dtype})")
+        arr = arr.astype(np.float64)
         if arr.shape != (K.shape[0],):
             raise ValueError(f"goal {name!r} must return shape ({K.shape[0]},) (one value per design), "
                              f"got shape {arr.shape}")
@@ -375,12 +437,25 @@ class TuningProblem(Problem):
         F = np.full((K.shape[0], self.n_obj), np.inf)
         G = np.full((K.shape[0], self.n_ieq_constr), np.inf)
         if run.any():
-            Kr = np.ascontiguousarray(K[run])
-            for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
-                F[run, j] = self._call(g, name, Kr, plants)
-            for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
-                G[run, j] = self._call(g, name, Kr, plants)
+            F[run], G[run] = self._goals_of(K[run], tuple(plants))
         return F, G
+
+    def _goals_of(self, K: np.ndarray, plants: tuple[rc.Plant, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """Objective and constraint values (B, n_obj), (B, n_constr) of the designs ``K``, every goal called once.
+
+        Every goal gets the same read-only copy of ``K`` and the same tuple of
+        plants: a goal cannot change what the next one sees (goals that share a
+        simulation recognise the same objects).
+        """
+        K = np.array(K, dtype=float)
+        K.flags.writeable = False
+        J = np.empty((K.shape[0], self.n_obj))
+        C = np.empty((K.shape[0], self.n_ieq_constr))
+        for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
+            J[:, j] = self._call(g, name, K, plants)
+        for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
+            C[:, j] = self._call(g, name, K, plants)
+        return J, C
 
     def sample_reference_points(self, n: int = 500, *, seed=0, margin: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
         r"""Reference points from the scale of the objectives, by the rule the paper's two MOPs use.
@@ -452,11 +527,7 @@ class TuningProblem(Problem):
         C = np.full((B, self.n_ieq_constr), np.inf)
         flags = np.where(ok, np.where(run, "", "unstable"), fg.reason).astype(object)
         if run.any():
-            Kr = K[run]
-            for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
-                J[run, j] = self._call(g, name, Kr, self.scenarios)
-            for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
-                C[run, j] = self._call(g, name, Kr, self.scenarios)
+            J[run], C[run] = self._goals_of(K[run], self._plants)
             vals = np.concatenate([J[run], C[run]], axis=1)
             bad = ~np.all(np.isfinite(vals), axis=1)
             if bad.any():

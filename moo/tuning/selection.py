@@ -217,6 +217,8 @@ def check_weights(weights, n_obj: int) -> np.ndarray:
     w = as_float_array(weights, "weights").ravel()
     if w.shape != (n_obj,) or not np.all(np.isfinite(w)) or np.any(w < 0):
         raise ValueError(f"weights must be {n_obj} finite non-negative numbers (one per objective), got {w}")
+    if not w.any():
+        raise ValueError(f"weights must not all be zero (every design would tie), got {w}")
     return w
 
 
@@ -236,10 +238,16 @@ def draw_errors(problem, K, n_sims: int, rng: np.random.Generator,
     if not callable(sampler):
         raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, got {type(sampler).__name__}")
     plants = []
+    ref = problem.scenarios[0]
     for _ in range(n_sims):
         p = sampler(rng)
         if not isinstance(p, rc.Plant):
             raise TypeError(f"sampler must return a robustctl.Plant, got {type(p).__name__}")
+        if (p.n, p.m) != (ref.n, ref.m):
+            raise ValueError(f"sampler returned a plant with n={p.n} states and m={p.m} inputs; the scenarios "
+                             f"have n={ref.n}, m={ref.m}")
+        if p.dt != ref.dt:
+            raise ValueError(f"sampler returned a plant with dt={p.dt}; the scenarios have dt={ref.dt}")
         plants.append(p)
     return scenario_errors(problem, K, plants, weights), np.full(n_sims, -1)
 
@@ -371,8 +379,10 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     ------
     TypeError, ValueError
         Gains of the wrong shape, ``n_sims`` not a positive integer, a bad
-        seed, weights not ``n_obj`` non-negative numbers, a sampler that is
-        not callable or does not return a plant, no design with a finite
+        seed, weights not ``n_obj`` non-negative numbers or all zero, a
+        sampler that is not callable or returns anything but a plant of the
+        scenarios' size and sampling time, no candidate that stabilises every
+        scenario (a front that is all penalised), no design with a finite
         error in any simulation.
 
     See Also
@@ -382,8 +392,9 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
 
     Notes
     -----
-    Simulation :math:`s` draws a plant :math:`P_s`; every design :math:`d`
-    gets the cumulative error
+    Only the candidates that stabilise every scenario of the problem take
+    part (the others get ``+inf`` everywhere). Simulation :math:`s` draws a
+    plant :math:`P_s`; every design :math:`d` gets the cumulative error
 
     .. math::
 
@@ -422,14 +433,23 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     Kc = problem.check_gains(K)
     n_sims = check_int(n_sims, "n_sims", 1)
     rng = _rng(seed)
+    stable, _ = problem.stability(np.where(np.isfinite(Kc), Kc, 0.0))
+    candidates = stable.all(axis=1) & np.all(np.isfinite(Kc), axis=(1, 2))
+    if not candidates.any():
+        raise ValueError("no candidate stabilises every scenario of the problem (the whole front is penalised): "
+                         "nothing to select; tune longer, widen the bounds or revise the goals")
     if weights is None:
         if F is None:
             F, _ = problem.evaluate_gains(Kc)
         Ff = as_float_array(F, "F")
-        fin = np.all(np.isfinite(Ff), axis=1) if Ff.ndim == 2 else None
-        weights = default_weights(Ff[fin] if fin is not None and fin.any() else Ff)
+        if Ff.shape != (Kc.shape[0], problem.n_obj):
+            raise ValueError(f"F must have shape ({Kc.shape[0]}, {problem.n_obj}) (candidates, objectives), "
+                             f"got shape {Ff.shape}")
+        use = candidates & np.all(np.isfinite(Ff), axis=1)
+        weights = default_weights(Ff[use] if use.any() else Ff[candidates])
     w = check_weights(weights, problem.n_obj)
     E, draws = draw_errors(problem, Kc, n_sims, rng, sampler, w)
+    E[~candidates] = np.inf                     # a design unstable on a scenario never wins
     res = monte_carlo_selection(E)
     Kbest = Kc[res.best]
     ctrl = rc.Controller(Kbest, method, problem.scenarios[0] if plant is None else plant,

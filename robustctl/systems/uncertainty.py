@@ -18,6 +18,24 @@ from .plant import Plant, check_plant, check_plants
 __all__ = ["NormBounded", "check_norm_bounded"]
 
 
+def _domain(value) -> float | str | None:
+    """``None``, ``"continuous"`` or a positive finite sampling time (``ValueError`` naming ``domain``)."""
+    if value is None or value == "continuous":
+        return value
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) \
+            and np.isfinite(value) and value > 0:
+        return float(value)
+    raise ValueError(f"domain must be None, 'continuous' or a positive sampling time, got {value!r}")
+
+
+def _domain_of(plant: Plant) -> float | str:
+    return "continuous" if plant.dt is None else float(plant.dt)
+
+
+def _domain_text(domain: float | str) -> str:
+    return "continuous-time plants" if domain == "continuous" else f"discrete-time plants with dt={domain:g}"
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class NormBounded:
     """Uncertainty ``dF = H Delta EF``, ``dG = H Delta EG`` with ``||Delta||_2 <= 1``.
@@ -27,13 +45,20 @@ class NormBounded:
     H : (n, p) array_like (1-D is read as a column)
     EF : (l, n) array_like (1-D is read as a row)
     EG : (l, m) array_like (1-D is read as a row)
+    domain : None, "continuous" or float
+        The time domain of the plants the model is about: ``"continuous"``, or
+        the sampling time ``dt`` of discrete-time plants. :meth:`check_plant`
+        (and so every analysis that takes the model) refuses a plant of another
+        domain. ``None`` (the default of a hand-built model) leaves it
+        unchecked; :meth:`from_plants` records the plants' domain.
     """
 
     H: np.ndarray
     EF: np.ndarray
     EG: np.ndarray
+    domain: float | str | None = None
 
-    def __init__(self, H, EF, EG):
+    def __init__(self, H, EF, EG, *, domain: float | str | None = None):
         EF = as_matrix(EF, "EF")
         l, n = EF.shape
         H = as_matrix(H, "H", rows=n, vector="column", rows_what="the number of states, from EF's columns")
@@ -41,6 +66,7 @@ class NormBounded:
         object.__setattr__(self, "H", frozen(H))
         object.__setattr__(self, "EF", frozen(EF))
         object.__setattr__(self, "EG", frozen(EG))
+        object.__setattr__(self, "domain", _domain(domain))
 
     @property
     def n(self) -> int:
@@ -63,11 +89,14 @@ class NormBounded:
         return self.EF.shape[0]
 
     def check_plant(self, plant: Plant) -> None:
-        """Raise ``TypeError`` if ``plant`` is not a :class:`Plant`, ``ValueError`` if the sizes do not match it."""
+        """``TypeError`` if ``plant`` is not a :class:`Plant`, ``ValueError`` if its sizes or its domain do not fit."""
         check_plant(plant)
         if (plant.n, plant.m) != (self.n, self.m):
             raise ValueError(f"uncertainty is for n={self.n} states and m={self.m} inputs, "
                              f"plant has n={plant.n}, m={plant.m}")
+        if self.domain is not None and _domain_of(plant) != self.domain:
+            got = "continuous time" if plant.dt is None else f"dt={plant.dt:g}"
+            raise ValueError(f"uncertainty is for {_domain_text(self.domain)} (its domain), plant has {got}")
 
     def _deltas(self, Delta) -> np.ndarray:
         D = as_float_array(Delta, "Delta")
@@ -168,7 +197,8 @@ class NormBounded:
         Returns
         -------
         NormBounded
-            ``H`` (n x p), ``EF`` (l x n), ``EG`` (l x m).
+            ``H`` (n x p), ``EF`` (l x n), ``EG`` (l x m); its ``domain`` is
+            the plants' (``"continuous"`` or their ``dt``).
 
         Raises
         ------
@@ -191,7 +221,7 @@ class NormBounded:
         >>> plants = [rc.Plant(nominal.F, nominal.G * s, dt=0.1) for s in (0.8, 1.2)]
         >>> unc = rc.NormBounded.from_plants(nominal, plants)
         >>> unc
-        NormBounded(n=2, m=1, p=1, l=1)
+        NormBounded(n=2, m=1, p=1, l=1, domain=0.1)
         >>> bool(np.allclose(abs(unc.H @ unc.EG), [[0.0], [0.02]]))
         True
         """
@@ -225,10 +255,11 @@ class NormBounded:
                              f"plants[{worst}] only to a relative error of {resid[worst]:.3g} > tol={tol:g}; "
                              "allow a larger rank (or a larger tol)")
         n = nominal.n
-        return cls(H, E[:, :n], E[:, n:])
+        return cls(H, E[:, :n], E[:, n:], domain=_domain_of(nominal))
 
     def __repr__(self) -> str:
-        return f"NormBounded(n={self.n}, m={self.m}, p={self.p}, l={self.l})"
+        domain = "" if self.domain is None else f", domain={self.domain!r}"
+        return f"NormBounded(n={self.n}, m={self.m}, p={self.p}, l={self.l}{domain})"
 
 
 def check_norm_bounded(value, plant: Plant, name: str = "uncertainty") -> NormBounded:
