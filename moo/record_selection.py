@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -286,8 +287,12 @@ def select_from_records(records: list[dict], problem, *, problem_name: str, algo
     return select_on_front(problem, front, n_sims=n_sims, seed=seed)
 
 
-def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=None) -> RecordSelection:
-    """The selection of :func:`select_from_records` on a front already pooled (:func:`front_from_records`)."""
+def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=None,
+                    progress: Callable[[int, int], None] | None = None) -> RecordSelection:
+    """The selection of :func:`select_from_records` on a front already pooled (:func:`front_from_records`).
+
+    ``progress(done, total)`` follows the simulated plants (the paper's rule: all at once).
+    """
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"select needs a moo.tuning.TuningProblem, got a {type(problem).__name__}")
     n_sims = check_int(n_sims, "n_sims", 1)
@@ -295,12 +300,16 @@ def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=Non
     from .tuning.tune import select_front
 
     if is_paper_problem(problem):                                           # the paper's: their own rule
+        if progress is not None:
+            progress(0, n_sims)
         ds = select_design(problem, front.X, n_sims=n_sims, seed=seed)
+        if progress is not None:
+            progress(n_sims, n_sims)
         best = ds.best
         index = best if ds.designs.kinds[best] == "front" else None
         K, z, labels, counts, rule = ds.designs.K[best], ds.z, ds.designs.labels, ds.result.counts, "paper"
     else:
-        sel = select_front(problem, front.X, front.F, n_sims=n_sims, seed=seed)
+        sel = select_front(problem, front.X, front.F, n_sims=n_sims, seed=seed, progress=progress)
         best = index = sel.index
         K, z, counts, rule = sel.K, front.X[index].copy(), sel.counts, "scenarios"
         labels = tuple(str(i + 1) for i in range(len(front)))

@@ -223,17 +223,19 @@ def check_weights(weights, n_obj: int) -> np.ndarray:
 
 
 def draw_errors(problem, K, n_sims: int, rng: np.random.Generator,
-                sampler: Callable[[np.random.Generator], rc.Plant] | None, weights) -> tuple[np.ndarray, np.ndarray]:
+                sampler: Callable[[np.random.Generator], rc.Plant] | None, weights,
+                progress: Callable[[int, int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The (designs, simulations) errors of ``K`` on ``n_sims`` drawn plants, and the draws.
 
     Each simulation draws a scenario of ``problem`` (its index in ``draws``),
     or a plant from ``sampler(rng)`` (``draws`` -1); every used scenario is
-    simulated once (:func:`scenario_errors`).
+    simulated once (:func:`scenario_errors`, which calls ``progress(done, total)``
+    after each plant).
     """
     if sampler is None:
         draws = rng.integers(0, len(problem.scenarios), size=n_sims)
         used = np.unique(draws)
-        per = scenario_errors(problem, K, [problem.scenarios[i] for i in used], weights)
+        per = scenario_errors(problem, K, [problem.scenarios[i] for i in used], weights, progress)
         return per[:, np.searchsorted(used, draws)], draws
     if not callable(sampler):
         raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, got {type(sampler).__name__}")
@@ -249,13 +251,15 @@ def draw_errors(problem, K, n_sims: int, rng: np.random.Generator,
         if p.dt != ref.dt:
             raise ValueError(f"sampler returned a plant with dt={p.dt}; the scenarios have dt={ref.dt}")
         plants.append(p)
-    return scenario_errors(problem, K, plants, weights), np.full(n_sims, -1)
+    return scenario_errors(problem, K, plants, weights, progress), np.full(n_sims, -1)
 
 
-def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights) -> np.ndarray:
+def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights,
+                    progress: Callable[[int, int], None] | None = None) -> np.ndarray:
     """Cumulative errors (D, P): ``sum_j w_j f_j(K_d, [plant_p])`` of every design on every plant alone.
 
     ``+inf`` where a design has NaN gains, is unstable on that plant or a goal is not finite there.
+    ``progress(done, P)`` is called after each plant.
     """
     K = problem.check_gains(K)
     w = check_weights(weights, problem.n_obj)
@@ -265,6 +269,8 @@ def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights) -> np.ndarr
         with np.errstate(invalid="ignore"):
             e = (np.where(w > 0, F, 0.0) * w).sum(axis=1)
         E[:, p] = np.where(np.isfinite(e), e, np.inf)
+        if progress is not None:
+            progress(p + 1, len(plants))
     return E
 
 
@@ -344,7 +350,8 @@ def _rng(seed) -> np.random.Generator:
 
 def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
            sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None,
-           plant: rc.Plant | None = None, method: str = "tuned") -> Selection:
+           plant: rc.Plant | None = None, method: str = "tuned",
+           progress: Callable[[int, int], None] | None = None) -> Selection:
     r"""The paper's Monte Carlo selection, for any tuning problem (module docstring).
 
     Parameters
@@ -369,6 +376,8 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
         The plant of the returned :class:`~robustctl.Controller` (default: the first scenario).
     method : str
         The controller's ``method``.
+    progress : callable, optional
+        ``progress(done, total)`` after each plant simulated (a drawn scenario, or a sampler's plant).
 
     Returns
     -------
@@ -448,7 +457,7 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
         use = candidates & np.all(np.isfinite(Ff), axis=1)
         weights = default_weights(Ff[use] if use.any() else Ff[candidates])
     w = check_weights(weights, problem.n_obj)
-    E, draws = draw_errors(problem, Kc, n_sims, rng, sampler, w)
+    E, draws = draw_errors(problem, Kc, n_sims, rng, sampler, w, progress)
     E[~candidates] = np.inf                     # a design unstable on a scenario never wins
     res = monte_carlo_selection(E)
     Kbest = Kc[res.best]

@@ -40,7 +40,8 @@ def design_plant(problem: TuningProblem) -> rc.Plant:
 
 
 def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=None,
-                 sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None) -> Selection:
+                 sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None,
+                 progress: Callable[[int, int], None] | None = None) -> Selection:
     """The Monte Carlo selection (:func:`moo.tuning.selection.select`) of one design of a front ``X``.
 
     What :meth:`TuningResult.select` does, for decision vectors from anywhere
@@ -57,7 +58,7 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
         Decision vectors of the front (N >= 1).
     F : (N, n_obj) array_like, optional
         Their objectives (for the default weights; default: evaluated).
-    n_sims, seed, sampler, weights
+    n_sims, seed, sampler, weights, progress
         As in :func:`moo.tuning.selection.select`.
 
     Returns
@@ -102,7 +103,7 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
         raise ValueError("the front is empty (no design stabilised every scenario): nothing to select")
     X = problem.population(X, "X")
     return select(problem, problem.gains(X).K, F=F, n_sims=n_sims, seed=seed, sampler=sampler, weights=weights,
-                  plant=design_plant(problem), method=_method(problem.family))
+                  plant=design_plant(problem), method=_method(problem.family), progress=progress)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
