@@ -24,7 +24,12 @@ def _fmt(x) -> str:
 
 @dataclass(frozen=True, eq=False, repr=False)
 class RobustStability:
-    """Quadratic-stability certificate of a closed loop.
+    r"""Quadratic-stability certificate of a closed loop (:func:`robustctl.robust_stability`).
+
+    Parameters
+    ----------
+    certified, margin, radius, P, certificate, kind, info
+        The attributes below.
 
     Attributes
     ----------
@@ -57,7 +62,46 @@ class RobustStability:
         AB13DD) and ``"riccati"`` (``"doubling"`` or ``"eigenvectors"``:
         how the certifying Riccati solution was computed; None if the
         Riccati path did not certify); polytope: solver
-        diagnostics (``solve_time``, ``iterations``, ``solves``).
+        diagnostics (``solve_time``, ``iterations``, ``solves``). The table
+        of keys is in :func:`robustctl.robust_stability`.
+
+    See Also
+    --------
+    robustctl.robust_stability : computes it.
+    RobustStabilityBatch : the same for a stack of gains.
+
+    Notes
+    -----
+    For a norm-bounded uncertainty the certificate is the LMI at ``r = radius``
+
+    .. math::
+
+        \begin{bmatrix} P - A^T P A - E^T E & -r A^T P H \\
+                        -r H^T P A & I - r^2 H^T P H \end{bmatrix} \succ 0,
+        \qquad P \succ 0,
+
+    whose smallest eigenvalues are ``certificate["lyapunov"]`` and
+    ``certificate["P"]``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> ctrl = rc.lqr(plant)
+    >>> unc = rc.NormBounded([[0.0], [0.1]], [[0.0, 0.0]], [[0.5]])        # input gain +- 50 %
+    >>> res = rc.robust_stability(ctrl, unc)
+    >>> res.certified, res.radius
+    (True, 1.0)
+
+    The certificate holds, rebuilt here from ``P``:
+
+    >>> A, H, E, P = ctrl.closed_loop(), unc.H, unc.EF + unc.EG @ ctrl.K, res.P
+    >>> M = np.block([[P - A.T @ P @ A - E.T @ E, -A.T @ P @ H], [-H.T @ P @ A, np.eye(1) - H.T @ P @ H]])
+    >>> bool(np.isclose(np.linalg.eigvalsh(M)[0], res.certificate["lyapunov"]))
+    True
+    >>> bool(np.linalg.eigvalsh(M)[0] > 0 and np.linalg.eigvalsh(P)[0] > 0)
+    True
     """
 
     certified: bool
@@ -89,6 +133,13 @@ class RobustStabilityBatch:
     a caller that needs only the margins (a tuning goal) does not pay for
     them. Pickling computes them first (the result can cross processes).
 
+    Parameters
+    ----------
+    margin, reason, kind
+        The attributes below.
+    _certify : callable
+        Returns ``(certified, radius, P, certificate, info)``; called on first access.
+
     Attributes
     ----------
     margin : (B,) ndarray
@@ -115,7 +166,32 @@ class RobustStabilityBatch:
         ``"nominal_radius"``: (B,) spectral radius (abscissa) of ``F + G K``;
         ``"norm"``: ``"level-set"`` (the batched H-infinity norm);
         ``"norm_iterations"``: level-set steps of the H-infinity norm;
-        ``"sdp_solves"``: designs that needed the SDP.
+        ``"sdp_solves"``: designs that needed the SDP (the table of
+        :func:`robustctl.robust_stability`).
+
+    See Also
+    --------
+    robustctl.robust_stability : computes it.
+    RobustStability : the result for one gain.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> ctrl = rc.lqr(plant)
+    >>> unc = rc.NormBounded([[0.0], [0.1]], [[0.0, 0.0]], [[0.5]])        # input gain +- 50 %
+    >>> batch = rc.robust_stability((plant, np.stack([ctrl.K, 0.5 * ctrl.K, -ctrl.K])), unc)
+    >>> batch.reason.tolist(), batch.certified.tolist()
+    (['ok', 'ok', 'unstable'], [True, True, False])
+
+    The margins are the small-gain values (python-control's ``linfnorm``):
+
+    >>> import control
+    >>> ref = [1.0 / control.linfnorm(control.ss(plant.F + plant.G @ K, unc.H, unc.EG @ K, 0, 0.1))[0]
+    ...        for K in (ctrl.K, 0.5 * ctrl.K)]
+    >>> bool(np.allclose(batch.margin[:2], ref, rtol=1e-8))
+    True
     """
 
     margin: np.ndarray
@@ -175,7 +251,12 @@ class RobustStabilityBatch:
 
 @dataclass(frozen=True, eq=False, repr=False)
 class CostBound:
-    """Guaranteed LQ cost: ``sum x'Qx + u'Ru <= bound`` for every admissible ``Delta``.
+    r"""Guaranteed LQ cost: ``sum x'Qx + u'Ru <= bound`` for every admissible ``Delta``.
+
+    Parameters
+    ----------
+    bound, P, multiplier, x0, certificate, info
+        The attributes below.
 
     Attributes
     ----------
@@ -186,9 +267,37 @@ class CostBound:
     multiplier : float
         S-procedure multiplier ``lam``.
     x0 : (n,) ndarray or None
+        The initial state, None for the worst unit one.
     certificate : Mapping[str, float]
         Smallest eigenvalue of each LMI block at the solution (solver's coordinates, ``>= 0`` up to rounding).
     info : Mapping
+        Solver diagnostics: ``"solve_time"`` [s], ``"iterations"``,
+        ``"solves"`` (one report per SDP).
+
+    See Also
+    --------
+    robustctl.guaranteed_cost : computes it (the LMI is in its Notes).
+    CostBoundBatch : the same for a stack of gains.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> ctrl = rc.lqr(plant)
+    >>> unc = rc.NormBounded([[0.0], [0.1]], [[0.0, 0.0]], [[0.5]])        # input gain +- 50 %
+    >>> cost = rc.guaranteed_cost(ctrl, unc, Q=np.eye(2), R=np.eye(1))
+    >>> bool(np.isclose(cost.bound, np.linalg.eigvalsh(cost.P)[-1]))      # x0 not given: lambda_max(P)
+    True
+
+    ``(P, multiplier)`` satisfies the guaranteed-cost LMI, rebuilt here:
+
+    >>> A, H, E, P, lam = ctrl.closed_loop(), unc.H, unc.EG @ ctrl.K, cost.P, cost.multiplier
+    >>> QK = np.eye(2) + ctrl.K.T @ ctrl.K
+    >>> M = np.block([[P - A.T @ P @ A - QK - lam * E.T @ E, -A.T @ P @ H],
+    ...               [-H.T @ P @ A, lam * np.eye(1) - H.T @ P @ H]])
+    >>> bool(np.linalg.eigvalsh(M)[0] > -1e-8 * np.linalg.eigvalsh(M)[-1])
+    True
     """
 
     bound: float
@@ -211,6 +320,11 @@ class CostBoundBatch:
     equations and a search over the multiplier instead of an SDP), as
     entries of arrays.
 
+    Parameters
+    ----------
+    bound, P, multiplier, reason, x0, certificate, info
+        The attributes below.
+
     Attributes
     ----------
     bound : (B,) ndarray
@@ -226,6 +340,7 @@ class CostBoundBatch:
         stable"`` (``||E (zI - A)^-1 H||_inf >= 1``: no bound exists) or
         ``"not finite"``.
     x0 : (n,) ndarray or None
+        The initial state, None for the worst unit one.
     certificate : Mapping[str, (B,) ndarray]
         Smallest eigenvalue of each LMI block at ``(P, lam)`` in the plant's
         coordinates: ``"cost"`` (the guaranteed-cost LMI) and ``"P"``
@@ -235,6 +350,27 @@ class CostBoundBatch:
         ``"path"``: ``"riccati"``; ``"search_steps"``: golden-section steps
         of the multiplier search; ``"riccati_failures"``: designs whose
         Riccati solution failed at the optimal multiplier (bound ``inf``).
+
+    See Also
+    --------
+    robustctl.guaranteed_cost : computes it.
+
+    Examples
+    --------
+    A scalar loop ``x+ = (0.5 + k + 0.2 Delta) x`` costs at worst
+    ``(1 + k^2) / (1 - (|0.5 + k| + 0.2)^2)`` from ``x0 = 1``:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[0.5]], [[1.0]], dt=0.1)
+    >>> unc = rc.NormBounded([[1.0]], [[0.2]], [[0.0]])
+    >>> gains = np.array([-0.2, -0.4, 0.5]).reshape(3, 1, 1)
+    >>> batch = rc.guaranteed_cost((plant, gains), unc, Q=[[1.0]], R=[[1.0]], x0=[1.0])
+    >>> batch.reason.tolist()
+    ['ok', 'ok', 'unstable']
+    >>> k = gains[:2, 0, 0]
+    >>> bool(np.allclose(batch.bound[:2], (1 + k**2) / (1 - (abs(0.5 + k) + 0.2) ** 2), rtol=1e-6))
+    True
     """
 
     bound: np.ndarray
@@ -259,9 +395,15 @@ class CostBoundBatch:
 class HinfBound:
     """Robust H-infinity bound: ``||T_zw||_inf <= gamma`` for every admissible ``Delta``.
 
+    Parameters
+    ----------
+    gamma, P, multiplier, certificate, info
+        The attributes below.
+
     Attributes
     ----------
     gamma : float
+        The bound.
     P : (n, n) ndarray
         Storage function ``x'Px`` of the dissipation inequality.
     multiplier : float
@@ -269,6 +411,30 @@ class HinfBound:
     certificate : Mapping[str, float]
         Smallest eigenvalue of each LMI block at the solution (solver's coordinates).
     info : Mapping
+        Solver diagnostics: ``"solve_time"`` [s], ``"iterations"``,
+        ``"solves"`` (one report per SDP).
+
+    See Also
+    --------
+    robustctl.robust_hinf_bound : computes it (the LMI is in its Notes).
+
+    Examples
+    --------
+    The bound is at least the nominal norm (python-control's ``linfnorm``)
+    and at least the norm of every plant of the set, here ``Delta = -1``:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> ctrl = rc.lqr(plant)
+    >>> unc = rc.NormBounded([[0.0], [0.1]], [[0.0, 0.0]], [[0.5]])        # input gain +- 50 %
+    >>> Bw, Cz = [[0.0], [0.1]], [[1.0, 0.0]]
+    >>> res = rc.robust_hinf_bound(ctrl, unc, Bw=Bw, Cz=Cz, Dzu=[[0.0]])
+    >>> import control
+    >>> worst = unc.perturb(plant, [[-1.0]])
+    >>> norms = [control.linfnorm(control.ss(p.F + p.G @ ctrl.K, Bw, Cz, 0, 0.1))[0] for p in (plant, worst)]
+    >>> bool(res.gamma >= max(norms))
+    True
     """
 
     gamma: float
@@ -283,7 +449,12 @@ class HinfBound:
 
 @dataclass(frozen=True, eq=False, repr=False)
 class WorstCase:
-    """Result of the worst-case search over ``||Delta|| <= 1``.
+    """Result of the worst-case search over ``||Delta|| <= 1`` (:func:`robustctl.worst_case`).
+
+    Parameters
+    ----------
+    Delta, radius, destabilizing, nominal_radius, evaluations
+        The attributes below.
 
     Attributes
     ----------
@@ -301,6 +472,24 @@ class WorstCase:
         The same for ``Delta = 0``.
     evaluations : int
         Eigenvalue decompositions used.
+
+    See Also
+    --------
+    robustctl.worst_case : computes it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> ctrl = rc.lqr(plant)
+    >>> unc = rc.NormBounded([[0.0], [0.1]], [[0.0, 0.0]], [[0.5]])        # input gain +- 50 %
+    >>> wc = rc.worst_case(ctrl, unc)
+    >>> wc.destabilizing, float(np.linalg.norm(wc.Delta, 2))
+    (False, 1.0)
+    >>> A, H, E = ctrl.closed_loop(), unc.H, unc.EG @ ctrl.K
+    >>> bool(np.isclose(wc.radius, max(abs(np.linalg.eigvals(A + H @ wc.Delta @ E)))))
+    True
     """
 
     Delta: np.ndarray

@@ -103,7 +103,9 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     Parameters
     ----------
     controller : Controller or (Plant, (m, n) array_like)
+        The gain ``K`` and the nominal plant.
     uncertainty : NormBounded
+        ``[dF dG] = H Delta [EF EG]``.
     seed : None, int, SeedSequence or Generator
         For the random starts (``np.random.default_rng``).
     n_starts : int, default 20
@@ -112,6 +114,56 @@ def worst_case(controller: Controller | tuple[Plant, ArrayLike], uncertainty: No
     Returns
     -------
     WorstCase
+        The worst ``Delta`` found, its spectral radius (abscissa), whether
+        it destabilises the loop and the number of eigenvalue problems solved.
+
+    Raises
+    ------
+    ValueError
+        ``n_starts`` not an integer ``>= 0``; sizes that do not match the plant.
+    TypeError
+        ``controller`` or ``uncertainty`` of the wrong type.
+
+    See Also
+    --------
+    robust_stability : the certified margin (the upper side).
+
+    Notes
+    -----
+    For a simple eigenvalue ``lambda`` of ``A + H Delta E`` with right and
+    left eigenvectors ``x`` and ``y``, the ascent uses [1]_
+
+    .. math::
+
+        \frac{\partial \lambda}{\partial \Delta} =
+        \frac{(H^T \bar y)(E x)^T}{y^H x} ,
+
+    of ``|lambda|`` (discrete) or ``Re lambda`` (continuous), and projects
+    each step back onto ``||Delta||_2 <= 1`` by clipping the singular values.
+
+    References
+    ----------
+    .. [1] J. H. Wilkinson, *The Algebraic Eigenvalue Problem*, Oxford 1965,
+       Ch. 2 (first-order perturbation of a simple eigenvalue).
+
+    Examples
+    --------
+    An LQR of a double integrator whose input gain may be off by up to
+    300 %: the search finds the destabilising end, which a fine grid over
+    the scalar ``Delta`` confirms:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> ctrl = rc.lqr(plant)
+    >>> unc = rc.NormBounded([[0.0], [0.1]], [[0.0, 0.0]], [[3.0]])
+    >>> wc = rc.worst_case(ctrl, unc)
+    >>> wc.destabilizing, round(wc.radius, 5)
+    (True, 1.37186)
+    >>> A, H, E = ctrl.closed_loop(), unc.H, unc.EF + unc.EG @ ctrl.K
+    >>> grid = max(abs(np.linalg.eigvals(A + H * d @ E)).max() for d in np.linspace(-1.0, 1.0, 201))
+    >>> bool(np.isclose(wc.radius, grid, rtol=1e-9))
+    True
     """
     import control
 

@@ -119,6 +119,50 @@ def algebraic_uncertainty(source: str = "printed", *, params: truck.TruckParamet
     ``source="computed"`` applies the appendix's rule to the model
     (:func:`robustctl.models.truck.algebraic_uncertainty`, with ``params``).
     Both use the printed ``(log10 mu)^2 = 81``, ``mu = 1e9``.
+
+    Parameters
+    ----------
+    source : {"printed", "computed"}
+        The paper's printed values, or the rule of its Appendix A applied to the model.
+    params : TruckParameters, optional
+        The model's parameters for ``"computed"`` (default the paper's).
+
+    Returns
+    -------
+    AlgebraicUncertainty
+        ``H``, ``EF``, ``EG``, ``mu`` and ``source``.
+
+    Raises
+    ------
+    ValueError, TypeError
+        An unknown ``source``.
+
+    See Also
+    --------
+    robustctl.models.truck.algebraic_uncertainty : the rule on the model.
+
+    References
+    ----------
+    .. [1] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022,
+       Section 4.5 and Appendix A.
+
+    Examples
+    --------
+    The printed ``EF[3]`` is not zero, while the model's lateral velocity
+    does not depend on ``theta`` (column 4 of row 1 of ``F`` is the same
+    at every payload [1]_):
+
+    >>> import numpy as np
+    >>> from robustctl.models import morais2022, truck
+    >>> printed = morais2022.algebraic_uncertainty()
+    >>> computed = morais2022.algebraic_uncertainty("computed")
+    >>> printed.mu, float(printed.EF[0, 3]), float(computed.EF[0, 3])
+    (1000000000.0, -0.0066666, 0.0)
+    >>> F = truck.discretise([0.0, 100.0])[0]
+    >>> bool(F[0, 0, 3] == F[1, 0, 3] == 0.0)
+    True
     """
     check_choice(source, "source", ("printed", "computed"))
     mu = 10.0 ** np.sqrt(PRINTED_LOG10_MU_SQ)
@@ -140,10 +184,32 @@ def uncertainty_from_z(z) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Returns
     -------
     EF : (B, 1, 4) ndarray
+        ``z[:4]``.
     EG : (B, 1, 2) ndarray
+        ``z[4:6]``.
     mu : (B,) ndarray
-        With ``H = ones((4, 1))`` they define the RLQR design on the
-        doubled-column plant (``truck_plant(doubled=True)``). A single z gives B = 1.
+        ``10**sqrt(z[6])``. With ``H = ones((4, 1))`` they define the RLQR
+        design on the doubled-column plant (``truck_plant(doubled=True)``).
+        A single z gives B = 1.
+
+    Raises
+    ------
+    ValueError
+        Not 7 entries per vector, non-finite entries, ``z[6] < 0``.
+    TypeError
+        A string or other non-numeric input.
+
+    Examples
+    --------
+    The paper's ``z*`` of RLQR^MOP:
+
+    >>> import math
+    >>> from robustctl.models.morais2022 import RLQR_MOP_Z, uncertainty_from_z
+    >>> EF, EG, mu = uncertainty_from_z(RLQR_MOP_Z)
+    >>> EF.shape, EG.shape, EG.ravel().tolist()
+    ((1, 1, 4), (1, 1, 2), [48.05012, 44.98551])
+    >>> bool(math.isclose(mu[0], 10 ** math.sqrt(280.28421)))
+    True
     """
     Z = np.asarray(z, dtype=float) if not isinstance(z, (str, bytes)) else None
     if Z is None:
@@ -226,17 +292,44 @@ def authors_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
     ``alpha`` is ``u1 = u2 = alpha/2`` at a cost ``67070 alpha^2 / 2`` (the rule
     of :func:`robustctl.models.truck.lqr_weights`).
 
+    Parameters
+    ----------
+    doubled : bool
+        Weights for the doubled steering column (two inputs).
+
     Returns
     -------
     Q : (4, 4) ndarray
+        ``diag(1, 1, 25000, 100)``.
     R : (1, 1) or (2, 2) ndarray
+        ``[[33535]]``, or ``67070 I2`` for the doubled column.
+
+    References
+    ----------
+    .. [1] F. M. Barbosa, L. B. Marcos, M. M. da Silva, M. H. Terra,
+       V. Grassi Jr, "Robust path-following control for articulated
+       heavy-duty vehicles", Control Engineering Practice 85, 246-256, 2019,
+       and its code, https://github.com/barbosafilipe/robust_lqr.
+
+    Examples
+    --------
+    The even split ``u1 = u2 = alpha / 2`` of the doubled column costs what
+    ``alpha`` costs on the plain truck [1]_:
+
+    >>> import numpy as np
+    >>> from robustctl.models.morais2022 import authors_weights
+    >>> Q, R2 = authors_weights(doubled=True)
+    >>> _, R1 = authors_weights()
+    >>> half = np.array([0.5, 0.5])
+    >>> bool(np.isclose(half @ R2 @ half, R1[0, 0])), np.diag(Q).tolist()
+    (True, [1.0, 1.0, 25000.0, 100.0])
     """
     Q = np.diag(AUTHORS_Q_DIAG)
     return Q, (AUTHORS_R_DOUBLED * np.eye(2) if doubled else np.array([[AUTHORS_R_DOUBLED / 2.0]]))
 
 
 def code_manoeuvre(*, params: truck.TruckParameters | None = None) -> ReferencePath:
-    """The reference manoeuvre of the authors' code, as a path: 30 s with two sine lane changes.
+    r"""The reference manoeuvre of the authors' code, as a path: 30 s with two sine lane changes.
 
     ``standard_formulation/parameters.m`` of Barbosa et al. (2019)'s code
     (GitHub ``barbosafilipe/robust_lqr``) drives the nominal vehicle open
@@ -250,6 +343,47 @@ def code_manoeuvre(*, params: truck.TruckParameters | None = None) -> ReferenceP
     (``L = 5 v``), so the ``"open_loop"`` reference of the ``"authors"``
     set-up (:data:`SETUPS`) along it is the code's ``x_ref`` (at our 0.1 s
     sampling, ZOH model).
+
+    Parameters
+    ----------
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
+
+    Returns
+    -------
+    ReferencePath
+        30 s at the model's speed and sampling time.
+
+    Notes
+    -----
+    The code's command is
+
+    .. math::
+
+        u(t) = 0.01 \sin(0.4 \pi (t - 10)) \text{ on } [10, 15) \text{ s},
+        \qquad -0.01 \sin(0.4 \pi (t - 20)) \text{ on } [20, 25) \text{ s},
+
+    zero elsewhere, and :class:`~robustctl.models.path.LaneChange` has the
+    curvature ``offset (2 pi / L^2) sin(2 pi s / L)``, so with ``s = v t``
+    and ``L = 5 v`` the offset above gives ``alpha_per_kappa kappa = u``.
+
+    Examples
+    --------
+    The steady-cornering steering along the path is the code's command,
+    sample by sample (``kappa[k]`` is the mean over the sample, so the
+    command is compared at mid-sample):
+
+    >>> import numpy as np
+    >>> from robustctl.models import morais2022, truck
+    >>> path = morais2022.code_manoeuvre()
+    >>> path.T, path.duration
+    (300, 30.0)
+    >>> _, alpha_per_kappa = truck.steady_state_cornering(0.0)
+    >>> t = path.t + path.dt / 2
+    >>> u = np.where((t >= 10) & (t < 15), 0.01 * np.sin(0.4 * np.pi * (t - 10)), 0.0)
+    >>> u -= np.where((t >= 20) & (t < 25), 0.01 * np.sin(0.4 * np.pi * (t - 20)), 0.0)
+    >>> bool(np.abs(alpha_per_kappa * path.kappa - u).max() < 1e-5)
+    True
     """
     p = truck._params(params)
     _, a_per_kappa = truck.steady_state_cornering(0.0, params=p)
@@ -272,7 +406,38 @@ SETUPS = {
 
 
 def get_setup(setup: str | PathFollowingSetup) -> PathFollowingSetup:
-    """A :class:`~robustctl.models.pathfollow.PathFollowingSetup` by name (a key of :data:`SETUPS`), or ``setup``."""
+    """A :class:`~robustctl.models.pathfollow.PathFollowingSetup` by name (a key of :data:`SETUPS`), or ``setup``.
+
+    Parameters
+    ----------
+    setup : str or PathFollowingSetup
+        ``"ours"`` or ``"authors"`` (module docstring), or a set-up, returned as it is.
+
+    Returns
+    -------
+    PathFollowingSetup
+
+    Raises
+    ------
+    TypeError
+        Neither a string nor a set-up.
+    ValueError
+        An unknown name.
+
+    Examples
+    --------
+    The ``"authors"`` set-up carries the weights of the authors' code:
+
+    >>> import numpy as np
+    >>> from robustctl.models.morais2022 import authors_weights, get_setup
+    >>> setup = get_setup("authors")
+    >>> setup.reference, setup.feedforward, setup.x0
+    ('open_loop', False, (0.0, 0.0, 0.3, -0.1))
+    >>> Q, R = setup.weights(doubled=True)
+    >>> Q_ref, R_ref = authors_weights(doubled=True)
+    >>> bool(np.allclose(Q, Q_ref) and np.allclose(R, R_ref))
+    True
+    """
     if isinstance(setup, PathFollowingSetup):
         return setup
     if not isinstance(setup, str):

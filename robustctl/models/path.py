@@ -39,7 +39,29 @@ _FINE = 16  # integration sub-steps per sample
 # -- road elements ------------------------------------------------------------
 @dataclass(frozen=True)
 class Straight:
-    """A straight of ``length`` metres."""
+    """A straight of ``length`` metres (a road element of :meth:`ReferencePath.from_segments`).
+
+    Parameters
+    ----------
+    length : float
+        Length [m], positive.
+
+    Raises
+    ------
+    ValueError, TypeError
+        A length that is not a positive number.
+
+    See Also
+    --------
+    Curve, LaneChange : the other road elements.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.models.path import Straight
+    >>> Straight(100.0).curvature(np.array([0.0, 50.0])).tolist()
+    [0.0, 0.0]
+    """
 
     length: float
 
@@ -47,19 +69,78 @@ class Straight:
         check_positive_scalar(self.length, "Straight.length")
 
     def curvature(self, s: np.ndarray) -> np.ndarray:
-        """Curvature [1/m] at arc lengths ``s`` [m] from the element's start: zero."""
+        """Curvature [1/m] at arc lengths ``s`` [m] from the element's start: zero.
+
+        Parameters
+        ----------
+        s : ndarray
+            Arc lengths from the element's start [m].
+
+        Returns
+        -------
+        ndarray
+            Zeros of the shape of ``s``.
+        """
         return np.zeros_like(s)
 
 
 @dataclass(frozen=True)
 class Curve:
-    """A circular arc of ``radius`` [m] turning by ``angle`` [deg] (positive = left).
+    r"""A circular arc of ``radius`` [m] turning by ``angle`` [deg] (positive = left).
 
     The curvature ramps linearly from 0 to ``±1/radius`` over ``transition``
-    metres (a clothoid, as in road design), stays constant, and ramps back over
+    metres (a clothoid, as in road design [1]_), stays constant, and ramps back over
     another ``transition`` metres. The heading turns by exactly ``angle``; the
     element's length is ``|angle| radius + transition`` (needs
     ``|angle| radius >= transition``).
+
+    Parameters
+    ----------
+    radius : float
+        Radius of the arc [m], positive.
+    angle : float
+        Heading change [deg], non-zero; positive turns left.
+    transition : float
+        Length of each clothoid ramp [m], ``>= 0``.
+
+    Raises
+    ------
+    ValueError
+        A non-positive radius, a zero or non-finite angle, a negative
+        transition or one longer than the turn.
+
+    See Also
+    --------
+    Straight, LaneChange : the other road elements.
+
+    Notes
+    -----
+    With ``k = sign(angle) / radius``, ``L`` the length and ``L_t`` the
+    transition, the curvature at ``s`` is
+
+    .. math::
+
+        \kappa(s) = k\, \min\left(1, \frac{\min(s, L - s)}{L_t}\right),
+        \qquad \int_0^L \kappa(s)\, ds = k\,(L - L_t) = \text{angle} .
+
+    References
+    ----------
+    .. [1] American Association of State Highway and Transportation
+       Officials, *A Policy on Geometric Design of Highways and Streets*,
+       7th ed., AASHTO 2018 (transition curves).
+
+    Examples
+    --------
+    The curvature integrates to the heading change:
+
+    >>> import numpy as np
+    >>> from robustctl.models.path import Curve
+    >>> bend = Curve(radius=400.0, angle=90.0, transition=80.0)
+    >>> round(float(bend.length), 3)
+    708.319
+    >>> s = np.linspace(0.0, bend.length, 100001)
+    >>> bool(np.isclose(np.trapezoid(bend.curvature(s), s), np.radians(90.0), rtol=1e-8))
+    True
     """
 
     radius: float
@@ -82,7 +163,18 @@ class Curve:
         return abs(np.radians(self.angle)) * self.radius + self.transition
 
     def curvature(self, s: np.ndarray) -> np.ndarray:
-        """Curvature [1/m] at arc lengths ``s`` [m] from the element's start (the arc between two clothoid ramps)."""
+        """Curvature [1/m] at arc lengths ``s`` [m] from the element's start (the arc between two clothoid ramps).
+
+        Parameters
+        ----------
+        s : ndarray
+            Arc lengths from the element's start [m].
+
+        Returns
+        -------
+        ndarray
+            The curvature, of the shape of ``s``.
+        """
         k = np.sign(self.angle) / self.radius
         L, Lt = self.length, self.transition
         if Lt == 0:
@@ -92,12 +184,46 @@ class Curve:
 
 @dataclass(frozen=True)
 class LaneChange:
-    """A lane change by ``offset`` metres (positive = to the left) over ``length`` metres.
+    r"""A lane change by ``offset`` metres (positive = to the left) over ``length`` metres.
 
-    Lateral offset ``y(s) = offset (s/L - sin(2 pi s/L) / (2 pi))`` (zero
-    heading and curvature at both ends); curvature
-    ``kappa(s) = offset (2 pi / L^2) sin(2 pi s / L)`` (small-angle form, so the
-    achieved offset equals ``offset`` to within ``(2 offset/L)^2``).
+    Parameters
+    ----------
+    offset : float
+        Lateral offset [m], non-zero; positive to the left.
+    length : float
+        Length along the road [m], positive.
+
+    Raises
+    ------
+    ValueError
+        A zero or non-finite offset, a length that is not positive.
+
+    See Also
+    --------
+    Straight, Curve : the other road elements.
+
+    Notes
+    -----
+    The lateral offset is the cycloid-like profile (zero heading and
+    curvature at both ends)
+
+    .. math::
+
+        y(s) = \text{offset}\left(\frac{s}{L} - \frac{\sin(2\pi s/L)}{2\pi}\right),
+        \qquad \kappa(s) \approx y''(s) = \text{offset}\,\frac{2\pi}{L^2}\sin\frac{2\pi s}{L},
+
+    in the small-angle form, so the achieved offset equals ``offset`` to
+    within ``(2 offset/L)^2``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.models.path import LaneChange, ReferencePath, Straight
+    >>> path = ReferencePath.from_segments([Straight(50.0), LaneChange(3.5, 150.0), Straight(50.0)])
+    >>> bool(abs(path.Y[-1] - 3.5) < (2 * 3.5 / 150.0) ** 2 * 3.5)     # one lane to the left
+    True
+    >>> bool(abs(path.heading[-1]) < 1e-8)                            # and parallel to the road again
+    True
     """
 
     offset: float
@@ -109,7 +235,18 @@ class LaneChange:
             raise ValueError(f"LaneChange.offset must be finite and non-zero, got {self.offset}")
 
     def curvature(self, s: np.ndarray) -> np.ndarray:
-        """Curvature [1/m] at arc lengths ``s`` [m] from its start: ``offset (2 pi / L^2) sin(2 pi s / L)``."""
+        """Curvature [1/m] at arc lengths ``s`` [m] from its start: ``offset (2 pi / L^2) sin(2 pi s / L)``.
+
+        Parameters
+        ----------
+        s : ndarray
+            Arc lengths from the element's start [m].
+
+        Returns
+        -------
+        ndarray
+            The curvature, of the shape of ``s``.
+        """
         L = self.length
         return self.offset * 2 * np.pi / L**2 * np.sin(2 * np.pi * s / L)
 
@@ -120,7 +257,16 @@ Segment = Straight | Curve | LaneChange
 # -- the path -------------------------------------------------------------------
 @dataclass(frozen=True, eq=False, repr=False)
 class ReferencePath:
-    """A path driven at constant ``speed`` and sampled every ``dt`` seconds.
+    r"""A path driven at constant ``speed`` and sampled every ``dt`` seconds.
+
+    Build one with :meth:`from_segments`, :meth:`from_curvature`,
+    :meth:`from_waypoints` or :meth:`straight`; the constructor takes the
+    sampled arrays as they are.
+
+    Parameters
+    ----------
+    kappa, X, Y, heading, speed, dt, name
+        The attributes below.
 
     Attributes
     ----------
@@ -133,6 +279,39 @@ class ReferencePath:
     dt : float
         [s].
     name : str
+        Shown by ``repr``.
+
+    See Also
+    --------
+    default_route : the route of the paper reproduction.
+    robustctl.models.pathfollow.PathFollowing : the truck along a path.
+
+    Notes
+    -----
+    The pose integrates the curvature along the arc length (module
+    docstring),
+
+    .. math::
+
+        \psi(s) = \psi_0 + \int_0^s \kappa, \qquad
+        X(s) = X_0 + \int_0^s \cos\psi, \qquad Y(s) = Y_0 + \int_0^s \sin\psi,
+
+    and ``kappa[k]`` is the mean curvature over ``[s_k, s_{k+1}]``, so that
+    ``v dt sum_k kappa[k]`` is the heading change.
+
+    Examples
+    --------
+    A straight, a 90-degree left bend of radius 400 m, a straight:
+
+    >>> import numpy as np
+    >>> from robustctl.models.path import Curve, ReferencePath, Straight
+    >>> path = ReferencePath.from_segments([Straight(100.0), Curve(400.0, 90.0, 80.0), Straight(100.0)])
+    >>> path
+    ReferencePath('', T=544, duration=54.4 s, length=907 m, speed=16.6667 m/s, dt=0.1 s, min radius=400 m)
+    >>> bool(np.isclose(path.heading[-1], np.pi / 2))
+    True
+    >>> bool(np.isclose(path.speed * path.dt * path.kappa.sum(), np.pi / 2))
+    True
     """
 
     kappa: np.ndarray
@@ -185,6 +364,34 @@ class ReferencePath:
             Constant forward speed [m/s] and sampling time [s].
         start : (X0, Y0, heading0)
             Start pose [m, m, rad].
+        name : str
+            Shown by ``repr``.
+
+        Returns
+        -------
+        ReferencePath
+            ``T = duration / dt`` samples (rounded down).
+
+        Raises
+        ------
+        ValueError
+            A duration shorter than one sample or missing for a function,
+            a function that does not return finite values of the shape of
+            its argument, too few curvature samples.
+
+        Examples
+        --------
+        A circle of radius 400 m: after ``s`` metres the path is at
+        ``(R sin(s/R), R (1 - cos(s/R)))``:
+
+        >>> import numpy as np
+        >>> from robustctl.models.path import ReferencePath
+        >>> path = ReferencePath.from_curvature(lambda s: np.full_like(s, 1 / 400.0), duration=10.0)
+        >>> theta = path.heading[-1]
+        >>> bool(np.isclose(theta, path.s[-1] / 400.0))
+        True
+        >>> bool(np.allclose([path.X[-1], path.Y[-1]], [400 * np.sin(theta), 400 * (1 - np.cos(theta))], rtol=1e-7))
+        True
         """
         speed = check_positive_scalar(speed, "speed")
         dt = check_positive_scalar(dt, "dt")
@@ -228,8 +435,38 @@ class ReferencePath:
                       name: str = "") -> ReferencePath:
         """Path from a sequence of road elements (:class:`Straight`, :class:`Curve`, :class:`LaneChange`).
 
-        ``duration`` defaults to the time to drive all elements (rounded down to
-        whole samples); a longer duration continues straight after the last one.
+        Parameters
+        ----------
+        segments : sequence of Straight, Curve or LaneChange
+            The road, in driving order.
+        duration : float, optional
+            Length of the run [s]; default: the time to drive all elements
+            (rounded down to whole samples). A longer duration continues
+            straight after the last one.
+        speed, dt : float
+            Constant forward speed [m/s] and sampling time [s].
+        start : (X0, Y0, heading0)
+            Start pose [m, m, rad].
+        name : str
+            Shown by ``repr``.
+
+        Returns
+        -------
+        ReferencePath
+
+        Raises
+        ------
+        TypeError
+            An element of another type.
+        ValueError
+            No element; see :meth:`from_curvature`.
+
+        Examples
+        --------
+        >>> from robustctl.models.path import ReferencePath, Straight
+        >>> path = ReferencePath.from_segments([Straight(166.667)])
+        >>> path.T, float(path.kappa.max())
+        (100, 0.0)
         """
         segments = list(segments)
         if not segments:
@@ -270,6 +507,35 @@ class ReferencePath:
         ----------
         X, Y : (N,) array_like
             Waypoints [m], N >= 4, distinct consecutive points.
+        speed, dt : float
+            Constant forward speed [m/s] and sampling time [s].
+        duration : float, optional
+            Length of the run [s]; default: the length of the spline.
+        name : str
+            Shown by ``repr``.
+
+        Returns
+        -------
+        ReferencePath
+            Starting at the first waypoint, along the spline's tangent.
+
+        Raises
+        ------
+        ValueError
+            Fewer than 4 waypoints, repeated consecutive points, ``X`` and
+            ``Y`` of different lengths.
+
+        Examples
+        --------
+        Ten points of a quarter circle of radius 400 m give a curvature
+        close to 1/400:
+
+        >>> import numpy as np
+        >>> from robustctl.models.path import ReferencePath
+        >>> angle = np.linspace(0.0, np.pi / 2, 10)
+        >>> path = ReferencePath.from_waypoints(400 * np.cos(angle), 400 * np.sin(angle))
+        >>> bool(abs(np.median(path.kappa) * 400.0 - 1.0) < 1e-2)
+        True
         """
         from scipy.interpolate import CubicSpline
 
@@ -297,12 +563,47 @@ class ReferencePath:
 
     @classmethod
     def straight(cls, duration: float, *, speed: float = DEFAULT_SPEED, dt: float = 0.1) -> ReferencePath:
-        """A straight along the X axis lasting ``duration`` seconds."""
+        """A straight along the X axis lasting ``duration`` seconds.
+
+        Parameters
+        ----------
+        duration : float
+            Length of the run [s].
+        speed, dt : float
+            Constant forward speed [m/s] and sampling time [s].
+
+        Returns
+        -------
+        ReferencePath
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from robustctl.models.path import ReferencePath
+        >>> path = ReferencePath.straight(10.0)
+        >>> path.T, bool(np.allclose(path.X, path.s) and not path.Y.any())
+        (100, True)
+        """
         return cls.from_curvature(np.zeros_like, duration=duration, speed=speed, dt=dt,
                                   name="straight")
 
     def truncated(self, duration: float) -> ReferencePath:
-        """The first ``duration`` seconds of the path (at least one sample)."""
+        """The first ``duration`` seconds of the path (at least one sample).
+
+        Parameters
+        ----------
+        duration : float
+            Length kept [s]; longer than the path keeps all of it.
+
+        Returns
+        -------
+        ReferencePath
+
+        Raises
+        ------
+        ValueError
+            A duration shorter than one sample.
+        """
         T = _n_samples(duration, self.dt)
         T = min(T, self.T)
         return ReferencePath(self.kappa[:T], self.X[:T], self.Y[:T], self.heading[:T],
@@ -365,6 +666,28 @@ def default_route(*, speed: float = DEFAULT_SPEED, dt: float = 0.1,
     elements are in ``DEFAULT_ROUTE``; build your own with
     :meth:`ReferencePath.from_segments`, :meth:`~ReferencePath.from_curvature`
     or :meth:`~ReferencePath.from_waypoints`.
+
+    Parameters
+    ----------
+    speed, dt : float
+        Constant forward speed [m/s] and sampling time [s].
+    duration : float, optional
+        Length of the run [s]; default: the whole route.
+
+    Returns
+    -------
+    ReferencePath
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.models.path import default_route
+    >>> route = default_route()
+    >>> route
+    ReferencePath('default route', T=5406, duration=540.6 s, length=9010 m, ...)
+    >>> v2_over_R = route.speed**2 * np.abs(route.kappa).max()        # lateral acceleration at 60 km/h
+    >>> bool(v2_over_R < 1.4)
+    True
     """
     return ReferencePath.from_segments(DEFAULT_ROUTE, speed=speed, dt=dt, duration=duration,
                                        name="default route")

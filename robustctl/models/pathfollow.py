@@ -76,6 +76,11 @@ DEFAULT_INITIAL_ERROR = (0.0, 0.0, 1.0, 0.0)
 class PathFollowingSetup:
     """How a path-following study is posed: reference, loop, initial state and design weights.
 
+    Parameters
+    ----------
+    name, reference, feedforward, x0, Q_diag, r, source
+        The attributes below.
+
     Attributes
     ----------
     name : str
@@ -101,6 +106,30 @@ class PathFollowingSetup:
         see :func:`robustctl.models.truck.lqr_weights`).
     source : str
         Where the choices come from.
+
+    Raises
+    ------
+    ValueError, TypeError
+        An unknown ``reference``, a non-bool ``feedforward``, ``x0`` or
+        ``Q_diag`` not four finite numbers, a negative weight, ``r <= 0``.
+
+    See Also
+    --------
+    robustctl.models.morais2022.get_setup : the set-ups of the paper's reproduction.
+
+    Examples
+    --------
+    The default set-up uses Bryson's weights of the truck:
+
+    >>> import numpy as np
+    >>> from robustctl.models.pathfollow import DEFAULT_SETUP
+    >>> from robustctl.models.truck import lqr_weights
+    >>> DEFAULT_SETUP.name, DEFAULT_SETUP.reference, DEFAULT_SETUP.x0
+    ('engineering', 'steady', (0.0, 0.0, 1.0, 0.0))
+    >>> Q, R = DEFAULT_SETUP.weights(doubled=True)
+    >>> Q_ref, R_ref = lqr_weights(doubled=True)
+    >>> bool(np.allclose(Q, Q_ref) and np.allclose(R, R_ref))
+    True
     """
 
     name: str
@@ -120,7 +149,20 @@ class PathFollowingSetup:
         check_positive_scalar(self.r, "r")
 
     def weights(self, *, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """``Q`` (4, 4) and ``R``: ``[[r]]``, or ``2 r I2`` on the doubled steering column."""
+        """``Q`` (4, 4) and ``R``: ``[[r]]``, or ``2 r I2`` on the doubled steering column.
+
+        Parameters
+        ----------
+        doubled : bool
+            Weights for the doubled steering column (two inputs).
+
+        Returns
+        -------
+        Q : (4, 4) ndarray
+            ``diag(Q_diag)``.
+        R : (1, 1) or (2, 2) ndarray
+            ``[[r]]``, or ``2 r I2``.
+        """
         Q = np.diag(np.asarray(self.Q_diag, dtype=float))
         return Q, (2.0 * self.r * np.eye(2) if doubled else np.array([[float(self.r)]]))
 
@@ -157,11 +199,43 @@ class PathFollowingResult(SimulationResult):
     (``rho_ref = 0``): in a bend the yaw rate must be ``v kappa``, so its
     regulation error measures the path as much as the controller.
 
+    Parameters
+    ----------
+    path : ReferencePath, optional
+        The path the runs followed.
+    overloads : tuple, optional
+        The scenarios' overloads.
+    **fields
+        The fields of :class:`~robustctl.sim.simulator.SimulationResult`.
+
     Attributes
     ----------
     path : ReferencePath
+        The path the runs followed.
     overloads : tuple
         Scenario overloads in percent (floats, or (T,) arrays when time-varying).
+
+    See Also
+    --------
+    PathFollowing.run : produces it.
+
+    Examples
+    --------
+    On a straight along the X axis the vehicle's global ``Y`` is its
+    lateral displacement ``rho``:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.models import truck
+    >>> from robustctl.models.path import ReferencePath
+    >>> from robustctl.models.pathfollow import simulate
+    >>> K = rc.lqr(truck.truck_plant(0.0), Q=truck.lqr_weights()[0], R=truck.lqr_weights()[1]).K
+    >>> res = simulate(K, ReferencePath.straight(20.0), [0.0, 100.0], backend="numpy")
+    >>> res.objective_names
+    ('rho', 'psidot', 'ydot', 'theta')
+    >>> X, Y, heading = res.pose()
+    >>> bool(np.allclose(Y, res.states[..., 2]) and np.allclose(heading, res.states[..., 3]))
+    True
     """
 
     path: ReferencePath | None = None
@@ -176,6 +250,16 @@ class PathFollowingResult(SimulationResult):
         """Global position ``(X, Y)`` of the reference, each (T,) or (S, T).
 
         The path displaced by ``rho_ref`` along its left normal (the path itself for the ``"steady"`` reference).
+
+        Returns
+        -------
+        X, Y : ndarray
+            (T,), or (S, T) for a reference per scenario.
+
+        Raises
+        ------
+        ValueError
+            The result has no path.
         """
         path = self._path()
         h = path.heading[: self.T]
@@ -205,6 +289,21 @@ class PathFollowingResult(SimulationResult):
         pose of the ``"path"`` method. It differs from ``"path"`` by the
         linearisation of the model (second order in ``theta`` and
         ``kappa rho``), which accumulates along the route.
+
+        Parameters
+        ----------
+        method : {"path", "integrated"}
+            The model's frame, or dead reckoning.
+
+        Returns
+        -------
+        X, Y, heading : (B, S, T) ndarray
+            Global position [m] and heading [rad].
+
+        Raises
+        ------
+        ValueError
+            Trajectories not kept, no path, an unknown ``method``.
         """
         check_choice(method, "method", ("path", "integrated"))
         self._need_trajectories()
@@ -254,7 +353,7 @@ def _scenarios(overloads, T: int) -> tuple:
 
 
 class PathFollowing:
-    """The truck along ``path`` at S payload scenarios, ready to simulate gains (checked once).
+    r"""The truck along ``path`` at S payload scenarios, ready to simulate gains (checked once).
 
     Parameters
     ----------
@@ -282,6 +381,74 @@ class PathFollowing:
         steering column (:data:`robustctl.models.truck.DOUBLED_INPUT_MAP`).
         Gains of several rows need it: without it they are summed, with a
         ``DeprecationWarning`` (the earlier, implicit behaviour).
+
+    Attributes
+    ----------
+    path : ReferencePath
+        The path.
+    overloads : tuple
+        The scenarios' overloads (floats, or (T,) arrays).
+    setup : PathFollowingSetup
+        The set-up.
+
+    Raises
+    ------
+    TypeError
+        ``path`` not a ReferencePath, ``setup`` not a PathFollowingSetup,
+        non-numeric overloads.
+    ValueError
+        A path whose speed or ``dt`` differs from the model's, negative
+        overloads, a time-varying overload of another length than the path.
+
+    See Also
+    --------
+    simulate : the one-call form.
+    robustctl.sim.LinearSimulator : the simulator underneath.
+
+    Notes
+    -----
+    Each scenario ``s`` is the ZOH model of the truck at its overload
+    (:func:`robustctl.models.truck.discretise`) in the loop (module docstring) [1]_
+
+    .. math::
+
+        e_k = x_k - x^{ref}_k, \qquad
+        \alpha_k = \operatorname{sat}_{0.45}\left(M K e_k + \alpha^{ff}_k\right), \qquad
+        x_{k+1} = F_s x_k + G_s \alpha_k + G_{\kappa,s} \kappa_k .
+
+    References
+    ----------
+    .. [1] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022,
+       Section 4.5.
+
+    Examples
+    --------
+    An LQR of the nominal truck on a straight, started 1 m off the path,
+    at the nominal payload and at 100 % overload; without saturation the
+    error is ``(F_s + G_s K)^k e_0``, written out here:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.models import truck
+    >>> from robustctl.models.path import ReferencePath
+    >>> from robustctl.models.pathfollow import PathFollowing
+    >>> Q, R = truck.lqr_weights()
+    >>> K = rc.lqr(truck.truck_plant(0.0), Q=Q, R=R).K
+    >>> runs = PathFollowing(ReferencePath.straight(20.0), [0.0, 100.0])
+    >>> runs
+    PathFollowing(path='straight', setup='engineering', S=2, T=200, input_map=default)
+    >>> res = runs.run(K, backend="numpy")
+    >>> bool(np.abs(res.steering).max() < truck.STEER_LIMIT)          # never saturated
+    True
+    >>> plant = truck.truck_plant(100.0)
+    >>> e, squares = np.array([0.0, 0.0, 1.0, 0.0]), np.zeros(4)
+    >>> for _ in range(runs.T):
+    ...     squares += e * e
+    ...     e = (plant.F + plant.G @ K) @ e
+    >>> bool(np.allclose(res.state_mse()[0, 1], squares / runs.T))
+    True
     """
 
     def __init__(self, path: ReferencePath, overloads=0.0, *, setup: PathFollowingSetup = DEFAULT_SETUP,
@@ -379,6 +546,17 @@ class PathFollowing:
         PathFollowingResult
             ``errors`` (B, S, T, 4), ``steering`` (B, S, T), ``mse()`` (B, S, 4)
             in the paper's order f1..f4; ``pose()`` for plotting.
+
+        Raises
+        ------
+        ValueError
+            Gains of the wrong shape or with non-finite entries (unless
+            ``nan_gains="flag"``), ``K_input`` with an input map.
+
+        Warns
+        -----
+        DeprecationWarning
+            Gains of several rows without an ``input_map`` (summed).
         """
         if K_input is not None:
             return self._run_with_memory(K, K_input, keep_trajectories, nan_gains, backend)
@@ -420,6 +598,11 @@ class PathFollowing:
         -------
         PathFollowingResult
             As :meth:`run`, B = ``len(laws)``.
+
+        Raises
+        ------
+        TypeError
+            ``laws`` empty or not all :class:`~robustctl.InputMemoryFeedback`.
         """
         laws = list(laws)
         if not laws or not all(isinstance(law, InputMemoryFeedback) for law in laws):
@@ -487,12 +670,74 @@ def simulate(K, path: ReferencePath, overloads=0.0, *, setup: PathFollowingSetup
     ``[[1, 1]]`` for the doubled steering column); without it the rows are
     summed with a ``DeprecationWarning``.
 
+    Parameters
+    ----------
+    K : (m, 4) or (B, m, 4) array_like
+        Gains, ``u = K e``.
+    path : ReferencePath
+        The path (speed and ``dt`` of the model).
+    overloads : float, or sequence of S floats / (T,) arrays
+        Payload overload of each scenario in percent.
+    setup : PathFollowingSetup
+        Reference, loop and initial state (default :data:`DEFAULT_SETUP`).
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
+    nominal_overload : float
+        Overload of the model the reference is computed on.
+    steer_limit : float or None
+        Steering saturation [rad]; None for none.
+    feedforward : bool, optional
+        Add the reference's steering command (default: the set-up's).
+    x0 : (4,) or (S, 4) array_like, optional
+        Initial error (default: the set-up's).
+    bound : float
+        Divergence bound.
+    keep_trajectories : bool
+        False keeps only the MSE sums.
+    nan_gains : {"raise", "flag"}
+        Raise on non-finite gains, or flag them as diverged.
+    input_map : (1, m) array_like, optional
+        How the controller's inputs make the steering angle.
+    K_input : (m, 1) or (B, m, 1) array_like, optional
+        Gain on the previous steering angle (laws with input memory).
+    backend : {"numba", "numpy"}
+        Compiled kernel (default) or the numpy reference.
+
     Returns
     -------
     PathFollowingResult
         ``errors`` (B, S, T, 4), ``steering`` (B, S, T), ``mse()`` (B, S, 4)
         in the paper's order f1..f4 = MSE of rho, psidot, ydot, theta;
         ``pose()`` for plotting.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :class:`PathFollowing` and :meth:`PathFollowing.run`.
+
+    See Also
+    --------
+    PathFollowing : the same with the scenarios built once.
+
+    Examples
+    --------
+    On a path of constant curvature the nominal truck, started on its
+    steady-cornering reference, follows it with no error (the feedforward
+    is the steady-state steering):
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.models import truck
+    >>> from robustctl.models.path import ReferencePath
+    >>> from robustctl.models.pathfollow import simulate
+    >>> Q, R = truck.lqr_weights()
+    >>> K = rc.lqr(truck.truck_plant(0.0), Q=Q, R=R).K
+    >>> circle = ReferencePath.from_curvature(np.full(100, 1 / 300.0))
+    >>> res = simulate(K, circle, 0.0, x0=np.zeros(4), backend="numpy")
+    >>> res.mse().shape
+    (1, 1, 4)
+    >>> bool(np.abs(res.errors).max() < 1e-12)
+    True
     """
     sim = PathFollowing(path, overloads, setup=setup, params=params, nominal_overload=nominal_overload,
                         steer_limit=steer_limit, feedforward=feedforward, x0=x0, bound=bound,

@@ -70,6 +70,7 @@ __all__ = [
 
 #: State names, in the model's order.
 STATE_NAMES = ("ydot", "psidot", "rho", "theta")
+#: Units of the states, in the model's order.
 STATE_UNITS = ("m/s", "rad/s", "m", "rad")
 #: State index of each of the paper's objectives f1..f4: rho, psidot, ydot, theta.
 OBJECTIVE_STATES = (2, 1, 0, 3)
@@ -81,7 +82,14 @@ DOUBLED_INPUT_MAP = ((1.0, 1.0),)
 
 @dataclass(frozen=True)
 class TruckParameters:
-    """Parameters of the single-track truck model (paper's Table "Vehicle parameters values").
+    r"""Parameters of the single-track truck model (paper's Table "Vehicle parameters values").
+
+    The defaults are the paper's values [1]_ (:data:`PAPER_PARAMETERS`).
+
+    Parameters
+    ----------
+    a, b, v, m, payload, J, c1, c2, dt : float
+        The attributes below; each positive (``payload`` may be 0).
 
     Attributes
     ----------
@@ -101,6 +109,42 @@ class TruckParameters:
         Cornering stiffness of the front and rear axle [N/rad].
     dt : float
         Sampling time [s].
+
+    Raises
+    ------
+    ValueError
+        A parameter that is not positive and finite (``payload``: negative).
+
+    See Also
+    --------
+    truck_plant : the discretised model at an overload.
+
+    Notes
+    -----
+    At an overload of ``k`` percent the payload is ``payload (1 + k/100)``,
+    spread like the vehicle's own mass (module docstring):
+
+    .. math::
+
+        m_{total}(k) = m + \text{payload}\,(1 + k/100), \qquad
+        J_{total}(k) = J\, m_{total}(k) / m .
+
+    References
+    ----------
+    .. [1] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022,
+       Table "Vehicle parameters values".
+
+    Examples
+    --------
+    >>> from robustctl.models.truck import PAPER_PARAMETERS as p
+    >>> round(p.wheelbase, 3), float(p.total_mass(100.0))
+    (4.805, 41130.0)
+    >>> bool(p.total_mass(100.0) == p.m + 2 * p.payload)
+    True
+    >>> bool(abs(p.inertia(100.0) / p.total_mass(100.0) - p.J / p.m) < 1e-12)     # same radius of gyration
+    True
     """
 
     a: float = 3.1870
@@ -128,11 +172,31 @@ class TruckParameters:
         return self.a + self.b
 
     def total_mass(self, overload: float = 0.0) -> float:
-        """``m + payload (1 + overload/100)`` [kg]."""
+        """``m + payload (1 + overload/100)`` [kg].
+
+        Parameters
+        ----------
+        overload : float
+            Payload overload in percent (>= 0).
+
+        Returns
+        -------
+        float
+        """
         return self._mass(1.0 + check_overload(overload) / 100.0)
 
     def inertia(self, overload: float = 0.0) -> float:
-        """``J m_total / m`` [kg m^2] (payload with the vehicle's radius of gyration)."""
+        """``J m_total / m`` [kg m^2] (payload with the vehicle's radius of gyration).
+
+        Parameters
+        ----------
+        overload : float
+            Payload overload in percent (>= 0).
+
+        Returns
+        -------
+        float
+        """
         return self._inertia(1.0 + check_overload(overload) / 100.0)
 
     def _mass(self, load):
@@ -146,7 +210,37 @@ PAPER_PARAMETERS = TruckParameters()
 
 
 def check_overload(overload, name: str = "overload") -> float | np.ndarray:
-    """Return ``overload`` (percent, >= 0, finite) as float or float array; raise otherwise."""
+    """Return ``overload`` (percent, >= 0, finite) as float or float array; raise otherwise.
+
+    Parameters
+    ----------
+    overload : float or array_like
+        Payload overload in percent (0 = nominal payload).
+    name : str
+        The argument's name in the messages.
+
+    Returns
+    -------
+    float or ndarray
+        A float for a scalar, a float array otherwise.
+
+    Raises
+    ------
+    TypeError
+        Not a number (a string, a boolean, None).
+    ValueError
+        Negative or non-finite.
+
+    Examples
+    --------
+    >>> from robustctl.models.truck import check_overload
+    >>> check_overload(50), check_overload([0, 100]).tolist()
+    (50.0, [0.0, 100.0])
+    >>> check_overload(-10)
+    Traceback (most recent call last):
+    ...
+    ValueError: overload must be >= 0 percent (0 = nominal payload), got -10
+    """
     if isinstance(overload, (str, bytes)) or overload is None or isinstance(overload, bool):
         raise TypeError(f"{name} must be a number (percent), got {type(overload).__name__}")
     try:
@@ -191,15 +285,65 @@ def _continuous_batch(p: TruckParameters, load: float | np.ndarray):
 
 def continuous_model(overload: float = 0.0, *, params: TruckParameters | None = None
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Continuous-time matrices ``x' = A x + B alpha + E kappa`` at ``overload`` percent.
+    r"""Continuous-time matrices ``x' = A x + B alpha + E kappa`` at ``overload`` percent.
+
+    Parameters
+    ----------
+    overload : float
+        Payload overload in percent (0 = nominal payload).
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
 
     Returns
     -------
     A : (4, 4) ndarray
+        State matrix (Notes).
     B : (4, 1) ndarray
         Steering input column ``[c1/m, a c1/J, 0, 0]^T``.
     E : (4,) ndarray
         Path-curvature input ``[0, 0, 0, -v]^T`` (``kappa`` in 1/m, positive to the left).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A negative or non-numeric overload.
+
+    See Also
+    --------
+    truck_plant : the zero-order hold of this model.
+
+    Notes
+    -----
+    The single-track model of the paper's Eq. 1 [1]_ with its two typos
+    corrected (module docstring), ``m`` and ``J`` at the overload:
+
+    .. math::
+
+        A = \begin{bmatrix}
+        -\frac{c_1 + c_2}{m v} & \frac{b c_2 - a c_1 - m v^2}{m v} & 0 & 0 \\
+        \frac{b c_2 - a c_1}{J v} & -\frac{a^2 c_1 + b^2 c_2}{J v} & 0 & 0 \\
+        1 & 0 & 0 & v \\
+        0 & 1 & 0 & 0 \end{bmatrix}, \qquad
+        B = \begin{bmatrix} c_1 / m \\ a c_1 / J \\ 0 \\ 0 \end{bmatrix}, \qquad
+        E = \begin{bmatrix} 0 \\ 0 \\ 0 \\ -v \end{bmatrix}.
+
+    References
+    ----------
+    .. [1] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022,
+       Eq. 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.models.truck import PAPER_PARAMETERS as p, continuous_model
+    >>> A, B, E = continuous_model(0.0)
+    >>> m, J = p.m + p.payload, p.J * (p.m + p.payload) / p.m
+    >>> bool(np.isclose(A[1, 1], -(p.a**2 * p.c1 + p.b**2 * p.c2) / (J * p.v)))
+    True
+    >>> bool(np.allclose(B[:2, 0], [p.c1 / m, p.a * p.c1 / J]))
+    True
     """
     p = _params(params)
     A, B, E = _continuous_batch(p, 1.0 + check_overload(overload) / 100.0)
@@ -208,7 +352,7 @@ def continuous_model(overload: float = 0.0, *, params: TruckParameters | None = 
 
 def truck_plant(overload: float = 0.0, *, params: TruckParameters | None = None,
                 doubled: bool = False) -> Plant:
-    """The truck discretised with zero-order hold at ``params.dt`` (0.1 s).
+    r"""The truck discretised with zero-order hold at ``params.dt`` (0.1 s).
 
     Parameters
     ----------
@@ -231,6 +375,49 @@ def truck_plant(overload: float = 0.0, *, params: TruckParameters | None = None,
         ``c2d`` through :meth:`robustctl.Plant.from_continuous`, which a test
         checks, without importing python-control). The curvature input is
         not part of the plant; see :func:`discretise`.
+
+    Raises
+    ------
+    ValueError, TypeError
+        A negative or non-numeric overload, ``params`` not a TruckParameters.
+
+    See Also
+    --------
+    continuous_model : the continuous-time matrices.
+    discretise : many overloads at once, with the curvature input.
+
+    Notes
+    -----
+    The zero-order hold of ``(A, B)`` of :func:`continuous_model`,
+
+    .. math::
+
+        \exp\left(\begin{bmatrix} A & B \\ 0 & 0 \end{bmatrix} dt\right) =
+        \begin{bmatrix} F & G \\ 0 & I \end{bmatrix},
+
+    for the ZOH model of the paper [1]_ (``dt`` = 0.1 s).
+
+    References
+    ----------
+    .. [1] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022.
+
+    Examples
+    --------
+    The plant is python-control's zero-order hold of the continuous model:
+
+    >>> import numpy as np, control
+    >>> from robustctl.models.truck import continuous_model, truck_plant
+    >>> plant = truck_plant(100.0)
+    >>> plant
+    Plant(n=4, m=1, dt=0.1)
+    >>> A, B, _ = continuous_model(100.0)
+    >>> ref = control.c2d(control.ss(A, B, np.eye(4), 0), 0.1, "zoh")
+    >>> bool(np.allclose(plant.F, ref.A) and np.allclose(plant.G, ref.B))
+    True
+    >>> truck_plant(0.0, doubled=True).G.shape       # alpha = u1 + u2
+    (4, 2)
     """
     p = _params(params)
     F, G, _ = _discrete_batch(p, 1.0 + check_overload(overload) / 100.0)
@@ -256,7 +443,7 @@ def _discrete_batch(p: TruckParameters, load) -> tuple[np.ndarray, np.ndarray, n
 
 def discretise(overloads, *, params: TruckParameters | None = None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """ZOH discretisation at many overloads at once, with the curvature input.
+    r"""ZOH discretisation at many overloads at once, with the curvature input.
 
     ``x[k+1] = F x[k] + G alpha[k] + Gk kappa[k]`` with ``alpha`` and ``kappa``
     held constant over each sample (exact for piecewise-constant signals).
@@ -265,13 +452,49 @@ def discretise(overloads, *, params: TruckParameters | None = None
     ----------
     overloads : float or (k,) array_like
         Overloads in percent (>= 0).
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
 
     Returns
     -------
     F : (k, 4, 4) ndarray
+        State matrices.
     G : (k, 4, 1) ndarray
+        Steering input columns.
     Gk : (k, 4) ndarray
         Discretised curvature input.
+
+    Raises
+    ------
+    ValueError, TypeError
+        Negative or non-numeric overloads, more than one axis.
+
+    See Also
+    --------
+    truck_plant : one overload as a :class:`~robustctl.Plant`.
+
+    Notes
+    -----
+    With ``E`` the curvature input of :func:`continuous_model`,
+
+    .. math::
+
+        \exp\left(\begin{bmatrix} A & B & E \\ 0 & 0 & 0 \\ 0 & 0 & 0 \end{bmatrix} dt\right) =
+        \begin{bmatrix} F & G & G_\kappa \\ 0 & I & 0 \\ 0 & 0 & 1 \end{bmatrix},
+
+    for every overload at once (a stack of matrix exponentials).
+
+    Examples
+    --------
+    >>> import numpy as np, scipy.signal
+    >>> from robustctl.models.truck import continuous_model, discretise
+    >>> F, G, Gk = discretise([0.0, 300.0])
+    >>> F.shape, G.shape, Gk.shape
+    ((2, 4, 4), (2, 4, 1), (2, 4))
+    >>> A, B, E = continuous_model(300.0)
+    >>> Fd, BEd, *_ = scipy.signal.cont2discrete((A, np.c_[B, E], np.eye(4), np.zeros((4, 2))), 0.1)
+    >>> bool(np.allclose(F[1], Fd) and np.allclose(G[1, :, 0], BEd[:, 0]) and np.allclose(Gk[1], BEd[:, 1]))
+    True
     """
     p = _params(params)
     ov = np.atleast_1d(check_overload(overloads, "overloads"))
@@ -282,7 +505,7 @@ def discretise(overloads, *, params: TruckParameters | None = None
 
 def steady_state_cornering(overload: float = 0.0, *, params: TruckParameters | None = None
                            ) -> tuple[np.ndarray, float]:
-    """State and steering per unit curvature in steady cornering on the path.
+    r"""State and steering per unit curvature in steady cornering on the path.
 
     Solves ``A x + B alpha + E kappa = 0`` with ``rho = 0`` for ``kappa = 1``:
     ``psidot = v kappa`` (row 4), ``theta = -ydot / v`` (row 3, the body's
@@ -291,12 +514,48 @@ def steady_state_cornering(overload: float = 0.0, *, params: TruckParameters | N
     ``L kappa`` plus the understeer term). Because ZOH keeps equilibria, this is
     also a fixed point of the discretised model.
 
+    Parameters
+    ----------
+    overload : float
+        Payload overload in percent.
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
+
     Returns
     -------
     x_per_kappa : (4,) ndarray
         ``[ydot, psidot, rho, theta]`` per 1/m of curvature.
     alpha_per_kappa : float
         Steady-state steering angle per 1/m of curvature [rad m].
+
+    Raises
+    ------
+    ValueError, TypeError
+        A negative or non-numeric overload.
+
+    See Also
+    --------
+    reference_states : the reference along a curvature signal.
+
+    Notes
+    -----
+    The equilibrium of :func:`continuous_model` on a path of constant
+    curvature ``kappa = 1`` with ``rho = 0``:
+
+    .. math::
+
+        A x + B \alpha + E = 0, \qquad \dot\psi = v, \quad \theta = -\dot y / v .
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.models.truck import continuous_model, steady_state_cornering
+    >>> x, alpha = steady_state_cornering(0.0)
+    >>> A, B, E = continuous_model(0.0)
+    >>> bool(np.allclose(A @ x + B[:, 0] * alpha + E, 0.0, atol=1e-12))
+    True
+    >>> alpha > 4.805          # more than the Ackermann angle (wheelbase * kappa): the truck understeers
+    True
     """
     A, B, _ = continuous_model(overload, params=params)
     v = _params(params).v
@@ -320,11 +579,38 @@ def reference_states(kappa, overload: float = 0.0, *, params: TruckParameters | 
     ----------
     kappa : (T,) array_like
         Path curvature at each sample [1/m].
+    overload : float
+        Payload of the model the reference is computed on, in percent.
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
 
     Returns
     -------
     x_ref : (T, 4) ndarray
+        Reference states, ``x_per_kappa kappa[k]``.
     alpha_ff : (T,) ndarray
+        Steering feedforward [rad], ``alpha_per_kappa kappa[k]``.
+
+    Raises
+    ------
+    ValueError, TypeError
+        ``kappa`` not a finite 1-D array, a bad overload.
+
+    See Also
+    --------
+    open_loop_reference : the reference of the authors' code.
+
+    Examples
+    --------
+    On a constant curvature the reference is a fixed point of the
+    discretised model driven by its feedforward (ZOH keeps equilibria):
+
+    >>> import numpy as np
+    >>> from robustctl.models.truck import discretise, reference_states
+    >>> x_ref, alpha_ff = reference_states([0.002, 0.002])
+    >>> F, G, Gk = discretise(0.0)
+    >>> bool(np.allclose(F[0] @ x_ref[1] + G[0, :, 0] * alpha_ff[1] + Gk[0] * 0.002, x_ref[1]))
+    True
     """
     kappa = as_batch(kappa, "kappa", (None,))
     xk, ak = steady_state_cornering(overload, params=params)
@@ -333,9 +619,9 @@ def reference_states(kappa, overload: float = 0.0, *, params: TruckParameters | 
 
 def open_loop_reference(kappa, overload: float = 0.0, *, params: TruckParameters | None = None
                         ) -> tuple[np.ndarray, np.ndarray]:
-    """The truck at ``overload`` driven open loop by its steady-cornering steering along a path.
+    r"""The truck at ``overload`` driven open loop by its steady-cornering steering along a path.
 
-    The reference of the authors' published code (Barbosa et al. 2019, GitHub
+    The reference of the authors' published code (Barbosa et al. 2019 [1]_, GitHub
     ``barbosafilipe/robust_lqr``, ``standard_formulation/parameters.m``): the
     nominal vehicle, started at rest on the path, is driven by a smooth
     steering command ``u_ref`` and its simulated states are the reference
@@ -362,12 +648,48 @@ def open_loop_reference(kappa, overload: float = 0.0, *, params: TruckParameters
     overload : float
         Payload of the reference vehicle (the controller's nominal model).
 
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
+
     Returns
     -------
     x_ref : (T, 4) ndarray
         States ``[ydot, psidot, rho, theta]`` of the open-loop vehicle.
     u_ref : (T,) ndarray
         The steering command [rad].
+
+    Raises
+    ------
+    ValueError, TypeError
+        ``kappa`` not a finite 1-D array, a bad overload.
+
+    See Also
+    --------
+    reference_states : the steady-cornering reference.
+    robustctl.models.morais2022.code_manoeuvre : the manoeuvre of the authors' code.
+
+    References
+    ----------
+    .. [1] F. M. Barbosa, L. B. Marcos, M. M. da Silva, M. H. Terra,
+       V. Grassi Jr, "Robust path-following control for articulated
+       heavy-duty vehicles", Control Engineering Practice 85, 246-256, 2019,
+       and its code, https://github.com/barbosafilipe/robust_lqr.
+
+    Examples
+    --------
+    A straight then a constant bend; the reference obeys the recursion of
+    the ZOH model, written out here:
+
+    >>> import numpy as np
+    >>> from robustctl.models.truck import discretise, open_loop_reference
+    >>> kappa = np.r_[np.zeros(5), np.full(20, 0.002)]
+    >>> x_ref, u_ref = open_loop_reference(kappa)
+    >>> F, G, Gk = discretise(0.0)
+    >>> x = np.zeros(4)
+    >>> for k in range(24):
+    ...     x = F[0] @ x + G[0, :, 0] * u_ref[k] + Gk[0] * kappa[k]
+    >>> bool(np.allclose(x, x_ref[-1]))
+    True
     """
     kappa = as_batch(kappa, "kappa", (None,))
     _, a_per_kappa = steady_state_cornering(overload, params=params)
@@ -384,18 +706,42 @@ def open_loop_reference(kappa, overload: float = 0.0, *, params: TruckParameters
 class AlgebraicUncertainty:
     """Norm-bounded uncertainty of the RLQR^A design (paper's Appendix A).
 
+    Parameters
+    ----------
+    H, EF, EG, mu, source
+        The attributes below.
+
     Attributes
     ----------
     H : (4, 1) ndarray
+        Input matrix of the uncertainty.
     EF : (1, 4) ndarray
+        State part.
     EG : (1, 2) ndarray
-        For the doubled steering column.
+        Input part, for the doubled steering column.
     mu : float
         Penalty parameter (the appendix's ``(log10 mu)^2 = 81``, i.e. ``mu = 1e9``).
     source : str
         ``"computed"`` (from the model, :func:`algebraic_uncertainty`) or
         ``"printed"`` (the paper's values,
         :func:`robustctl.models.morais2022.algebraic_uncertainty`).
+
+    See Also
+    --------
+    algebraic_uncertainty : computes it.
+
+    Examples
+    --------
+    Its matrices make a :class:`~robustctl.NormBounded` of the doubled-column plant:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.models.truck import algebraic_uncertainty, truck_plant
+    >>> au = algebraic_uncertainty()
+    >>> unc = rc.NormBounded(au.H, au.EF, au.EG)
+    >>> unc.check_plant(truck_plant(0.0, doubled=True))       # passes: the sizes fit
+    >>> unc
+    NormBounded(n=4, m=2, p=1, l=1)
     """
 
     H: np.ndarray
@@ -411,7 +757,7 @@ class AlgebraicUncertainty:
 
 
 def algebraic_uncertainty(*, mu: float = 1e9, params: TruckParameters | None = None) -> AlgebraicUncertainty:
-    """``H``, ``EF``, ``EG`` of RLQR^A computed from the model by the rule of the paper's Appendix A.
+    r"""``H``, ``EF``, ``EG`` of RLQR^A computed from the model by the rule of the paper's Appendix A.
 
     With ``F_min, G_min`` the discretised model of the unloaded vehicle (mass
     ``m``) and ``F_max, G_max`` that at 100 % overload (``m + 2 payload``),
@@ -436,6 +782,42 @@ def algebraic_uncertainty(*, mu: float = 1e9, params: TruckParameters | None = N
     AlgebraicUncertainty
         ``source = "computed"``. The values the paper prints instead are
         :func:`robustctl.models.morais2022.algebraic_uncertainty`.
+
+    Raises
+    ------
+    ValueError, TypeError
+        ``mu`` not a positive number, ``params`` not a TruckParameters.
+
+    Notes
+    -----
+    With the unloaded (``min``) and the 100 %-overloaded (``max``) ZOH
+    models [1]_:
+
+    .. math::
+
+        E_F = [1, 1, 1, 0.1] \circ (F_{min} - F_{max})_{1,:}, \qquad
+        E_G = 0.1\, (G_{min} - G_{max})_{1} [1, 1], \qquad H = [1, 1, 1, 1]^T .
+
+    References
+    ----------
+    .. [1] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022,
+       Appendix A.
+
+    Examples
+    --------
+    The rule applied here by hand to the unloaded truck (no payload) and
+    the truck at 100 % overload:
+
+    >>> import numpy as np
+    >>> from robustctl.models.truck import TruckParameters, algebraic_uncertainty, truck_plant
+    >>> au = algebraic_uncertainty()
+    >>> unloaded, heavy = truck_plant(0.0, params=TruckParameters(payload=0.0)), truck_plant(100.0)
+    >>> bool(np.allclose(au.EF[0], [1.0, 1.0, 1.0, 0.1] * (unloaded.F - heavy.F)[0]))
+    True
+    >>> bool(np.allclose(au.EG[0], 0.1 * (unloaded.G - heavy.G)[0, 0]))
+    True
     """
     mu = check_positive_scalar(mu, "mu")
     p = _params(params)
@@ -455,7 +837,7 @@ MAX_STEER = 0.1
 
 
 def lqr_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Bryson's-rule weights used for every truck design (LQR, RLQR, H-infinity).
+    r"""Bryson's-rule weights used for every truck design (LQR, RLQR, H-infinity).
 
     ``Q = diag(1 / MAX_ERRORS^2)``, ``R = 1 / MAX_STEER^2``: each state or the
     steering costs 1 when it reaches its acceptable value (Bryson & Ho, *Applied
@@ -464,10 +846,46 @@ def lqr_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
     of a steering angle ``alpha`` is ``u1 = u2 = alpha/2`` and costs
     ``2 r (alpha^2/4 + alpha^2/4) = r alpha^2``, the same as on the plain plant.
 
+    Parameters
+    ----------
+    doubled : bool
+        Weights for the doubled steering column (two inputs).
+
     Returns
     -------
     Q : (4, 4) ndarray
+        ``diag(1 / MAX_ERRORS^2)``.
     R : (1, 1) or (2, 2) ndarray
+        ``1 / MAX_STEER^2``, or ``2 / MAX_STEER^2 I_2`` for the doubled column.
+
+    Notes
+    -----
+    Bryson's rule [1]_: each term of the cost is 1 at its acceptable value,
+
+    .. math::
+
+        Q_{ii} = \frac{1}{x_{i,\max}^2}, \qquad R = \frac{1}{\alpha_{\max}^2} .
+
+    References
+    ----------
+    .. [1] A. E. Bryson, Y.-C. Ho, *Applied Optimal Control*, Hemisphere
+       1975, Sec. 5.4.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.models.truck import MAX_ERRORS, MAX_STEER, lqr_weights
+    >>> Q, R = lqr_weights()
+    >>> bool(np.allclose(np.diag(Q) * np.square(MAX_ERRORS), 1.0) and np.isclose(R[0, 0] * MAX_STEER**2, 1.0))
+    True
+
+    On the doubled column the even split ``u1 = u2 = alpha / 2`` costs what
+    ``alpha`` costs on the plain truck:
+
+    >>> _, R2 = lqr_weights(doubled=True)
+    >>> half = np.array([0.5, 0.5])
+    >>> bool(np.isclose(half @ R2 @ half, R[0, 0]))
+    True
     """
     Q = np.diag(1.0 / np.square(MAX_ERRORS))
     r = 1.0 / MAX_STEER**2

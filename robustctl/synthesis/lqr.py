@@ -122,14 +122,45 @@ def _unobservable_on_circle(F, Q) -> np.ndarray:
 def dare(F, G, Q=None, R=None) -> tuple[np.ndarray, str]:
     """Stabilising solution of the DARE: slycot (via python-control) if installed, scipy otherwise or as fallback.
 
-    Returns ``(P, backend)``; raises :class:`ConvergenceError` if neither
-    backend gives a solution with relative residual below 1e-8 (relative to
-    the norms of the equation's terms, see the module docstring) that makes
-    ``F + G K`` Schur stable, e.g. when ``Q`` leaves a mode on the unit circle
-    (an integrator) unweighted; the message says which. A backend that fails,
-    raises, or warns (slycot's ``SlycotResultWarning`` on a badly scaled
-    problem) hands over to the other. The
-    arguments are checked like :func:`lqr`'s (``Q``, ``R`` may be ``None``: identity).
+    A backend that fails, raises, or warns (slycot's ``SlycotResultWarning``
+    on a badly scaled problem) hands over to the other.
+
+    Parameters
+    ----------
+    F : (n, n) array_like
+        State matrix.
+    G : (n, m) array_like
+        Input matrix.
+    Q : (n, n) array_like, optional
+        State weight, symmetric positive semidefinite (default identity).
+    R : (m, m) array_like, optional
+        Input weight, symmetric positive definite (default identity).
+
+    Returns
+    -------
+    P : (n, n) ndarray
+        The stabilising solution.
+    backend : str
+        ``"slycot"`` or ``"scipy"``.
+
+    Raises
+    ------
+    ConvergenceError
+        Neither backend gives a solution with relative residual below 1e-8
+        (relative to the norms of the equation's terms, module docstring)
+        that makes ``F + G K`` Schur stable, e.g. when ``Q`` leaves a mode on
+        the unit circle (an integrator) unweighted; the message says which.
+    ValueError
+        Arguments checked like :func:`lqr`'s.
+
+    Examples
+    --------
+    >>> import numpy as np, scipy.linalg
+    >>> from robustctl.synthesis.lqr import dare
+    >>> F, G = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
+    >>> P, backend = dare(F, G)
+    >>> bool(np.allclose(P, scipy.linalg.solve_discrete_are(F, G, np.eye(2), np.eye(1))))
+    True
     """
     plant = Plant(F, G, 1.0)
     P, backend, _, _ = _dare(plant.F, plant.G, *_weights(plant, Q, R))
@@ -180,14 +211,16 @@ def _dare(F, G, Q, R) -> tuple[np.ndarray, str, np.ndarray, float]:
 
 
 def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
-    """Discrete-time LQR state feedback ``u = K x`` (``K = -control.dlqr(...)[0]``).
+    r"""Discrete-time LQR state feedback ``u = K x`` (``K = -control.dlqr(...)[0]``).
 
     Parameters
     ----------
     plant : Plant
         Discrete-time plant.
-    Q : (n, n) symmetric positive semidefinite, default identity
-    R : (m, m) symmetric positive definite, default identity
+    Q : (n, n) array_like, optional
+        State weight, symmetric positive semidefinite; default identity.
+    R : (m, m) array_like, optional
+        Input weight, symmetric positive definite; default identity.
 
     Returns
     -------
@@ -206,6 +239,38 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
         No backend finds the stabilising solution of the Riccati equation,
         e.g. ``(Q^1/2, F)`` has an unobservable mode on the unit circle (an
         integrator whose state ``Q`` does not weight); the message says why.
+    ValueError
+        A continuous-time plant, weights of the wrong shape or not positive
+        (semi)definite.
+
+    See Also
+    --------
+    robustctl.rlqr : the robust LQR (equal to the LQR without uncertainty).
+    robustctl.synthesis.lqr.dare : the Riccati solution alone.
+
+    Notes
+    -----
+    The gain minimises ``sum_k x_k' Q x_k + u_k' R u_k`` subject to
+    ``x_{k+1} = F x_k + G u_k`` [1]_. With ``P`` the stabilising solution of
+    the discrete algebraic Riccati equation
+
+    .. math::
+
+        P = F^T P F - F^T P G (R + G^T P G)^{-1} G^T P F + Q ,
+
+    the gain is ``K = -(R + G' P G)^-1 G' P F`` and the optimal cost from
+    ``x_0`` is ``x_0' P x_0``. The solution exists iff ``(F, G)`` is
+    stabilisable and ``(Q^1/2, F)`` has no unobservable mode on the unit
+    circle [2]_. It is accepted when its residual, relative to the sum of
+    the norms of the equation's terms (a backward error), is below 1e-8 and
+    ``F + G K`` is Schur stable.
+
+    References
+    ----------
+    .. [1] B. D. O. Anderson, J. B. Moore, *Optimal Control: Linear Quadratic
+       Methods*, Prentice Hall 1990, Ch. 2.
+    .. [2] P. Lancaster, L. Rodman, *Algebraic Riccati Equations*, Oxford
+       1995, Thm 13.1.3.
 
     Examples
     --------
@@ -219,6 +284,13 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     >>> K_pc, _, _ = control.dlqr(plant.F, plant.G, np.diag([1.0, 0.1]), [[0.01]])
     >>> bool(np.allclose(ctrl.K, -K_pc)), ctrl.is_stabilizing()
     (True, True)
+
+    The Riccati equation holds at ``info["P"]``:
+
+    >>> F, G, P = plant.F, plant.G, ctrl.info["P"]
+    >>> res = F.T @ P @ F - F.T @ P @ G @ np.linalg.solve(0.01 + G.T @ P @ G, G.T @ P @ F) + np.diag([1.0, 0.1]) - P
+    >>> bool(np.abs(res).max() < 1e-9 * np.abs(P).max())
+    True
     """
     check_plant(plant, discrete_for="lqr")
     Q, R = _weights(plant, Q, R)

@@ -69,6 +69,26 @@ def lq_output(Q: ArrayLike, R: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     ValueError
         ``Q`` or ``R`` not square, not symmetric or not positive semidefinite.
 
+    See Also
+    --------
+    robustctl.hinf, robustctl.h2 : take the criterion as ``(Cz, Dzu)``.
+
+    Notes
+    -----
+    For every ``x`` and ``u``
+
+    .. math::
+
+        \|C_z x + D_{zu} u\|^2 = x^T Q x + u^T R u ,
+
+    since ``Cz'Cz = Q``, ``Dzu'Dzu = R`` and ``Cz'Dzu = 0``: the LQ cost is
+    the energy (squared 2-norm) of ``z`` [1]_.
+
+    References
+    ----------
+    .. [1] K. Zhou, J. C. Doyle, K. Glover, *Robust and Optimal Control*,
+       Prentice Hall 1996, Sec. 14.1.
+
     Examples
     --------
     >>> import numpy as np
@@ -80,6 +100,15 @@ def lq_output(Q: ArrayLike, R: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
            [0., 0.]])
     >>> Dzu.ravel()
     array([0., 0., 4.])
+
+    A weight with coupling gets its symmetric square root; the energy of
+    ``z`` is the cost:
+
+    >>> Q = np.array([[2.0, 1.0], [1.0, 2.0]])
+    >>> Cz, Dzu = rc.lq_output(Q, [[0.5]])
+    >>> x, u = np.array([0.3, -1.2]), np.array([2.0])
+    >>> bool(np.isclose(np.sum((Cz @ x + Dzu @ u) ** 2), x @ Q @ x + 0.5 * u @ u))
+    True
     """
     Qa = check_spd(as_matrix(Q, "Q"), "Q", semidefinite=True)
     Ra = check_spd(as_matrix(R, "R"), "R", semidefinite=True)

@@ -135,7 +135,16 @@ _FALLBACKS = ("recursion", "newton")
 
 @dataclass(frozen=True, eq=False, repr=False)
 class RLQRBatch:
-    """Steady-state RLQR designs for a batch of ``B`` uncertainty models.
+    """Steady-state RLQR designs for a batch of ``B`` uncertainty models (:func:`rlqr_gains`).
+
+    Design ``b`` is the steady state that ``rlqr`` computes for the ``b``-th
+    uncertainty and penalty, as entries of stacked arrays; a design that
+    fails is flagged in ``ok`` and ``reason``, never raised for the batch.
+
+    Parameters
+    ----------
+    K, P, L, ok, reason, stabilizing, iterations, residual : ndarray
+        The attributes below (built by :func:`rlqr_gains`).
 
     Attributes
     ----------
@@ -148,9 +157,17 @@ class RLQRBatch:
     ok : (B,) bool ndarray
         The design converged to a finite fixed point with ``residual < tol``.
     reason : (B,) str ndarray
-        ``"ok"``, ``"rank"`` (``mu = inf`` and ``EG`` not of full row rank),
-        ``"unstabilizable"`` (the plant is not stabilisable: every design),
-        ``"not converged"`` or ``"diverged"`` (no stabilising steady state).
+        Why a design failed (``"ok"`` where it did not):
+
+        ====================  ==================================================
+        ``reason``            meaning
+        ====================  ==================================================
+        ``"ok"``              converged; see ``stabilizing``
+        ``"rank"``            ``mu = inf`` and ``EG`` is not of full row rank
+        ``"unstabilizable"``  the plant is not stabilisable (every design)
+        ``"not converged"``   no fixed point within ``max_iter`` steps
+        ``"diverged"``        ``P`` grows without bound: no stabilising steady state
+        ====================  ==================================================
     stabilizing : (B,) bool ndarray
         ``F + G K`` is Schur stable (``rho < 1 - 1e-9``, the nominal closed
         loop). For finite ``mu`` the RLQR stabilises its own closed loop
@@ -160,6 +177,29 @@ class RLQRBatch:
         Doubling steps (plus Newton evaluations and recursion steps where they were needed).
     residual : (B,) ndarray
         Relative change of ``P`` in one more recursion step at the returned ``P``.
+
+    See Also
+    --------
+    rlqr_gains : builds it.
+    robustctl.rlqr : one design, as a :class:`~robustctl.Controller`.
+
+    Examples
+    --------
+    Three penalties at once; the first asks for ``EF + EG K = 0`` with a
+    rank-deficient ``EG`` (two rows, one input) and is flagged:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> EF, EG = [[0.1, 0.0], [0.0, 0.1]], [[0.1], [0.2]]
+    >>> batch = rc.rlqr_gains(plant, EF, EG, [np.inf, 1e2, 1e4], H=np.eye(2))
+    >>> batch.reason.tolist(), batch.stabilizing.tolist()
+    (['rank', 'ok', 'ok'], [False, True, True])
+    >>> bool(np.isnan(batch.K[0]).all())
+    True
+    >>> rho = [max(abs(np.linalg.eigvals(plant.F + plant.G @ K))) for K in batch.K[1:]]
+    >>> bool(max(rho) < 1.0)
+    True
     """
 
     K: np.ndarray
@@ -181,14 +221,51 @@ class RLQRBatch:
 
 @dataclass(frozen=True, eq=False, repr=False)
 class RLQRSchedule:
-    """Finite-horizon RLQR: time-varying gains ``u[k] = K[k] x[k]``, ``k = 0..N-1``.
+    """Finite-horizon RLQR: time-varying gains ``u[k] = K[k] x[k]``, ``k = 0..N-1`` (:func:`rlqr_schedule`).
+
+    Parameters
+    ----------
+    K, L, P : ndarray
+        The gains, closed loops and Riccati matrices (attributes below).
+    plant : Plant
+        The nominal plant.
+    info : Mapping, optional
+        Diagnostics.
 
     Attributes
     ----------
-    K : (N, m, n), L : (N, n, n), P : (N + 1, n, n) ndarrays
-        ``P[N]`` is the terminal weight ``P_N``; ``x*[k+1] = L[k] x*[k]``.
+    K : (N, m, n) ndarray
+        Gains, ``u[k] = K[k] x[k]``.
+    L : (N, n, n) ndarray
+        Closed loops of the RLQR, ``x*[k+1] = L[k] x*[k]``.
+    P : (N + 1, n, n) ndarray
+        Riccati matrices; ``P[N]`` is the terminal weight ``P_N``.
     plant : Plant
+        The nominal plant.
     info : Mapping
+        ``"mu"``, ``"alpha"``, ``"lambda"`` and ``"implementation"`` (as in
+        :func:`rlqr`'s table).
+
+    See Also
+    --------
+    rlqr_schedule : builds it.
+
+    Examples
+    --------
+    Far from the end of a long horizon the gains settle at the steady
+    state that :func:`rlqr` finds by doubling:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> H, EF, EG = [[0.0], [0.1]], [[0.1, 0.0]], [[0.1]]
+    >>> schedule = rc.rlqr_schedule(plant, EF, EG, 1e4, H=H, horizon=200)
+    >>> schedule
+    RLQRSchedule(horizon=200, plant=Plant(n=2, m=1, dt=0.1))
+    >>> schedule.K.shape, schedule.P.shape
+    ((200, 1, 2), (201, 2, 2))
+    >>> bool(np.allclose(schedule.K[0], rc.rlqr(plant, EF, EG, 1e4, H=H).K, rtol=1e-8))
+    True
     """
 
     K: np.ndarray
@@ -203,7 +280,18 @@ class RLQRSchedule:
         return self.K.shape[0]
 
     def controller(self, k: int) -> Controller:
-        """The gain of step ``k`` as a :class:`Controller`."""
+        """The gain of step ``k`` as a :class:`Controller`.
+
+        Parameters
+        ----------
+        k : int
+            The step, ``0 <= k < N`` (negative indices count from the end).
+
+        Returns
+        -------
+        Controller
+            ``K[k]``, with ``info`` holding ``step``, ``L`` (``L[k]``) and ``P`` (``P[k]``).
+        """
         return Controller(self.K[k], "rlqr", self.plant, {"step": k, "L": self.L[k], "P": self.P[k]})
 
     def __repr__(self) -> str:
@@ -227,18 +315,23 @@ def _info(d: Model, implementation: str) -> dict:
 def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None,
                alpha: float = DEFAULT_ALPHA, uncertainty=None, tol: float = DEFAULT_TOL,
                max_iter: int = DEFAULT_MAX_ITER, P_N=None, fallback: str = "recursion") -> RLQRBatch:
-    """Steady-state RLQR gains for ``B`` uncertainty models at once (vectorised).
+    r"""Steady-state RLQR gains for ``B`` uncertainty models at once (vectorised).
 
     Parameters
     ----------
     plant : Plant
         Nominal discrete-time plant (shared by the batch).
     EF : (B, l, n) array_like
+        State part of each design's uncertainty.
     EG : (B, l, m) array_like
+        Input part of each design's uncertainty.
     mu : (B,) array_like
         Penalty parameters in ``[1e-100, inf]``; ``np.inf`` gives the limit form.
         Any of ``EF``, ``EG``, ``mu`` may omit the batch axis to be shared.
-    Q, R : weights (defaults identity)
+    Q : (n, n) array_like, optional
+        State weight, symmetric positive semidefinite (default identity).
+    R : (m, m) array_like, optional
+        Input weight, symmetric positive definite (default identity).
     H : (n, p) array_like, default ``ones((n, l))``
         Same default as :func:`rlqr` (every row of ``Delta [EF EG]`` perturbs
         every state equally); give it explicitly unless that is the
@@ -248,10 +341,11 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
         ``lambda = (1 + alpha) ||mu H'H||``.
     uncertainty : NormBounded, optional
         ``H``, ``EF``, ``EG`` of one uncertainty model, instead of the three arguments.
-    tol, max_iter :
+    tol : float
         Acceptance: one more recursion step changes ``P`` by less than ``tol``
-        (relative) and ``rho(L) < 1 - 1e-9``; at most ``max_iter`` steps of
-        the plain recursion where it is needed.
+        (relative) and ``rho(L) < 1 - 1e-9``.
+    max_iter : int
+        At most this many steps of the plain recursion where it is needed.
     P_N : (n, n) array_like, optional
         Starting point of the plain recursion where it is needed (default
         ``Q``; the steady state does not depend on it). The same name as in
@@ -279,10 +373,54 @@ def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=Non
         NaN: check ``ok``/``reason``. A plant that is not stabilisable flags
         every design ``"unstabilizable"`` (:func:`rlqr` raises instead).
 
+    Raises
+    ------
+    TypeError
+        ``plant`` is not a Plant; a non-numeric argument.
+    ValueError
+        Shapes that do not agree (named), ``mu`` outside ``[1e-100, inf]``,
+        weights that are not symmetric positive (semi)definite, an unknown
+        ``fallback``. Designs that cannot be computed are flagged, not raised.
+
+    See Also
+    --------
+    rlqr : one design, with its errors raised.
+    RLQRBatch : the result.
+
     Notes
     -----
-    All designs are solved together with stacked ``(B, k, k)`` solves by
-    doubling (package docstring); no Python loop over designs.
+    Every design is the fixed point ``P = f(P)`` of the recursion of
+    :func:`rlqr` (its Notes), found for all designs together with stacked
+    ``(B, k, k)`` solves by the structure-preserving doubling algorithm
+    [1]_ on the equivalent Riccati equation (module docstring); no Python
+    loop over designs. The fixed point is accepted when
+
+    .. math::
+
+        \frac{\|f(P) - P\|_F}{\|P\|_F} < \mathrm{tol}
+        \quad\text{and}\quad \rho(L) < 1 - 10^{-9}.
+
+    References
+    ----------
+    .. [1] E. K.-W. Chu, H.-Y. Fan, W.-W. Lin, "A structure-preserving
+       doubling algorithm for continuous-time algebraic Riccati equations",
+       Linear Algebra Appl. 396, 55-80, 2005.
+
+    Examples
+    --------
+    Three penalties at once; each gain is a fixed point of the paper's block
+    recursion (:func:`rlqr_step_block`, an independent implementation):
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> H, EF, EG = [[0.0], [0.1]], [[0.0, 0.0]], [[0.3]]
+    >>> batch = rc.rlqr_gains(plant, EF, EG, [1e2, 1e4, 1e6], H=H)
+    >>> batch.ok.tolist(), batch.stabilizing.tolist()
+    ([True, True, True], [True, True, True])
+    >>> _, K, P = rc.rlqr_step_block(batch.P[1], plant.F, plant.G, EF, EG, np.eye(2), np.eye(1), H, 1e4)
+    >>> bool(np.allclose(P, batch.P[1], rtol=1e-8) and np.allclose(K, batch.K[1], rtol=1e-6))
+    True
     """
     d = build(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, uncertainty=uncertainty, batch=True)
     tol = check_positive_scalar(tol, "tol")
@@ -313,21 +451,26 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
          uncertainty=None, P_N=None, tol: float = DEFAULT_TOL, max_iter: int = DEFAULT_MAX_ITER,
          accelerate: bool = True, implementation: str = "kkt", fallback: str = "recursion",
          check_stability: bool = True) -> Controller:
-    """Steady-state robust LQR for ``[dF dG] = H Delta [EF EG]``, ``||Delta|| <= 1`` (paper Theorem 1).
+    r"""Steady-state robust LQR for ``[dF dG] = H Delta [EF EG]``, ``||Delta|| <= 1`` (paper Theorem 1).
 
     Parameters
     ----------
     plant : Plant
         Nominal discrete-time plant ``(F, G)``.
     EF : (l, n) array_like
+        State part of the uncertainty.
     EG : (l, m) array_like
+        Input part of the uncertainty.
     mu : float
         Penalty parameter in ``[1e-100, inf]``; ``np.inf`` gives Algorithm 1 (``Sigma = 0``),
         which forces ``EF + EG K = 0`` and ``L = F + G K`` and needs ``EG`` of
         full row rank.
-    Q : (n, n) symmetric PSD, default identity (PD for ``implementation="block"``)
-    R : (m, m) symmetric PD, default identity
-    H : (n, p), default ``ones((n, l))``
+    Q : (n, n) array_like, optional
+        State weight, symmetric positive semidefinite (positive definite for
+        ``implementation="block"``); default identity.
+    R : (m, m) array_like, optional
+        Input weight, symmetric positive definite; default identity.
+    H : (n, p) array_like, default ``ones((n, l))``
         ``[dF dG] = H Delta [EF EG]``. Without ``H`` every row of
         ``Delta [EF EG]`` perturbs every state equally (``H`` all ones, the
         paper's choice for its examples), which is rarely the uncertainty
@@ -339,12 +482,13 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     uncertainty : NormBounded, optional
         ``H``, ``EF``, ``EG`` in one object, instead of the three arguments
         (``rlqr(plant, mu=1e8, uncertainty=rc.NormBounded(H, EF, EG))``).
-    P_N : (n, n), optional
+    P_N : (n, n) array_like, optional
         Starting point of the plain recursion (default ``Q``).
-    tol, max_iter :
+    tol : float
         Acceptance: one more recursion step changes ``P`` by less than
-        ``tol`` (relative Frobenius norm) and ``rho(L) < 1 - 1e-9``; at most
-        ``max_iter`` steps of the plain recursion.
+        ``tol`` (relative Frobenius norm) and ``rho(L) < 1 - 1e-9``.
+    max_iter : int
+        At most this many steps of the plain recursion.
     accelerate : bool, default True
         Find the steady state by doubling (same fixed point, same acceptance
         test, far fewer steps). ``False``: the paper's plain recursion.
@@ -362,10 +506,21 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     Returns
     -------
     Controller
-        ``info`` holds ``P``, ``L``, ``mu``, ``alpha``, ``lambda``,
-        ``implementation``, ``iterations``, ``residual`` and ``stabilizing``
-        (``F + G K`` is Schur stable; always True unless
-        ``check_stability=False``).
+        ``K`` and, in ``info``:
+
+        ======================  ===========================================================
+        key                     value
+        ======================  ===========================================================
+        ``"P"``                 (n, n) steady-state Riccati matrix
+        ``"L"``                 (n, n) closed loop of the RLQR, ``x*[k+1] = L x*[k]``
+        ``"mu"``                the penalty
+        ``"alpha"``             the margin of ``lambda``
+        ``"lambda"``            ``(1 + alpha) ||mu H'H||`` (0 without uncertainty)
+        ``"implementation"``    ``"kkt"`` or ``"block"``
+        ``"iterations"``        doubling (or recursion) steps
+        ``"residual"``          relative change of ``P`` in one more recursion step
+        ``"stabilizing"``       ``F + G K`` is Schur stable (True unless ``check_stability=False``)
+        ======================  ===========================================================
 
     Raises
     ------
@@ -381,6 +536,55 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
     NotStabilizingError
         (a ``ConvergenceError``) The steady state was reached but ``F + G K``
         is not Schur stable, with ``check_stability`` True (the default).
+    ValueError, TypeError
+        Bad arguments (shapes, weights that are not positive (semi)definite,
+        ``mu`` outside ``[1e-100, inf]``), named in the message.
+
+    See Also
+    --------
+    rlqr_gains : many uncertainty models at once.
+    rlqr_schedule : the finite-horizon gains.
+    robustctl.robust_stability : certify the design against the uncertainty.
+
+    Notes
+    -----
+    Each step of the recursion solves the regularised min-max problem of
+    Cerri, Terra & Ishihara [1]_ [2]_ (paper Section 2.2 [3]_)
+
+    .. math::
+
+        \min_{x_{k+1},\,u_k} \max_{\|\Delta\| \le 1}\;
+        x_{k+1}^T P_{k+1} x_{k+1} + u_k^T R u_k + x_k^T Q x_k
+        + \mu \,\| x_{k+1} - (F + H\Delta E_F) x_k - (G + H\Delta E_G) u_k \|^2 ,
+
+    whose solution is ``u_k = K_k x_k``, ``x_{k+1} = L_k x_k`` and the new
+    ``P_k``. With ``Fhat = [F; EF]``, ``Ghat = [G; EG]``, ``Ihat = [I; 0]``,
+    ``lambda = (1 + alpha) ||mu H'H||`` and
+    ``Sigma = blkdiag(mu^-1 I - lambda^-1 H H', lambda^-1 I)``:
+
+    .. math::
+
+        W &= \Sigma + \hat I P_{k+1}^{-1} \hat I^T + \hat G R^{-1} \hat G^T, \\
+        K_k &= -R^{-1} \hat G^T W^{-1} \hat F, \qquad
+        L_k = P_{k+1}^{-1} \hat I^T W^{-1} \hat F, \\
+        P_k &= Q + \hat F^T W^{-1} \hat F .
+
+    The code evaluates the equivalent penalty/KKT form of the module
+    docstring, which needs no inverse of ``P`` or ``Q`` and is exact at
+    ``mu = inf`` (then ``EF + EG K = 0`` and ``L = F + G K``). The steady
+    state is the fixed point ``P = P_k = P_{k+1}``.
+
+    References
+    ----------
+    .. [1] J. P. Cerri, M. H. Terra, J. Y. Ishihara, "Recursive robust
+       regulator for discrete-time state-space systems", American Control
+       Conference 2009, 3077-3082.
+    .. [2] M. H. Terra, J. P. Cerri, J. Y. Ishihara, "Optimal robust linear
+       quadratic regulator for systems subject to uncertainties", IEEE Trans.
+       Automatic Control 59(9), 2586-2591, 2014.
+    .. [3] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022.
 
     Examples
     --------
@@ -439,11 +643,42 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
 def rlqr_schedule(plant: Plant, EF=None, EG=None, mu=None, *, horizon: int, Q=None, R=None, H=None,
                   alpha: float = DEFAULT_ALPHA, uncertainty=None, P_N=None,
                   implementation: str = "kkt") -> RLQRSchedule:
-    """Finite-horizon RLQR: the recursion run ``horizon`` steps back from the terminal weight ``P_N``.
+    r"""Finite-horizon RLQR: the recursion run ``horizon`` steps back from the terminal weight ``P_N``.
 
-    Same arguments as :func:`rlqr` (``P_N`` default ``Q``); ``horizon`` is
-    the number of steps ``N``. Returns the time-varying gains ``K_0 ..
-    K_{N-1}`` as an :class:`RLQRSchedule`. No stabilisability is needed.
+    The time-varying gains ``K_0 .. K_{N-1}`` of the recursion of
+    :func:`rlqr` (its Notes), ``P_N`` at the end. No stabilisability is needed.
+
+    Parameters
+    ----------
+    plant : Plant
+        Nominal discrete-time plant.
+    EF : (l, n) array_like
+        State part of the uncertainty.
+    EG : (l, m) array_like
+        Input part of the uncertainty.
+    mu : float
+        Penalty in ``[1e-100, inf]``.
+    horizon : int
+        The number of steps ``N``.
+    Q : (n, n) array_like, optional
+        State weight (default identity).
+    R : (m, m) array_like, optional
+        Input weight (default identity).
+    H : (n, p) array_like, optional
+        As in :func:`rlqr` (default ``ones((n, l))``).
+    alpha : float
+        ``lambda = (1 + alpha) ||mu H'H||``.
+    uncertainty : NormBounded, optional
+        ``H``, ``EF``, ``EG`` in one object.
+    P_N : (n, n) array_like, optional
+        Terminal weight (default ``Q``).
+    implementation : {"kkt", "block"}
+        Step formula (as in :func:`rlqr`).
+
+    Returns
+    -------
+    RLQRSchedule
+        ``K`` (N, m, n), ``L`` (N, n, n), ``P`` (N + 1, n, n).
 
     Raises
     ------
@@ -451,6 +686,44 @@ def rlqr_schedule(plant: Plant, EF=None, EG=None, mu=None, *, horizon: int, Q=No
         ``mu = inf`` and ``EG`` is not of full row rank.
     ConvergenceError
         The recursion produced non-finite values.
+
+    See Also
+    --------
+    rlqr : the steady state of the same recursion.
+
+    Notes
+    -----
+    ``P[N] = P_N`` and, for ``k = N-1 .. 0``, ``(L[k], K[k], P[k])`` is the
+    step of :func:`rlqr_step` from ``P[k+1]``. With no uncertainty and a
+    large ``mu`` it is the dynamic-programming recursion of the
+    finite-horizon LQR [1]_,
+
+    .. math::
+
+        K_k = -(R + G^T P_{k+1} G)^{-1} G^T P_{k+1} F, \qquad
+        P_k = Q + F^T P_{k+1} (F + G K_k).
+
+    References
+    ----------
+    .. [1] B. D. O. Anderson, J. B. Moore, *Optimal Control: Linear Quadratic
+       Methods*, Prentice Hall 1990, Ch. 2.
+
+    Examples
+    --------
+    Without uncertainty, the gains are those of the LQR recursion, written
+    out here:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> schedule = rc.rlqr_schedule(plant, [[0.0, 0.0]], [[0.0]], 1e10, horizon=3)
+    >>> F, G, P, gains = plant.F, plant.G, np.eye(2), []
+    >>> for _ in range(3):
+    ...     K = -np.linalg.solve(np.eye(1) + G.T @ P @ G, G.T @ P @ F)
+    ...     P = np.eye(2) + F.T @ P @ (F + G @ K)
+    ...     gains.insert(0, K)
+    >>> bool(np.allclose(schedule.K, gains, rtol=1e-6))
+    True
     """
     d = build(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, uncertainty=uncertainty, batch=False)
     horizon = check_int(horizon, "horizon")

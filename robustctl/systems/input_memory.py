@@ -43,9 +43,18 @@ __all__ = ["InputMemoryFeedback", "with_input_memory"]
 
 @dataclass(frozen=True, eq=False, repr=False)
 class InputMemoryFeedback:
-    """The law ``u[k] = K x[k] + K_input u[k-1]`` (``u[-1] = 0``); ``K_input=None``: ``u = K x``.
+    r"""The law ``u[k] = K x[k] + K_input u[k-1]`` (``u[-1] = 0``); ``K_input=None``: ``u = K x``.
 
     Sign convention ``u = K x`` (the paper's), as :class:`robustctl.Controller`.
+    Calling the law, ``law(x, u_prev)``, gives the input for a state (or a
+    stack of states).
+
+    Parameters
+    ----------
+    K : (m, n) array_like
+        State gain.
+    K_input : (m, m) array_like, optional
+        Gain on the previous applied input; None (default) for a static law.
 
     Attributes
     ----------
@@ -54,8 +63,55 @@ class InputMemoryFeedback:
     K_input : (m, m) ndarray or None
         Gain on the previous applied input; None for a static law.
 
+    Raises
+    ------
+    ValueError
+        ``K_input`` not ``m x m`` for the ``m`` rows of ``K``; non-finite entries.
+
+    See Also
+    --------
+    with_input_memory : the augmented plant.
+    robustctl.synthesis.hinf_game : the delayed full-information law.
+
+    Notes
+    -----
+    The law is the static gain ``[K  K_input]`` on the plant augmented by
+    the previous input [1]_,
+
+    .. math::
+
+        \begin{bmatrix} x \\ u_{prev} \end{bmatrix}^+ =
+        \left(\begin{bmatrix} F & 0 \\ 0 & 0 \end{bmatrix} +
+        \begin{bmatrix} G \\ I \end{bmatrix}
+        \begin{bmatrix} K & K_{input} \end{bmatrix}\right)
+        \begin{bmatrix} x \\ u_{prev} \end{bmatrix},
+
+    whose matrix is :meth:`closed_loop`.
+
+    References
+    ----------
+    .. [1] G. F. Franklin, J. D. Powell, M. L. Workman, *Digital Control of
+       Dynamic Systems*, 3rd ed., Addison-Wesley 1998, Sec. 8.1.
+
     Examples
     --------
+    A law that feeds back the previous input: simulated step by step, it
+    gives the state that the powers of its augmented closed loop give.
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.1, 0.1], [0.0, 0.9]], [[0.0], [0.1]], dt=0.1)
+    >>> law = rc.InputMemoryFeedback([[-3.0, -2.0]], [[0.5]])
+    >>> law.is_stabilizing(plant)
+    True
+    >>> x, u_prev = np.array([1.0, 0.0]), np.zeros(1)
+    >>> for _ in range(20):
+    ...     u = law(x, u_prev)
+    ...     x, u_prev = plant.F @ x + plant.G @ u, u
+    >>> xa = np.linalg.matrix_power(law.closed_loop(plant), 20) @ [1.0, 0.0, 0.0]
+    >>> bool(np.allclose(xa, np.r_[x, u_prev]))
+    True
+
     The delayed full-information law of the game Riccati recursion on the
     paper's truck, closed around the plant augmented by the previous input:
 
@@ -104,7 +160,25 @@ class InputMemoryFeedback:
         return self.K if self.K_input is None else np.hstack([self.K, self.K_input])
 
     def __call__(self, x: ArrayLike, u_prev: ArrayLike | None = None) -> np.ndarray:
-        """``K x + K_input u_prev`` for one state (n,) or a stack (..., n); ``u_prev`` defaults to zero."""
+        """``K x + K_input u_prev`` for one state (n,) or a stack (..., n); ``u_prev`` defaults to zero.
+
+        Parameters
+        ----------
+        x : (n,) or (..., n) array_like
+            State(s).
+        u_prev : (m,) or (..., m) array_like, optional
+            Previous applied input(s); ignored by a static law.
+
+        Returns
+        -------
+        (m,) or (..., m) ndarray
+            The input(s).
+
+        Raises
+        ------
+        ValueError
+            ``x`` or ``u_prev`` with the wrong last axis.
+        """
         xa = as_float_array(x, "x")
         if xa.shape[-1:] != (self.n,):
             raise ValueError(f"x must have {self.n} entries in its last axis (the number of states), "
@@ -125,7 +199,18 @@ class InputMemoryFeedback:
                              f"got n={plant.n}, m={plant.m}")
 
     def augmented_plant(self, plant: Plant) -> Plant:
-        """The plant the law is a static gain of: ``plant`` with ``u[k-1]`` as extra states (or ``plant``)."""
+        """The plant the law is a static gain of: ``plant`` with ``u[k-1]`` as extra states (or ``plant``).
+
+        Parameters
+        ----------
+        plant : Plant
+            A discrete plant of the law's size (a static law also takes a continuous one).
+
+        Returns
+        -------
+        Plant
+            :func:`with_input_memory` of ``plant``, or ``plant`` for a static law.
+        """
         self._check(plant)
         if self.K_input is None:
             return plant
@@ -134,7 +219,20 @@ class InputMemoryFeedback:
         return aug
 
     def augmented_uncertainty(self, uncertainty: NormBounded, plant: Plant) -> NormBounded:
-        """``[dF dG] = H Delta [EF EG]`` on the augmented plant: ``[H; 0]``, ``[EF 0]``, ``EG`` (``u[k-1]`` exact)."""
+        """``[dF dG] = H Delta [EF EG]`` on the augmented plant: ``[H; 0]``, ``[EF 0]``, ``EG`` (``u[k-1]`` exact).
+
+        Parameters
+        ----------
+        uncertainty : NormBounded
+            The uncertainty of ``plant``.
+        plant : Plant
+            The plant.
+
+        Returns
+        -------
+        NormBounded
+            The uncertainty of :meth:`augmented_plant` (``uncertainty`` for a static law).
+        """
         self._check(plant)
         if self.K_input is None:
             return uncertainty
@@ -143,12 +241,33 @@ class InputMemoryFeedback:
         return aug[1]
 
     def closed_loop(self, plant: Plant) -> np.ndarray:
-        """``F_a + G_a gain``: the closed loop on the augmented state, (n + m, n + m) (or ``F + G K``)."""
+        """``F_a + G_a gain``: the closed loop on the augmented state, (n + m, n + m) (or ``F + G K``).
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant.
+
+        Returns
+        -------
+        ndarray
+            (n + m, n + m) with input memory, else (n, n).
+        """
         p = self.augmented_plant(plant)
         return p.F + p.G @ self.gain
 
     def is_stabilizing(self, plant: Plant) -> bool:
-        """Whether :meth:`closed_loop` is stable (margin of :mod:`robustctl.systems.stability`)."""
+        """Whether :meth:`closed_loop` is stable (margin of :mod:`robustctl.systems.stability`).
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant.
+
+        Returns
+        -------
+        bool
+        """
         return is_stable(self.closed_loop(plant), discrete=plant.is_discrete)
 
     def __repr__(self) -> str:
@@ -168,6 +287,38 @@ def with_input_memory(plant: Plant, uncertainty: NormBounded | None = None
     ``uncertainty`` (``[dF dG] = H Delta [EF EG]``) the augmented one is
     returned too: ``H_a = [H; 0]``, ``EF_a = [EF 0]``, ``EG`` unchanged
     (``u_prev`` is exactly known).
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant ``(F, G)``.
+    uncertainty : NormBounded, optional
+        Its uncertainty.
+
+    Returns
+    -------
+    Plant or (Plant, NormBounded)
+        The augmented plant (n + m states), with the augmented uncertainty
+        when ``uncertainty`` is given.
+
+    Raises
+    ------
+    TypeError
+        ``plant`` is not a Plant, ``uncertainty`` not a NormBounded.
+    ValueError
+        An uncertainty of another size.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.systems.input_memory import with_input_memory
+    >>> plant = rc.Plant([[1.1, 0.1], [0.0, 0.9]], [[0.0], [0.1]], dt=0.1)
+    >>> aug = with_input_memory(plant)
+    >>> aug
+    Plant(n=3, m=1, dt=0.1)
+    >>> bool(np.array_equal(aug.F, np.block([[plant.F, np.zeros((2, 1))], [np.zeros((1, 3))]])))
+    True
     """
     check_plant(plant)
     n, m = plant.n, plant.m

@@ -24,7 +24,7 @@ It is ``F_a + G_a K_a`` for the *augmented* plant ``F_a = diag(F, 0)``,
 ``G_a = diag(G, I)`` under the static gain ``K_a = [[E D_c C, E C_c],
 [B_c (C + D E D_c C), A_c + B_c D E C_c]]`` (:func:`augmented_gain`), so that
 every analysis written for state feedback ``(plant, K)`` applies to a dynamic
-controller: a norm-bounded uncertainty ``[dF dG] = H Delta [EF EG]`` of the
+controller [1]_: a norm-bounded uncertainty ``[dF dG] = H Delta [EF EG]`` of the
 plant becomes ``H_a = [H; 0]``, ``EF_a = [EF 0]``, ``EG_a = [EG 0]`` (the
 controller is known exactly), and the uncertain closed loop is
 ``A_cl + H_a Delta (EF_a + EG_a K_a)``.

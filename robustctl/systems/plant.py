@@ -11,7 +11,7 @@ import numpy as np
 from .._validation import as_matrix, check_choice, check_positive_scalar, check_square, frozen, frozen_complex
 from .stability import undetectable_modes, unstabilizable_modes
 
-__all__ = ["Plant", "check_plant", "check_vertices"]
+__all__ = ["Plant", "check_plant", "check_plants", "check_vertices"]
 
 _METHODS = ("zoh", "tustin", "euler")
 
@@ -347,10 +347,40 @@ class Plant:
 
 
 def check_plant(value, name: str = "plant", *, discrete_for: str | None = None) -> Plant:
-    """``value`` if it is a :class:`~robustctl.Plant`, else ``TypeError`` naming ``name``.
+    """``value`` itself if it is a :class:`~robustctl.Plant`; otherwise an error naming ``name``.
 
-    With ``discrete_for`` (a design's name), a continuous-time plant is refused
-    with a ``ValueError`` that says so.
+    Parameters
+    ----------
+    value : object
+        What the caller passed as a plant.
+    name : str
+        The argument's name in the messages.
+    discrete_for : str, optional
+        A design's name: a continuous-time plant is then refused.
+
+    Returns
+    -------
+    Plant
+        ``value``.
+
+    Raises
+    ------
+    TypeError
+        ``value`` is not a :class:`~robustctl.Plant`.
+    ValueError
+        ``discrete_for`` is given and the plant is continuous-time.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.validation import check_plant
+    >>> plant = rc.Plant([[0.5]], [[1.0]], 0.1)
+    >>> check_plant(plant) is plant
+    True
+    >>> check_plant([[0.5]], "scenario")
+    Traceback (most recent call last):
+        ...
+    TypeError: scenario must be a robustctl.Plant, got list
     """
     if not isinstance(value, Plant):
         raise TypeError(f"{name} must be a robustctl.Plant, got {type(value).__name__}")
@@ -363,14 +393,48 @@ def check_plants(plants, name: str = "plants", *, like: Plant | None = None, ref
                  non_empty: bool = True, discrete_for: str | None = None) -> list[Plant]:
     """``plants`` as a list of :class:`~robustctl.Plant` of one size and sampling time.
 
-    Every plant must have the ``n``, ``m`` and ``dt`` of ``like`` (default
-    ``plants[0]``), which ``reference`` names in the messages (default
-    ``"<name>[0]"``); with ``discrete_for`` each must be discrete-time. The
-    one check of a plant set: polytope vertices, the scenarios of a tuning
-    problem, the plants of :meth:`NormBounded.from_plants
-    <robustctl.NormBounded.from_plants>`. ``TypeError`` for anything but a
-    list (or tuple) of plants (an empty one too, with ``non_empty``),
-    ``ValueError`` naming ``<name>[i]`` for a size or sampling time that differs.
+    The one check of a plant set: polytope vertices, the scenarios of a
+    tuning problem, the plants of :meth:`NormBounded.from_plants
+    <robustctl.NormBounded.from_plants>`.
+
+    Parameters
+    ----------
+    plants : sequence of Plant
+        A list or tuple of plants.
+    name : str
+        The argument's name in the messages (``"<name>[i]"`` for an element).
+    like : Plant, optional
+        The plant every element must match in ``n``, ``m`` and ``dt``
+        (default ``plants[0]``).
+    reference : str, optional
+        How the messages name ``like`` (default ``"<name>[0]"``).
+    non_empty : bool
+        Refuse an empty sequence.
+    discrete_for : str, optional
+        A design's name: every plant must then be discrete-time.
+
+    Returns
+    -------
+    list of Plant
+
+    Raises
+    ------
+    TypeError
+        Anything but a list or tuple of plants (an empty one too, with ``non_empty``).
+    ValueError
+        ``<name>[i]`` with another size or sampling time than ``like``.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.validation import check_plants
+    >>> a, b = rc.Plant([[0.5]], [[1.0]], 0.1), rc.Plant([[0.7]], [[1.0]], 0.1)
+    >>> len(check_plants((a, b)))
+    2
+    >>> check_plants([a, rc.Plant([[0.7]], [[1.0]], 0.2)], "scenarios")
+    Traceback (most recent call last):
+        ...
+    ValueError: scenarios[1] must have the sampling time of scenarios[0] (dt=0.1), got dt=0.2
     """
     what = f"a {'non-empty ' if non_empty else ''}list of robustctl.Plant"
     if isinstance(plants, Plant) or not isinstance(plants, Sequence) or isinstance(plants, (str, bytes)):
@@ -391,12 +455,42 @@ def check_plants(plants, name: str = "plants", *, like: Plant | None = None, ref
 
 
 def check_vertices(plant: Plant, vertices, *, reference: str = "plant", non_empty: bool = False) -> list[Plant]:
-    """``[plant, *vertices]``, each vertex checked to be a :class:`~robustctl.Plant` of ``plant``'s size and ``dt``.
+    """``[plant, *vertices]``: the vertices of the polytope ``conv{plant, *vertices}``, each checked.
 
-    The vertices of a polytope ``conv{plant, *vertices}`` (e.g. the ``vertices``
-    of :func:`robustctl.hinf` and :func:`robustctl.robust_stability`).
-    ``vertices=None`` (and, unless ``non_empty``, an empty list) is the plant
-    alone. ``reference`` names ``plant`` in the messages (:func:`check_plants`).
+    Used by :func:`robustctl.hinf` and :func:`robustctl.robust_stability`:
+    each vertex must be a :class:`~robustctl.Plant` of ``plant``'s size and
+    sampling time (:func:`check_plants`).
+
+    Parameters
+    ----------
+    plant : Plant
+        The nominal plant, the first vertex.
+    vertices : sequence of Plant or None
+        The other vertices; ``None`` (and, unless ``non_empty``, an empty
+        list) is the plant alone.
+    reference : str
+        How the messages name ``plant``.
+    non_empty : bool
+        Require at least one vertex besides ``plant``.
+
+    Returns
+    -------
+    list of Plant
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`check_plants`, naming ``vertices[i]``.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.validation import check_vertices
+    >>> plant = rc.Plant([[0.5]], [[1.0]], 0.1)
+    >>> [v.F.item() for v in check_vertices(plant, [rc.Plant([[0.9]], [[1.0]], 0.1)])]
+    [0.5, 0.9]
+    >>> check_vertices(plant, None) == [plant]
+    True
     """
     if vertices is None and not non_empty:
         return [plant]

@@ -41,6 +41,15 @@ class PlantSamples(Sequence[Plant]):
     A :class:`~collections.abc.Sequence` of the plants (iterating, indexing and
     ``len`` act on them), so it is a scenario list as it is.
 
+    Parameters
+    ----------
+    plants : tuple of Plant
+        The plants, one per sample.
+    params : (N, d) ndarray
+        Their parameter values, one row per plant.
+    names : tuple of str
+        The parameter names, in the order of ``params``' columns.
+
     Attributes
     ----------
     plants : tuple of Plant
@@ -49,6 +58,21 @@ class PlantSamples(Sequence[Plant]):
         The parameter values, one row per plant, columns in the order of ``names``.
     names : tuple of str
         The parameters (the keys of ``ranges``).
+
+    See Also
+    --------
+    sample_plants : builds it.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> def plant_of(a):
+    ...     return rc.Plant([[a]], [[1.0]], dt=0.1)
+    >>> samples = rc.sample_plants(plant_of, {"a": (0.5, 1.5)}, n=3)
+    >>> len(samples), samples.as_dicts()[2]
+    (3, {'a': 1.5})
+    >>> [float(p.F[0, 0]) for p in samples] == samples.params[:, 0].tolist()
+    True
     """
 
     plants: tuple[Plant, ...]
@@ -70,7 +94,13 @@ class PlantSamples(Sequence[Plant]):
         return iter(self.plants)
 
     def as_dicts(self) -> list[dict[str, float]]:
-        """The parameters of each plant as ``{name: value}``."""
+        """The parameters of each plant as ``{name: value}``.
+
+        Returns
+        -------
+        list of dict
+            One ``{name: value}`` per plant, in the order of the plants.
+        """
         return [dict(zip(self.names, map(float, row), strict=True)) for row in self.params]
 
     def __repr__(self) -> str:
@@ -107,7 +137,7 @@ def _unit_samples(method: str, d: int, n: int, rng: np.random.Generator) -> np.n
 
 def sample_plants(model: Callable[..., Plant], ranges: Mapping[str, tuple[float, float]], *, n: int = 5,
                   method: str = "grid", seed=None) -> PlantSamples:
-    """The plants ``model(**params)`` over a box of parameter ranges.
+    r"""The plants ``model(**params)`` over a box of parameter ranges.
 
     Parameters
     ----------
@@ -133,6 +163,41 @@ def sample_plants(model: Callable[..., Plant], ranges: Mapping[str, tuple[float,
     PlantSamples
         The plants (a sequence: ``list(samples)`` is the scenario list) and their parameters.
 
+    Raises
+    ------
+    TypeError
+        ``model`` not callable or not returning a :class:`~robustctl.Plant`,
+        ``ranges`` not a non-empty mapping, ``n`` not an integer.
+    ValueError
+        A range that is not two finite numbers ``low <= high``, a key that is
+        not an identifier, plants of different sizes or sampling times (the
+        message names the call), an unknown ``method``.
+
+    See Also
+    --------
+    robustctl.NormBounded.from_plants : a norm-bounded model covering the plants.
+
+    Notes
+    -----
+    With ``d`` parameters, ``"grid"`` gives the ``n ** d`` points of the
+    grid with ``n`` evenly spaced values per parameter, ends included.
+    ``"lhs"`` cuts each range into ``n`` equal strata and draws, for each
+    parameter independently, a random permutation ``pi`` of the strata
+    and uniform offsets ``U_ij``; sample ``i`` is [1]_
+
+    .. math::
+
+        \theta_{ij} = a_j + (b_j - a_j)\, \frac{\pi_j(i) + U_{ij}}{n},
+        \qquad i = 1..n,
+
+    one sample in each stratum of each parameter.
+
+    References
+    ----------
+    .. [1] M. D. McKay, R. J. Beckman, W. J. Conover, "A comparison of three
+       methods for selecting values of input variables in the analysis of
+       output from a computer code", Technometrics 21(2), 239-245, 1979.
+
     Examples
     --------
     A mass on a spring, its mass between 1 and 2, on a grid of three:
@@ -145,6 +210,21 @@ def sample_plants(model: Callable[..., Plant], ranges: Mapping[str, tuple[float,
     PlantSamples(N=3, params=['mass'], n=2, m=1, dt=0.1)
     >>> samples.params.ravel().tolist()
     [1.0, 1.5, 2.0]
+
+    The heaviest plant is the zero-order hold of the model at ``mass = 2``
+    (scipy's ``cont2discrete``):
+
+    >>> import numpy as np, scipy.signal
+    >>> A, B = np.array([[0.0, 1.0], [-0.5, 0.0]]), np.array([[0.0], [0.5]])
+    >>> F, G, *_ = scipy.signal.cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), 0.1)
+    >>> bool(np.allclose(samples[2].F, F) and np.allclose(samples[2].G, G))
+    True
+
+    Latin-hypercube samples put one sample in each quarter of the range:
+
+    >>> lhs = rc.sample_plants(spring_mass, {"mass": (1.0, 2.0)}, n=4, method="lhs")
+    >>> np.sort(np.floor((lhs.params[:, 0] - 1.0) * 4)).tolist()
+    [0.0, 1.0, 2.0, 3.0]
     """
     if not callable(model):
         raise TypeError(f"model must be a callable params -> robustctl.Plant, got {type(model).__name__}")

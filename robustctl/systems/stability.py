@@ -83,9 +83,48 @@ def _per_matrix(A, measure) -> np.ndarray | float:
 
 
 def spectral_radius(A) -> np.ndarray | float:
-    """``max |eig(A)|`` of a matrix (n, n) or of each matrix of a stack (..., n, n).
+    r"""``max |eig(A)|`` of a matrix (n, n) or of each matrix of a stack (..., n, n).
 
-    Non-finite matrices have radius ``inf``. Returns a float for one matrix.
+    Parameters
+    ----------
+    A : (n, n) or (..., n, n) array_like
+        A square matrix or a stack of them.
+
+    Returns
+    -------
+    float or ndarray
+        A float for one matrix, else an array of the leading shape ``(...)``;
+        ``inf`` for a matrix with a non-finite entry.
+
+    Raises
+    ------
+    ValueError
+        ``A`` is not square in its last two axes.
+    TypeError
+        A non-numeric entry.
+
+    See Also
+    --------
+    is_schur_stable : the stability test on the radius.
+    spectral_abscissa : ``max Re eig(A)``, for continuous time.
+
+    Notes
+    -----
+    .. math::
+
+        \rho(A) = \max_i |\lambda_i(A)|,
+
+    from the eigenvalues of the whole stack at once (``numpy.linalg.eigvals``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> A = np.array([[[0.5, 1.0], [0.0, -0.9]], [[1.0, 0.1], [0.0, 0.3]]])
+    >>> rc.spectral_radius(A)
+    array([0.9, 1. ])
+    >>> bool(np.allclose(rc.spectral_radius(A), [max(abs(np.diag(a))) for a in A]))   # triangular
+    True
     """
     return _per_matrix(A, np.abs)
 
@@ -93,7 +132,26 @@ def spectral_radius(A) -> np.ndarray | float:
 def spectral_abscissa(A) -> np.ndarray | float:
     """``max Re eig(A)`` of a matrix (n, n) or of each matrix of a stack (..., n, n) (continuous time).
 
-    Non-finite matrices have abscissa ``inf``. Returns a float for one matrix.
+    Parameters
+    ----------
+    A : (n, n) or (..., n, n) array_like
+        A square matrix or a stack of them.
+
+    Returns
+    -------
+    float or ndarray
+        A float for one matrix, else an array of the leading shape; ``inf``
+        for a matrix with a non-finite entry.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.systems.stability import spectral_abscissa
+    >>> A = [[-1.0, 5.0], [0.0, -2.0]]
+    >>> spectral_abscissa(A)
+    -1.0
+    >>> bool(spectral_abscissa(A) == max(np.linalg.eigvals(A).real))
+    True
     """
     return _per_matrix(A, np.real)
 
@@ -121,9 +179,56 @@ def _schur(A: np.ndarray, bound: float) -> np.ndarray:
 
 
 def is_schur_stable(A, margin: float = STABILITY_MARGIN) -> np.ndarray | bool:
-    """``rho(A) < 1 - margin`` for a matrix or each matrix of a stack (..., n, n).
+    r"""``rho(A) < 1 - margin`` for a matrix or each matrix of a stack (..., n, n).
 
-    Non-finite matrices are unstable. Returns a bool for one matrix.
+    The one test of discrete-time stability of :mod:`robustctl` (module
+    docstring); the margin keeps a pole on the unit circle up to rounding
+    from counting as stable.
+
+    Parameters
+    ----------
+    A : (n, n) or (..., n, n) array_like
+        A square matrix or a stack of them.
+    margin : float, optional
+        Required distance of the spectral radius below 1 (default
+        ``STABILITY_MARGIN``, 1e-9).
+
+    Returns
+    -------
+    bool or ndarray of bool
+        A bool for one matrix, else an array of the leading shape; False for
+        a matrix with a non-finite entry.
+
+    Raises
+    ------
+    ValueError
+        ``A`` is not square in its last two axes.
+
+    See Also
+    --------
+    spectral_radius : the radius itself.
+    is_stable : one matrix, discrete or continuous time.
+
+    Notes
+    -----
+    A stack of more than a few matrices is decided first by the certificate
+
+    .. math::
+
+        \rho(A) \le \| A^{k} \|_F^{1/k}, \qquad k = 2^j,
+
+    with a few stacked squarings of ``A / (1 - margin)``; only the
+    matrices it leaves undecided get eigenvalues.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> A = np.array([[[0.5, 1.0], [0.0, -0.9]], [[1.0, 0.1], [0.0, 0.3]]])   # an integrator in the second
+    >>> rc.is_schur_stable(A)
+    array([ True, False])
+    >>> bool(np.array_equal(rc.is_schur_stable(A), abs(np.linalg.eigvals(A)).max(axis=1) < 1 - 1e-9))
+    True
     """
     A = _stack(A)
     out = _schur(A.reshape(-1, *A.shape[-2:]), 1.0 - margin).reshape(A.shape[:-2])
@@ -134,8 +239,29 @@ def stability_of_eigenvalues(lam, *, discrete: bool,
                              margin: float = STABILITY_MARGIN) -> tuple[np.ndarray, np.ndarray]:
     """``(nominal, stable)`` of eigenvalues already computed, ``lam`` (..., n), row by row.
 
-    ``nominal`` is the spectral radius (``discrete``) or abscissa, ``stable``
-    whether it is below ``1 - margin`` (resp. ``-margin``), the rule of :func:`is_stable`.
+    Parameters
+    ----------
+    lam : (..., n) array_like
+        Eigenvalues, one row per matrix.
+    discrete : bool
+        Discrete time (spectral radius) or continuous time (abscissa).
+    margin : float, optional
+        The margin of :func:`is_stable` (default ``STABILITY_MARGIN``).
+
+    Returns
+    -------
+    nominal : (...) ndarray
+        The spectral radius (``discrete``) or abscissa of each row.
+    stable : (...) ndarray of bool
+        Whether it is below ``1 - margin`` (resp. ``-margin``), the rule of :func:`is_stable`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.systems.stability import stability_of_eigenvalues
+    >>> radius, stable = stability_of_eigenvalues([[0.5, -0.9], [1.0, 0.3]], discrete=True)
+    >>> radius.tolist(), stable.tolist()
+    ([0.9, 1.0], [True, False])
     """
     lam = np.asarray(lam)
     nominal = np.abs(lam).max(axis=-1) if discrete else lam.real.max(axis=-1)
@@ -143,7 +269,36 @@ def stability_of_eigenvalues(lam, *, discrete: bool,
 
 
 def is_stable(A, *, discrete: bool, margin: float = STABILITY_MARGIN) -> bool:
-    """One matrix: Schur stable (``discrete``) or Hurwitz stable (every ``Re lambda < -margin``)."""
+    """One matrix: Schur stable (``discrete``) or Hurwitz stable (every ``Re lambda < -margin``).
+
+    Parameters
+    ----------
+    A : (n, n) array_like
+        One square matrix.
+    discrete : bool
+        Discrete time (:func:`is_schur_stable`) or continuous time.
+    margin : float, optional
+        Required distance from the stability boundary (default ``STABILITY_MARGIN``).
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    ValueError
+        ``A`` is not one square matrix.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.systems.stability import is_stable
+    >>> A = [[-1.0, 5.0], [0.0, -2.0]]
+    >>> is_stable(A, discrete=False), is_stable(A, discrete=True)
+    (True, False)
+    >>> bool(max(np.linalg.eigvals(A).real) < 0)
+    True
+    """
     A = _stack(A)
     if A.ndim != 2:
         raise ValueError(f"A must be one square matrix, got shape {A.shape}")
@@ -182,10 +337,34 @@ def _immovable(F: np.ndarray, G: np.ndarray, scale: float, modes: np.ndarray) ->
 def immovable_modes(F, G, concerned: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
     """Eigenvalues ``lambda`` of ``F`` with ``concerned(lambda)`` that no gain ``u = K x`` moves (PBH test).
 
-    ``concerned`` maps the (complex) eigenvalues to a boolean mask, e.g. "outside
-    a pole region"; the rank rule is that of the module docstring. The
-    eigenvalues of ``F + G K`` are those of ``F`` not returned plus any the gain
-    places (Wonham's pole assignment).
+    The rank rule is that of the module docstring. The eigenvalues of
+    ``F + G K`` are those of ``F`` not returned plus any the gain places
+    (Wonham's pole assignment).
+
+    Parameters
+    ----------
+    F : (n, n) array_like
+        State matrix.
+    G : (n, m) array_like
+        Input matrix.
+    concerned : callable
+        Maps the (complex) eigenvalues of ``F`` to a boolean mask, e.g.
+        "outside a pole region".
+
+    Returns
+    -------
+    ndarray of complex
+        The concerned eigenvalues that ``G`` cannot move (empty if none).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.systems.stability import immovable_modes
+    >>> F, G = np.diag([2.0, 0.5]), [[0.0], [1.0]]
+    >>> immovable_modes(F, G, lambda lam: abs(lam) > 0.4)
+    array([2.+0.j])
+    >>> int(np.linalg.matrix_rank(np.hstack([F - 2.0 * np.eye(2), G])))
+    1
     """
     F, G, scale = _pair(F, G)
     modes = np.linalg.eigvals(F)
@@ -193,7 +372,33 @@ def immovable_modes(F, G, concerned: Callable[[np.ndarray], np.ndarray]) -> np.n
 
 
 def unstabilizable_modes(F, G, *, discrete: bool = True) -> np.ndarray:
-    """Eigenvalues of ``F`` that are not stable and that ``G`` cannot move (PBH test, module docstring)."""
+    """Eigenvalues of ``F`` that are not stable and that ``G`` cannot move (PBH test, module docstring).
+
+    Parameters
+    ----------
+    F : (n, n) array_like
+        State matrix.
+    G : (n, m) array_like
+        Input matrix.
+    discrete : bool, default True
+        Unstable means ``|lambda| >= 1`` (discrete) or ``Re lambda >= 0``,
+        up to the tolerance of the module docstring.
+
+    Returns
+    -------
+    ndarray of complex
+        Empty for a stabilisable pair.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.systems.stability import unstabilizable_modes
+    >>> F, G = np.diag([2.0, 0.5]), [[0.0], [1.0]]
+    >>> unstabilizable_modes(F, G)
+    array([2.+0.j])
+    >>> int(np.linalg.matrix_rank(np.hstack([F - 2.0 * np.eye(2), G])))
+    1
+    """
     F, G, scale = _pair(F, G)
     modes = np.linalg.eigvals(F)
     edge = UNSTABLE_TOL * scale
@@ -202,7 +407,32 @@ def unstabilizable_modes(F, G, *, discrete: bool = True) -> np.ndarray:
 
 
 def undetectable_modes(F, C, *, discrete: bool = True) -> np.ndarray:
-    """Eigenvalues of ``F`` that are not stable and that ``C`` does not see (PBH test on ``(F', C')``)."""
+    """Eigenvalues of ``F`` that are not stable and that ``C`` does not see (PBH test on ``(F', C')``).
+
+    Parameters
+    ----------
+    F : (n, n) array_like
+        State matrix.
+    C : (p, n) array_like
+        Output matrix.
+    discrete : bool, default True
+        As in :func:`unstabilizable_modes`.
+
+    Returns
+    -------
+    ndarray of complex
+        Empty for a detectable pair.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from robustctl.systems.stability import undetectable_modes
+    >>> F, C = np.diag([2.0, 0.5]), [[0.0, 1.0]]
+    >>> undetectable_modes(F, C)
+    array([2.+0.j])
+    >>> int(np.linalg.matrix_rank(np.vstack([F - 2.0 * np.eye(2), C])))
+    1
+    """
     F = check_square(as_matrix(F, "F"), "F")
     C = as_matrix(C, "C", cols=F.shape[0], cols_what="the number of states, from F")
     return unstabilizable_modes(F.T, C.T, discrete=discrete)
@@ -216,6 +446,28 @@ def check_stabilizable(plant, name: str = "plant") -> None:
     design to return. ``name`` names the plant in the message (e.g.
     ``"vertices[0]"``). The error is also an ``InfeasibleError`` (what the LMI
     syntheses raise) and a ``ConvergenceError``.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant to test.
+    name : str
+        Its name in the message.
+
+    Raises
+    ------
+    NotStabilizableError
+        The plant has an unstable mode its input cannot move.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.systems.stability import check_stabilizable
+    >>> check_stabilizable(rc.Plant([[2.0]], [[1.0]], dt=0.1))      # passes silently
+    >>> check_stabilizable(rc.Plant([[2.0, 0.0], [0.0, 0.5]], [[0.0], [1.0]], dt=0.1))
+    Traceback (most recent call last):
+    ...
+    robustctl.errors.NotStabilizableError: plant is not stabilisable: its mode lambda = 2+0j ...
     """
     stuck = plant.unstabilizable_modes  # cached on the plant
     if stuck.size:
@@ -230,7 +482,29 @@ def check_detectable(plant, name: str = "plant") -> None:
 
     The estimators and the output-feedback syntheses call this first: no
     observer gain makes the estimation error of such a plant converge.
-    ``name`` names the plant in the message.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant to test (without an output model the state is measured:
+        always detectable).
+    name : str
+        Its name in the message.
+
+    Raises
+    ------
+    NotDetectableError
+        The plant has an unstable mode its outputs do not see.
+
+    Examples
+    --------
+    >>> import robustctl as rc
+    >>> from robustctl.systems.stability import check_detectable
+    >>> check_detectable(rc.Plant([[2.0]], [[1.0]], dt=0.1, C=[[1.0]]))     # passes silently
+    >>> check_detectable(rc.Plant([[2.0, 0.0], [0.0, 0.5]], [[1.0], [1.0]], dt=0.1, C=[[0.0, 1.0]]))
+    Traceback (most recent call last):
+    ...
+    robustctl.errors.NotDetectableError: plant is not detectable: its mode lambda = 2+0j ...
     """
     hidden = plant.undetectable_modes  # cached on the plant
     if hidden.size:

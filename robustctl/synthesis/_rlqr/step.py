@@ -103,8 +103,56 @@ def _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite: bool):
 
 
 def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_ALPHA):
-    """One RLQR step by the paper's block system (Theorem 1, PAPER_NOTES reading).
+    r"""One RLQR step by the paper's block system (Theorem 1, PAPER_NOTES reading).
 
+    The reference implementation of the step that :func:`rlqr_step` computes
+    in its penalty/KKT form: a dense ``(4n + 2m + l)``-square solve, for tests
+    and small problems, not for batches.
+
+    Parameters
+    ----------
+    P_next : (n, n) array_like
+        ``P[k+1]``, symmetric positive definite.
+    F : (n, n) array_like
+        Nominal state matrix.
+    G : (n, m) array_like
+        Nominal input matrix.
+    EF : (l, n) array_like
+        State part of the uncertainty.
+    EG : (l, m) array_like
+        Input part of the uncertainty.
+    Q : (n, n) array_like
+        State weight, symmetric positive definite.
+    R : (m, m) array_like
+        Input weight, symmetric positive definite.
+    H : (n, p) array_like
+        Input matrix of the uncertainty (``H = 0``: none).
+    mu : float
+        Penalty in ``[1e-100, inf]``.
+    alpha : float
+        ``lambda = (1 + alpha) ||mu H'H||``.
+
+    Returns
+    -------
+    L : (n, n) ndarray
+        Closed loop of the step, ``x*[k+1] = L x*[k]``.
+    K : (m, n) ndarray
+        Gain, ``u[k] = K x[k]``.
+    P : (n, n) ndarray
+        ``P[k]``.
+
+    Raises
+    ------
+    ValueError
+        Arguments checked like :func:`robustctl.rlqr`'s (shapes, weights,
+        ``mu``); ``P_next`` or ``Q`` not positive definite.
+
+    See Also
+    --------
+    rlqr_step : the same step by the penalty/KKT form.
+
+    Notes
+    -----
     ``Xi`` has block rows of sizes (n, m, n, n + l, n, m)::
 
         Xi = [[P^-1, 0,    0,    0,      I,     0     ],
@@ -118,10 +166,39 @@ def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEF
     ``Xi^-1 b``, ``P = b' Xi^-1 b``. ``Sigma = blkdiag(mu^-1 I - lambda^-1 H H',
     lambda^-1 I)`` with ``lambda = (1 + alpha) ||mu H'H||`` (``Sigma = 0`` at
     ``mu = inf``; with ``H = 0`` the EF/EG rows are dropped, the
-    ``lambda -> 0`` limit). Needs ``P_next`` and ``Q`` positive definite.
+    ``lambda -> 0`` limit). The system is the optimality condition of the
+    regularised least-squares problem of the step [1]_ [2]_,
 
-    Returns ``(L, K, P)``. Dense ``(4n + 2m + l)``-square solve: for tests and
-    small problems, not for batches. Arguments are validated like :func:`robustctl.rlqr`'s.
+    .. math::
+
+        \Xi \begin{bmatrix} \cdot \\ \cdot \\ \cdot \\ \cdot \\ L \\ K \end{bmatrix} = b,
+        \qquad P = b^T \Xi^{-1} b .
+
+    References
+    ----------
+    .. [1] J. P. Cerri, M. H. Terra, J. Y. Ishihara, "Recursive robust
+       regulator for discrete-time state-space systems", American Control
+       Conference 2009, 3077-3082.
+    .. [2] G. A. Prudencio de Morais et al., "Robust path-following control
+       design of heavy vehicles based on multiobjective evolutionary
+       optimization", Expert Systems with Applications 192, 116304, 2022,
+       Theorem 1.
+
+    Examples
+    --------
+    With no uncertainty and a large ``mu`` the step is one step of the LQR
+    Riccati recursion, written out here:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> F, G = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
+    >>> Q, R, P_next = np.eye(2), np.eye(1), np.diag([2.0, 3.0])
+    >>> L, K, P = rc.rlqr_step_block(P_next, F, G, [[0.0, 0.0]], [[0.0]], Q, R, [[0.0], [0.0]], 1e12)
+    >>> K_lqr = -np.linalg.solve(R + G.T @ P_next @ G, G.T @ P_next @ F)
+    >>> bool(np.allclose(K, K_lqr) and np.allclose(P, Q + F.T @ P_next @ (F + G @ K_lqr)))
+    True
+    >>> bool(np.allclose(L, F + G @ K_lqr))
+    True
     """
     P_next, d = _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite=True)
     P, K, L = block_step(P_next, d.F, d.G, d.EF[0], d.EG[0], d.Q, d.R, d.H, float(d.mu[0]), d.alpha)
@@ -129,10 +206,84 @@ def rlqr_step_block(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEF
 
 
 def rlqr_step(P_next, F, G, EF, EG, Q, R, H, mu: float, alpha: float = DEFAULT_ALPHA):
-    """One RLQR step by the penalty/KKT form (``robustctl.synthesis.rlqr``). Returns ``(L, K, P)``.
+    r"""One RLQR step ``P[k+1] -> (L[k], K[k], P[k])`` by the penalty/KKT form.
 
-    Same arguments as :func:`rlqr_step_block`; ``P_next`` and ``Q`` may be
-    only positive semidefinite.
+    The step that :func:`robustctl.rlqr` iterates to its steady state (the
+    docstring of the module ``robustctl.synthesis.rlqr`` gives the derivation).
+
+    Parameters
+    ----------
+    P_next : (n, n) array_like
+        ``P[k+1]``, symmetric positive semidefinite.
+    F : (n, n) array_like
+        Nominal state matrix.
+    G : (n, m) array_like
+        Nominal input matrix.
+    EF : (l, n) array_like
+        State part of the uncertainty.
+    EG : (l, m) array_like
+        Input part of the uncertainty.
+    Q : (n, n) array_like
+        State weight, symmetric positive semidefinite.
+    R : (m, m) array_like
+        Input weight, symmetric positive definite.
+    H : (n, p) array_like
+        Input matrix of the uncertainty (``H = 0``: none).
+    mu : float
+        Penalty in ``[1e-100, inf]``.
+    alpha : float
+        ``lambda = (1 + alpha) ||mu H'H||``.
+
+    Returns
+    -------
+    L : (n, n) ndarray
+        Closed loop of the step.
+    K : (m, n) ndarray
+        Gain, ``u[k] = K x[k]``.
+    P : (n, n) ndarray
+        ``P[k]``.
+
+    Raises
+    ------
+    ValueError
+        Arguments checked like :func:`robustctl.rlqr`'s.
+
+    See Also
+    --------
+    rlqr_step_block : the paper's block system (the reference).
+
+    Notes
+    -----
+    With ``S = mu^-1 I - lambda^-1 H H'`` and ``P~ = (P^-1 + S)^-1``
+    (computed as ``(I + P S)^-1 P``) [1]_:
+
+    .. math::
+
+        \begin{bmatrix} R + G^T\tilde P G & E_G^T \\ E_G & -\lambda^{-1} I \end{bmatrix}
+        \begin{bmatrix} K \\ \nu \end{bmatrix} =
+        -\begin{bmatrix} G^T\tilde P F \\ E_F \end{bmatrix}, \qquad
+        L = (I + S P)^{-1} (F + G K),
+
+        P_k = Q + K^T R K + (F + G K)^T \tilde P (F + G K) + \lambda^{-1} \nu^T \nu .
+
+    References
+    ----------
+    .. [1] M. H. Terra, J. P. Cerri, J. Y. Ishihara, "Optimal robust linear
+       quadratic regulator for systems subject to uncertainties", IEEE Trans.
+       Automatic Control 59(9), 2586-2591, 2014.
+
+    Examples
+    --------
+    The penalty/KKT form and the paper's block system give the same step:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> F, G = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
+    >>> args = (F, G, [[0.1, 0.0]], [[0.3]], np.eye(2), np.eye(1), [[0.0], [0.1]], 1e4)
+    >>> L, K, P = rc.rlqr_step(np.eye(2), *args)
+    >>> L_ref, K_ref, P_ref = rc.rlqr_step_block(np.eye(2), *args)
+    >>> bool(np.allclose(K, K_ref) and np.allclose(P, P_ref) and np.allclose(L, L_ref))
+    True
     """
     P_next, d = _checked(P_next, F, G, EF, EG, Q, R, H, mu, alpha, definite=False)
     P, K, L = kkt_step(P_next[None], d)
