@@ -491,7 +491,11 @@ def _cmd_select(args) -> int:
     print(f"  rule: {rule}; {args.n_sims} simulations, seed {args.seed}")
     print(f"  wins: {sel.wins}/{sel.n_sims} ({100 * sel.share:.1f} %)")
     print(f"  z = {_vector(sel.z)}")
-    print(f"  K = {_vector(sel.K).replace(chr(10), chr(10) + '      ')}")
+    if sel.K is not None:
+        print(f"  K = {_vector(sel.K).replace(chr(10), chr(10) + '      ')}")
+    elif sel.controller is not None:
+        print(f"  K(z): order {sel.controller.order}, "
+              f"Dc = {_vector(sel.controller.Dc).replace(chr(10), chr(10) + '      ')}")
     if sel.margin is not None:
         print(f"  certified robust margin (NormBounded uncertainty): {sel.margin:.6g}")
     if out is not None:

@@ -163,7 +163,7 @@ def test_problem_bad_input():
         tuning.TuningProblem(fam, [], [effort])
     with pytest.raises(ValueError, match=r"bounds inverted.*xl\[1\]"):
         tuning.TuningProblem(fam, SCENARIOS, [effort], xl=[0, 2, 0], xu=[1, 1, 1])
-    with pytest.raises(ValueError, match="family gives gains of shape"):
+    with pytest.raises(ValueError, match="family gives controllers for n=3 states and m=1 inputs"):
         tuning.TuningProblem(tuning.LQRFamily(rc.Plant(0.5 * np.eye(3), np.ones((3, 1)), dt=0.1)), SCENARIOS, [effort])
     with pytest.raises(TypeError, match=r"objectives\[0\] must be callable"):
         tuning.TuningProblem(fam, SCENARIOS, ["x"])

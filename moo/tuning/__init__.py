@@ -28,27 +28,34 @@ based on multiobjective evolutionary optimization", Expert Systems with
 Applications 192 (2022) 116304.
 """
 
-from .families import DesignFamily, FamilyGains, LQRFamily, RLQRFamily, dlqr_gains
+from .families import DesignFamily, FamilyControllers, FamilyGains, LQRFamily, RLQRFamily, dlqr_gains
 from .goals import (
     Bound,
+    ControllerPoles,
     ErrorGoal,
     Goal,
     H2Norm,
     HinfNorm,
+    Overshoot,
     PeakInput,
     PoleRegion,
     Response,
     RobustMargin,
     SettlingTime,
     SpectralRadius,
+    StepTracking,
+    Variance,
     at_least,
     at_most,
 )
+from .output_feedback import FixedOrderFamily, PIDFamily, StaticOutputFeedbackFamily
 from .problem import TuningProblem, penalise
 from .selection import Selection, SelectionResult, monte_carlo_selection, select
 from .tune import TuningResult, select_front, tune
 
-__all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains", "TuningProblem", "penalise",
+__all__ = ["DesignFamily", "FamilyGains", "FamilyControllers", "RLQRFamily", "LQRFamily", "dlqr_gains",
+           "StaticOutputFeedbackFamily", "PIDFamily", "FixedOrderFamily", "TuningProblem", "penalise",
            "tune", "TuningResult", "select_front", "select", "Selection", "SelectionResult", "monte_carlo_selection",
-           "Goal", "Response", "ErrorGoal", "PeakInput", "SettlingTime", "SpectralRadius", "PoleRegion", "H2Norm",
-           "HinfNorm", "RobustMargin", "Bound", "at_most", "at_least"]
+           "Goal", "Response", "StepTracking", "ErrorGoal", "PeakInput", "SettlingTime", "Overshoot", "SpectralRadius",
+           "PoleRegion", "ControllerPoles", "H2Norm", "HinfNorm", "Variance", "RobustMargin", "Bound", "at_most",
+           "at_least"]

@@ -39,7 +39,7 @@ from robustctl.validation import check_plant, check_positive_scalar
 
 from ..validation import as_float_array, as_matrix, check_int
 
-__all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains"]
+__all__ = ["DesignFamily", "FamilyGains", "FamilyControllers", "RLQRFamily", "LQRFamily", "dlqr_gains"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -84,6 +84,57 @@ class FamilyGains:
         return f"FamilyGains(B={B}, m={m}, n={n}, failed={int((~self.ok).sum())})"
 
 
+@dataclass(frozen=True, eq=False, repr=False)
+class FamilyControllers:
+    """Dynamic output feedbacks of a population of designs, with the designs that failed flagged.
+
+    What the ``gains`` of an output-feedback family returns (its
+    ``feedback`` attribute is ``"output"``): the controllers
+    ``x_c^+ = A_c x_c + B_c y``, ``u = C_c x_c + D_c y`` as one
+    :class:`robustctl.ControllerBatch` of the family's plant. A failed design
+    is a flagged row (NaN matrices), never an exception for the population.
+
+    Parameters
+    ----------
+    controllers : robustctl.ControllerBatch
+        ``B`` controllers (NaN matrices where ``ok`` is False).
+    ok : (B,) bool ndarray
+        The design was computed.
+    reason : (B,) object ndarray of str
+        ``""`` where ``ok``, otherwise why not.
+
+    See Also
+    --------
+    FamilyGains : the same for state feedback.
+    DesignFamily : the protocol.
+
+    Examples
+    --------
+    Two static output feedbacks ``u = D_c y`` of a plant with one output:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo.tuning import FamilyControllers
+    >>> plant = rc.Plant([[1.1, 0.1], [0.0, 0.9]], [[0.0], [0.1]], 0.1, C=[[0.0, 1.0]])
+    >>> Dc = np.array([[[-2.0]], [[-8.0]]])
+    >>> batch = rc.ControllerBatch(plant, np.zeros((2, 0, 0)), np.zeros((2, 0, 1)), np.zeros((2, 1, 0)), Dc)
+    >>> fc = FamilyControllers(batch, np.ones(2, bool), np.full(2, "", object))
+    >>> fc
+    FamilyControllers(B=2, order=0, m=1, p=1, failed=0)
+    >>> bool(np.allclose(fc.controllers.closed_loops()[1], plant.F + plant.G @ Dc[1] @ plant.C))
+    True
+    """
+
+    controllers: rc.ControllerBatch
+    ok: np.ndarray
+    reason: np.ndarray
+
+    def __repr__(self) -> str:
+        c = self.controllers
+        return (f"FamilyControllers(B={len(c)}, order={c.order}, m={c.plant.m}, p={c.plant.p}, "
+                f"failed={int((~self.ok).sum())})")
+
+
 @runtime_checkable
 class DesignFamily(Protocol):
     """What :class:`~moo.tuning.TuningProblem` needs of a design family (any object with these works).
@@ -95,17 +146,23 @@ class DesignFamily(Protocol):
     xl, xu : (n_var,) ndarray
         Default bounds of ``z`` (``xl < xu``).
     n_states, n_inputs : int
-        The gains are ``(n_inputs, n_states)``: the scenario plants' ``m`` and ``n``.
+        The scenario plants' ``n`` and ``m`` (a state feedback's gains are ``(n_inputs, n_states)``).
+    feedback : {"state", "output"}, optional
+        ``"output"`` for a family of dynamic output feedbacks (whose ``gains``
+        return :class:`FamilyControllers` and which has a ``plant`` with the
+        outputs it reads); missing means ``"state"``.
 
     Methods
     -------
     gains(Z)
-        ``Z`` (B, n_var) -> :class:`FamilyGains`; a design that cannot be
+        ``Z`` (B, n_var) -> :class:`FamilyGains` (state feedback) or
+        :class:`FamilyControllers` (output feedback); a design that cannot be
         computed is flagged (``ok`` False, NaN row), never raised.
 
     See Also
     --------
-    RLQRFamily, LQRFamily : the two families provided.
+    RLQRFamily, LQRFamily : state-feedback families.
+    moo.tuning.StaticOutputFeedbackFamily, moo.tuning.PIDFamily, moo.tuning.FixedOrderFamily : output feedback.
     moo.tuning.TuningProblem : what uses a family.
 
     Examples
@@ -128,6 +185,28 @@ class DesignFamily(Protocol):
     True
     >>> fam.gains(np.array([[-1.0, -2.0]])).K
     array([[[-1., -2.]]])
+
+    An output-feedback family in a few lines: a first-order controller
+    ``x_c^+ = a x_c + y``, ``u = c x_c + d y`` with ``z = (a, c, d)``:
+
+    >>> import robustctl as rc
+    >>> from moo.tuning import FamilyControllers
+    >>> class FirstOrder:
+    ...     feedback, n_var = "output", 3
+    ...     xl, xu = np.array([-1.0, -5.0, -5.0]), np.array([1.0, 5.0, 5.0])
+    ...
+    ...     def __init__(self, plant):
+    ...         self.plant, self.n_states, self.n_inputs = plant, plant.n, plant.m
+    ...
+    ...     def gains(self, Z):
+    ...         B = Z.shape[0]
+    ...         batch = rc.ControllerBatch(self.plant, Z[:, 0, None, None], np.ones((B, 1, 1)),
+    ...                                    Z[:, 1, None, None], Z[:, 2, None, None])
+    ...         return FamilyControllers(batch, np.ones(B, bool), np.full(B, "", object))
+    >>> plant = rc.Plant([[1.2]], [[1.0]], 0.1, C=[[1.0]])
+    >>> fam = FirstOrder(plant)
+    >>> fam.gains(np.array([[0.5, 0.0, -0.6]])).controllers.is_stabilizing().tolist()
+    [True]
     """
 
     n_var: int

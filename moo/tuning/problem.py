@@ -30,6 +30,7 @@ value as their objectives, so they are infeasible too.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import Any
 
 import moocore
@@ -39,9 +40,11 @@ from pymoo.core.problem import Problem
 import robustctl as rc
 from robustctl.validation import check_positive_scalar
 
-from ..validation import as_float_array, as_matrix, check_int
-from .families import DesignFamily, FamilyGains, bound_vector, check_bounds, population
-from .goals import check_scenarios, plant_stacks
+from ..validation import as_float_array, as_matrix, check_choice, check_int
+from .families import DesignFamily, FamilyControllers, FamilyGains, bound_vector, check_bounds, population
+from .goals import check_scenarios
+from .loops import Controllers, check_controllers, closed_loops, count, is_output_feedback, take
+from .loops import stability as loop_stability
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
 
@@ -136,6 +139,39 @@ def _goals(goals, kind: str) -> tuple[list, list[str]]:
             raise TypeError(f"{kind}[{i}] must be callable as f(K, plants), got {type(g).__name__}")
     names = [goal_name(g, i, kind) for i, g in enumerate(goals)]
     return goals, names
+
+
+def _with_outputs(plants: Sequence[rc.Plant], plant: rc.Plant) -> list[rc.Plant]:
+    """The scenarios as an output feedback reads them: ``plant``'s ``C``, ``D`` where a scenario has none."""
+    out = []
+    for i, p in enumerate(plants):
+        if p.has_outputs:
+            if p.p != plant.p:
+                raise ValueError(f"scenarios[{i}] has p={p.p} outputs, the family's controllers read p={plant.p}")
+            out.append(p)
+        else:
+            C, D = plant.output_matrices()
+            out.append(replace(p, C=C, D=D))
+    return out
+
+
+def _finite(K: Controllers) -> np.ndarray:
+    """(B,) designs without NaN or inf entries."""
+    if is_output_feedback(K):
+        return np.all([np.isfinite(M).all(axis=(1, 2)) for M in (K.Ac, K.Bc, K.Cc, K.Dc)], axis=0)
+    return np.all(np.isfinite(K), axis=(1, 2))
+
+
+def _zeroed(K: Controllers) -> Controllers:
+    """The designs with their non-finite entries set to 0 (flagged separately), read-only."""
+    if is_output_feedback(K):
+        if _finite(K).all():
+            return K
+        return rc.ControllerBatch(K.plant, *(np.nan_to_num(M, nan=0.0, posinf=0.0, neginf=0.0)
+                                             for M in (K.Ac, K.Bc, K.Cc, K.Dc)))
+    out = np.where(np.isfinite(K), K, 0.0)
+    out.flags.writeable = False
+    return out
 
 
 def _ref_point(value, name: str, default: np.ndarray) -> np.ndarray:
@@ -267,15 +303,23 @@ class TuningProblem(Problem):
                 raise TypeError(f"family must follow the DesignFamily protocol (missing {attr!r}), "
                                 f"got {type(family).__name__}")
         self.family = family
-        self.scenarios = check_scenarios(scenarios, "scenarios")
+        self.feedback = check_choice(getattr(family, "feedback", "state"), "family.feedback", ("state", "output"))
+        plant = getattr(family, "plant", None)
+        if self.feedback == "output" and not isinstance(plant, rc.Plant):
+            raise TypeError("family: an output-feedback family needs a plant attribute (a robustctl.Plant with the "
+                            "outputs its controllers read)")
+        continuous = isinstance(plant, rc.Plant) and plant.dt is None and self.feedback == "output"
+        self.scenarios = check_scenarios(scenarios, "scenarios", continuous=continuous)
         n, m = self.scenarios[0].n, self.scenarios[0].m
         if (family.n_states, family.n_inputs) != (n, m):
-            raise ValueError(f"family gives gains of shape ({family.n_inputs}, {family.n_states}), but the scenarios "
-                             f"have m={m} inputs and n={n} states")
-        plant = getattr(family, "plant", None)
+            raise ValueError(f"family gives controllers for n={family.n_states} states and m={family.n_inputs} "
+                             f"inputs, but the scenarios have m={m} inputs and n={n} states")
         if isinstance(plant, rc.Plant) and plant.dt != self.scenarios[0].dt:
             raise ValueError(f"family.plant has dt={plant.dt} but the scenarios have dt={self.scenarios[0].dt}: "
                              "design the family on a plant of the scenarios' sampling time")
+        if self.feedback == "output":
+            assert isinstance(plant, rc.Plant)
+            self.scenarios = _with_outputs(self.scenarios, plant)
         self.objectives, self.objective_names = _goals(objectives, "objectives")
         if not self.objectives:
             raise ValueError("objectives must not be empty")
@@ -297,7 +341,6 @@ class TuningProblem(Problem):
             self._molsp_ref = self._hv_ref.copy()
         self.hv_ref_source = "given" if self._hv_ref is not None else "sampled designs (not yet drawn)"
         self.reference_samples = check_int(reference_samples, "reference_samples", 2)
-        self._F_s, self._G_s = plant_stacks(self.scenarios)
         self._plants = tuple(self.scenarios)               # what the goals get (immutable)
         self.last_flags = np.zeros(0, dtype=object)
         super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=len(self.constraints), xl=lo, xu=hi, vtype=float)
@@ -341,34 +384,64 @@ class TuningProblem(Problem):
         if self._molsp_ref is None:
             self._molsp_ref = molsp
 
-    # -- gains and closed loops ----------------------------------------------------
+    # -- designs and closed loops ----------------------------------------------------
     @property
     def n_states(self) -> int:
         """Number of states of the scenario plants."""
-        return int(self._F_s.shape[-1])
+        return self.scenarios[0].n
 
     @property
     def n_inputs(self) -> int:
         """Number of inputs of the scenario plants."""
-        return int(self._G_s.shape[-1])
+        return self.scenarios[0].m
 
     def population(self, Z, name: str = "Z") -> np.ndarray:
         """``Z`` as a finite (B, n_var) float array (a single (n_var,) vector becomes B = 1)."""
         return population(Z, self.n_var, name)
 
-    def gains(self, Z) -> FamilyGains:
-        """The family's :class:`~moo.tuning.families.FamilyGains` of a population ``Z`` (B, n_var)."""
+    def gains(self, Z) -> FamilyGains | FamilyControllers:
+        """The family's designs of a population ``Z`` (B, n_var), checked.
+
+        :class:`~moo.tuning.FamilyGains` (``K`` (B, m, n)) for a state-feedback
+        family, :class:`~moo.tuning.FamilyControllers` for an output-feedback
+        one; failed designs have NaN rows and ``ok`` False.
+        """
         z = self.population(Z)
         fg = self.family.gains(z)
-        K = np.asarray(fg.K, dtype=float)
-        if K.shape != (z.shape[0], self.n_inputs, self.n_states):
+        B = z.shape[0]
+        if self.feedback == "output":
+            if not isinstance(fg, FamilyControllers) or len(fg.controllers) != B:
+                raise ValueError(f"family.gains must return FamilyControllers of {B} designs (an output-feedback "
+                                 f"family), got {fg!r}")
+            batch = fg.controllers
+            check_controllers(batch, self.scenarios, "family.gains(...).controllers")
+            mats = (batch.Ac, batch.Bc, batch.Cc, batch.Dc)
+            ok = np.asarray(fg.ok, dtype=bool) & np.all([np.isfinite(M).all(axis=(1, 2)) for M in mats], axis=0)
+            return FamilyControllers(batch, ok, np.asarray(fg.reason, dtype=object))
+        K = np.asarray(getattr(fg, "K", None), dtype=float)
+        if K.shape != (B, self.n_inputs, self.n_states):
             raise ValueError(f"family.gains returned K of shape {K.shape}, expected "
-                             f"({z.shape[0]}, {self.n_inputs}, {self.n_states})")
+                             f"({B}, {self.n_inputs}, {self.n_states})")
         ok = np.asarray(fg.ok, dtype=bool) & np.all(np.isfinite(K), axis=(1, 2))
         return FamilyGains(K=np.where(ok[:, None, None], K, np.nan), ok=ok, reason=np.asarray(fg.reason, dtype=object))
 
-    def check_gains(self, K) -> np.ndarray:
-        """``K`` as a (B, m, n) float array (NaN rows allowed: failed designs); one (m, n) gain becomes B = 1."""
+    def designs(self, Z) -> tuple[Controllers, np.ndarray, np.ndarray]:
+        """``(controllers, ok, reason)`` of a population: gains (B, m, n) or a :class:`robustctl.ControllerBatch`."""
+        fg = self.gains(Z)
+        return (fg.controllers if isinstance(fg, FamilyControllers) else fg.K), fg.ok, fg.reason
+
+    def check_gains(self, K) -> Controllers:
+        """The designs ``K`` checked: (B, m, n) gains, or an output-feedback problem's controllers.
+
+        Gains may have NaN rows (failed designs); one (m, n) gain becomes
+        B = 1. An output-feedback problem takes a
+        :class:`robustctl.ControllerBatch` of the scenarios' plant.
+        """
+        if is_output_feedback(K):
+            return check_controllers(K, self.scenarios, "K")
+        if self.feedback == "output":
+            raise TypeError(f"K must be a robustctl.ControllerBatch for this output-feedback problem, got "
+                            f"{type(K).__name__}")
         K = as_float_array(K, "K")
         if K.ndim == 2:
             K = K[None]
@@ -376,81 +449,92 @@ class TuningProblem(Problem):
             raise ValueError(f"K must have shape (B, {self.n_inputs}, {self.n_states}), got shape {K.shape}")
         return K
 
-    def closed_loops(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
-        """The closed loops ``F_s + G_s K`` (B, S, n, n) of gains ``K`` (B, m, n) (default: the problem's scenarios)."""
-        K = self.check_gains(K)
+    def _plants_of(self, scenarios) -> tuple[rc.Plant, ...]:
         if scenarios is None:
-            F_s, G_s = self._F_s, self._G_s
-        else:
-            F_s, G_s = plant_stacks(check_scenarios(scenarios, "scenarios"))
-        return F_s[None] + G_s[None] @ K[:, None]
+            return self._plants
+        plants = check_scenarios(scenarios, "scenarios", continuous=not self.scenarios[0].is_discrete)
+        if self.feedback == "output":
+            plants = _with_outputs(plants, getattr(self.family, "plant"))  # noqa: B009 - checked in __init__
+        return tuple(plants)
+
+    def closed_loops(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
+        """The closed loops (B, S, N, N) of the designs ``K`` on the scenarios (default the problem's).
+
+        ``F_s + G_s K`` for gains (``N = n``), the loops in ``(x, x_c)`` for a
+        :class:`robustctl.ControllerBatch` (``N = n + n_c``); NaN for designs
+        with non-finite entries.
+        """
+        Kc = self.check_gains(K)
+        A = np.array(closed_loops(_zeroed(Kc), self._plants_of(scenarios)).A)
+        A[~_finite(Kc)] = np.nan
+        return A
 
     def closed_loop_radius(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
-        """Spectral radius (B, S) of the closed loop per scenario (inf for non-finite K)."""
-        return np.asarray(rc.spectral_radius(self.closed_loops(K, scenarios)))      # a stack: an array
+        """Spectral radius (B, S) of the closed loop per scenario (inf for non-finite designs)."""
+        return np.asarray(rc.spectral_radius(self.closed_loops(K, scenarios)))     # inf where A is NaN
 
     def stability(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the worst spectral radius.
+        """``(stable (B, S), rho (B,))``: stability per scenario, and the worst "radius" of the unstable designs.
 
-        ``rho`` is the largest spectral radius over the scenarios of the designs
+        ``rho`` is the largest spectral radius over the scenarios (continuous
+        plants: ``exp`` of the largest real part of the poles) of the designs
         unstable somewhere (NaN for the others, which need no eigenvalues; inf
-        for non-finite K).
+        for non-finite designs and ill-posed loops).
         """
-        A = self.closed_loops(K, scenarios)
-        stable = np.asarray(rc.is_schur_stable(A))                         # a stack: an array
-        rho = np.full(A.shape[0], np.nan)
-        bad = ~stable.all(axis=1)
-        if bad.any():
-            rho[bad] = np.asarray(rc.spectral_radius(A[bad])).max(axis=1)
+        Kc = self.check_gains(K)
+        finite = _finite(Kc)
+        stable, rho = loop_stability(closed_loops(_zeroed(Kc), self._plants_of(scenarios)))
+        stable &= finite[:, None]
+        rho[~finite] = np.inf
         return stable, rho
 
     # -- goals ---------------------------------------------------------------------
-    def _call(self, goal, name: str, K: np.ndarray, plants: tuple[rc.Plant, ...]) -> np.ndarray:
+    def _call(self, goal, name: str, K: Controllers, plants: tuple[rc.Plant, ...]) -> np.ndarray:
         """``goal(K, plants)``, its value checked (``K`` read-only and ``plants`` a tuple: see :meth:`_goals_of`)."""
+        B = count(K)
         value = goal(K, plants)
         arr = np.asarray(value)
         real = arr.dtype.kind in "biuf" or (arr.dtype.kind == "O" and all(
             isinstance(v, (int, float, np.integer, np.floating)) for v in arr.ravel()))
         if not real:
             kind = {"c": "complex", "U": "str", "S": "bytes"}.get(arr.dtype.kind, "objects")
-            raise ValueError(f"goal {name!r} must return real numbers ({K.shape[0]}, one per design), got "
+            raise ValueError(f"goal {name!r} must return real numbers ({B}, one per design), got "
                              f"{type(value).__name__} of {kind} (dtype {arr.dtype})")
         arr = arr.astype(np.float64)
-        if arr.shape != (K.shape[0],):
-            raise ValueError(f"goal {name!r} must return shape ({K.shape[0]},) (one value per design), "
-                             f"got shape {arr.shape}")
+        if arr.shape != (B,):
+            raise ValueError(f"goal {name!r} must return shape ({B},) (one value per design), got shape {arr.shape}")
         return arr
 
     def evaluate_gains(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Goal values of given gains on the scenarios (default the problem's): ``(F (B, n_obj), G (B, n_constr))``.
+        """Goal values of given designs on the scenarios (default the problem's): ``(F (B, n_obj), G (B, n_constr))``.
 
-        Every goal is called once, on the designs that stabilise every
-        scenario; the others, and rows of ``K`` with NaN, get ``+inf``. No
-        penalty, no clipping; a goal's NaN stays NaN.
+        ``K``: gains (B, m, n) or a :class:`robustctl.ControllerBatch`. Every
+        goal is called once, on the designs that stabilise every scenario; the
+        others, and designs with NaN entries, get ``+inf``. No penalty, no
+        clipping; a goal's NaN stays NaN.
         """
-        K = self.check_gains(K)
-        plants = self.scenarios if scenarios is None else check_scenarios(scenarios, "scenarios")
-        finite = np.all(np.isfinite(K), axis=(1, 2))
-        Kf = np.where(finite[:, None, None], K, 0.0)
-        stable, _ = self.stability(Kf, plants)
-        run = finite & stable.all(axis=1)
-        F = np.full((K.shape[0], self.n_obj), np.inf)
-        G = np.full((K.shape[0], self.n_ieq_constr), np.inf)
+        Kc = self.check_gains(K)
+        plants = self._plants_of(scenarios)
+        stable, _ = self.stability(Kc, plants)
+        run = stable.all(axis=1)
+        B = count(Kc)
+        F = np.full((B, self.n_obj), np.inf)
+        G = np.full((B, self.n_ieq_constr), np.inf)
         if run.any():
-            F[run], G[run] = self._goals_of(K[run], tuple(plants))
+            F[run], G[run] = self._goals_of(take(Kc, run), plants)
         return F, G
 
-    def _goals_of(self, K: np.ndarray, plants: tuple[rc.Plant, ...]) -> tuple[np.ndarray, np.ndarray]:
+    def _goals_of(self, K: Controllers, plants: tuple[rc.Plant, ...]) -> tuple[np.ndarray, np.ndarray]:
         """Objective and constraint values (B, n_obj), (B, n_constr) of the designs ``K``, every goal called once.
 
-        Every goal gets the same read-only copy of ``K`` and the same tuple of
-        plants: a goal cannot change what the next one sees (goals that share a
-        simulation recognise the same objects).
+        Every goal gets the same read-only designs (``take`` copies gains
+        read-only; a :class:`robustctl.ControllerBatch` is frozen) and the same
+        tuple of plants: a goal cannot change what the next one sees (goals
+        that share a simulation recognise the same objects).
         """
-        K = np.array(K, dtype=float)
-        K.flags.writeable = False
-        J = np.empty((K.shape[0], self.n_obj))
-        C = np.empty((K.shape[0], self.n_ieq_constr))
+        B = count(K)
+        J = np.empty((B, self.n_obj))
+        C = np.empty((B, self.n_ieq_constr))
         for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
             J[:, j] = self._call(g, name, K, plants)
         for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
@@ -518,16 +602,15 @@ class TuningProblem(Problem):
         return super().evaluate(arr[0] if np.ndim(X) == 1 else arr, *args, **kwargs)
 
     def _evaluate(self, x, out, *args, **kwargs):
-        fg = self.gains(x)                     # checks the population
-        ok, K = fg.ok, fg.K
+        K, ok, reason = self.designs(x)                  # checks the population
         stable, rho = self.stability(K)
         run = ok & stable.all(axis=1)
-        B = K.shape[0]
+        B = count(K)
         J = np.full((B, self.n_obj), np.inf)
         C = np.full((B, self.n_ieq_constr), np.inf)
-        flags = np.where(ok, np.where(run, "", "unstable"), fg.reason).astype(object)
+        flags = np.where(ok, np.where(run, "", "unstable"), reason).astype(object)
         if run.any():
-            J[run], C[run] = self._goals_of(K[run], self._plants)
+            J[run], C[run] = self._goals_of(take(K, run), self._plants)
             vals = np.concatenate([J[run], C[run]], axis=1)
             bad = ~np.all(np.isfinite(vals), axis=1)
             if bad.any():

@@ -42,6 +42,7 @@ import numpy as np
 import robustctl as rc
 
 from ..validation import as_float_array, check_int
+from .loops import count, is_output_feedback
 
 __all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "scenario_errors", "draw_errors",
            "check_weights", "default_weights"]
@@ -263,7 +264,7 @@ def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights,
     """
     K = problem.check_gains(K)
     w = check_weights(weights, problem.n_obj)
-    E = np.empty((K.shape[0], len(plants)))
+    E = np.empty((count(K), len(plants)))
     for p, plant in enumerate(plants):
         F, _ = problem.evaluate_gains(K, [plant])
         with np.errstate(invalid="ignore"):
@@ -284,11 +285,11 @@ class Selection:
     Parameters
     ----------
     index : int
-        Row of the chosen design in the candidate gains.
-    K : (m, n) ndarray
-        Its gain ``u = K x``.
+        Row of the chosen design in the candidates.
+    K : (m, n) ndarray or None
+        Its gain ``u = K x`` (None for an output feedback: see ``controller``).
     controller : robustctl.Controller
-        Its controller.
+        Its controller (a dynamic one for an output-feedback problem).
     counts : (D,) int ndarray
         Simulations won by each candidate.
     winners : (S,) int ndarray
@@ -323,7 +324,7 @@ class Selection:
     """
 
     index: int
-    K: np.ndarray
+    K: np.ndarray | None
     controller: rc.Controller
     counts: np.ndarray
     winners: np.ndarray
@@ -358,8 +359,9 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     ----------
     problem : TuningProblem
         The problem whose objectives make the cumulative error.
-    K : (D, m, n) array_like
-        Candidate gains (e.g. a front's, ``TuningResult.gains``).
+    K : (D, m, n) array_like or robustctl.ControllerBatch
+        Candidate gains (e.g. a front's, ``TuningResult.gains``), or the
+        candidate controllers of an output-feedback problem.
     F : (D, n_obj) array_like, optional
         Their objectives, for the default weights (:func:`default_weights`);
         default: evaluated on the problem's scenarios.
@@ -442,8 +444,8 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     Kc = problem.check_gains(K)
     n_sims = check_int(n_sims, "n_sims", 1)
     rng = _rng(seed)
-    stable, _ = problem.stability(np.where(np.isfinite(Kc), Kc, 0.0))
-    candidates = stable.all(axis=1) & np.all(np.isfinite(Kc), axis=(1, 2))
+    stable, _ = problem.stability(Kc)
+    candidates = stable.all(axis=1)
     if not candidates.any():
         raise ValueError("no candidate stabilises every scenario of the problem (the whole front is penalised): "
                          "nothing to select; tune longer, widen the bounds or revise the goals")
@@ -451,8 +453,8 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
         if F is None:
             F, _ = problem.evaluate_gains(Kc)
         Ff = as_float_array(F, "F")
-        if Ff.shape != (Kc.shape[0], problem.n_obj):
-            raise ValueError(f"F must have shape ({Kc.shape[0]}, {problem.n_obj}) (candidates, objectives), "
+        if Ff.shape != (count(Kc), problem.n_obj):
+            raise ValueError(f"F must have shape ({count(Kc)}, {problem.n_obj}) (candidates, objectives), "
                              f"got shape {Ff.shape}")
         use = candidates & np.all(np.isfinite(Ff), axis=1)
         weights = default_weights(Ff[use] if use.any() else Ff[candidates])
@@ -460,8 +462,14 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     E, draws = draw_errors(problem, Kc, n_sims, rng, sampler, w, progress)
     E[~candidates] = np.inf                     # a design unstable on a scenario never wins
     res = monte_carlo_selection(E)
-    Kbest = Kc[res.best]
-    ctrl = rc.Controller(Kbest, method, problem.scenarios[0] if plant is None else plant,
-                         {"selection_wins": int(res.counts[res.best]), "n_sims": n_sims})
-    return Selection(index=res.best, K=Kbest.copy(), controller=ctrl, counts=res.counts, winners=res.winners,
+    info = {"selection_wins": int(res.counts[res.best]), "n_sims": n_sims}
+    owner = problem.scenarios[0] if plant is None else plant
+    if is_output_feedback(Kc):
+        one = Kc[res.best]
+        Kbest = None
+        ctrl = rc.Controller.dynamic(one.Ac, one.Bc, one.Cc, one.Dc, method, owner, info)
+    else:
+        Kbest = Kc[res.best].copy()
+        ctrl = rc.Controller(Kbest, method, owner, info)
+    return Selection(index=res.best, K=Kbest, controller=ctrl, counts=res.counts, winners=res.winners,
                      errors=E, draws=draws, weights=w)

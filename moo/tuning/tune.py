@@ -30,7 +30,9 @@ __all__ = ["tune", "TuningResult", "select_front", "design_plant"]
 
 def _method(family) -> str:
     name = type(family).__name__
-    return {"RLQRFamily": "rlqr", "LQRFamily": "lqr"}.get(name, "tuned")
+    return {"RLQRFamily": "rlqr", "LQRFamily": "lqr", "StaticOutputFeedbackFamily": "static output feedback",
+            "PIDFamily": "pid", "FixedOrderFamily": "fixed order", "LQGFamily": "lqg",
+            "RobustLQGFamily": "rlqg"}.get(name, "tuned")
 
 
 def design_plant(problem: TuningProblem) -> rc.Plant:
@@ -102,7 +104,7 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
     if len(X) == 0:
         raise ValueError("the front is empty (no design stabilised every scenario): nothing to select")
     X = problem.population(X, "X")
-    return select(problem, problem.gains(X).K, F=F, n_sims=n_sims, seed=seed, sampler=sampler, weights=weights,
+    return select(problem, problem.designs(X)[0], F=F, n_sims=n_sims, seed=seed, sampler=sampler, weights=weights,
                   plant=design_plant(problem), method=_method(problem.family), progress=progress)
 
 
@@ -155,10 +157,15 @@ class TuningResult:
     run: RunResult
 
     @functools.cached_property
-    def gains(self) -> np.ndarray:
-        """Gains (N, m, n) of the front (``u = K x`` for the scenarios; NaN rows: failed designs), designed once."""
-        K = self.problem.gains(self.X).K
-        K.flags.writeable = False
+    def gains(self) -> np.ndarray | rc.ControllerBatch:
+        """The front's designs, computed once.
+
+        Gains (N, m, n) (``u = K x``; NaN rows: failed designs), or the
+        :class:`robustctl.ControllerBatch` of an output-feedback family.
+        """
+        K = self.problem.designs(self.X)[0]
+        if isinstance(K, np.ndarray):
+            K.flags.writeable = False
         return K
 
     def _plant(self) -> rc.Plant:
@@ -171,8 +178,13 @@ class TuningResult:
         design of the run was acceptable, so the front holds penalised ones) is left out.
         """
         method, plant = _method(self.problem.family), self._plant()
-        return [rc.Controller(K, method, plant, {"z": x.copy(), "objectives": f.copy()})
-                for K, x, f in zip(self.gains, self.X, self.F, strict=True) if np.all(np.isfinite(K))]
+        K = self.gains
+        if isinstance(K, rc.ControllerBatch):
+            mats = [(K.Ac[i], K.Bc[i], K.Cc[i], K.Dc[i]) for i in range(len(K))]
+            return [rc.Controller.dynamic(*M, method, plant, {"z": x.copy(), "objectives": f.copy()})
+                    for M, x, f in zip(mats, self.X, self.F, strict=True) if all(np.isfinite(a).all() for a in M)]
+        return [rc.Controller(k, method, plant, {"z": x.copy(), "objectives": f.copy()})
+                for k, x, f in zip(K, self.X, self.F, strict=True) if np.all(np.isfinite(k))]
 
     def select(self, *, n_sims: int = 1000, seed=None, sampler: Callable[[np.random.Generator], rc.Plant] | None = None,
                weights=None) -> Selection:
@@ -217,9 +229,10 @@ class TuningResult:
         ax_f.set_ylabel(self.problem.objective_names[j])
         ax_f.set_title("front")
         ax_f.legend()
-        A = self.problem.closed_loops(selection.K[None])[0]         # (S, n, n)
-        traj = np.empty((A.shape[0], steps + 1, n))
-        traj[:, 0] = x
+        chosen = selection.controller.as_batch() if selection.K is None else selection.K[None]
+        A = self.problem.closed_loops(chosen)[0]                    # (S, N, N): states (x, xc)
+        traj = np.zeros((A.shape[0], steps + 1, A.shape[-1]))
+        traj[:, 0, :n] = x
         for k in range(steps):
             traj[:, k + 1] = np.einsum("sij,sj->si", A, traj[:, k])
         for s in range(A.shape[0]):
