@@ -283,7 +283,10 @@ class RLQRFamily:
     plant : robustctl.Plant
         Nominal discrete-time design model ``(F, G)`` (``n`` states, ``p`` inputs).
     H : (n, l) array_like, optional
-        Uncertainty input; default ``ones((n, 1))`` (the paper's).
+        Uncertainty input; default ``ones((n, 1))`` (the paper's: one
+        uncertainty row reaching every state; the ``repr`` says which). With a
+        model fitted to the plants, its ``H`` (:meth:`robustctl.NormBounded.from_plants`)
+        is the natural choice (user guide, "Choosing the robust LQR's mu, alpha and H").
     Q : (n, n) array_like, optional
         State weight, default identity.
     R : (m, m) array_like, optional
@@ -377,6 +380,7 @@ class RLQRFamily:
             raise ValueError("plant must be stabilisable (with the input map) for RLQRFamily")
         n, m = self.design_plant.n, self.design_plant.m
         self.H = np.ones((n, 1)) if H is None else as_matrix(H, "H", rows=n, rows_what="the number of states")
+        self._H_given = H is not None
         self.l = self.H.shape[1]
         self.Q = np.eye(n) if Q is None else as_matrix(Q, "Q")
         self.R = np.eye(m) if R is None else as_matrix(R, "R")
@@ -431,7 +435,8 @@ class RLQRFamily:
         return K if self.input_map is None else self.input_map @ K
 
     def __repr__(self) -> str:
-        return (f"RLQRFamily(n={self.design_plant.n}, m={self.design_plant.m}, l={self.l}, n_var={self.n_var}, "
+        H = f"given ({self.H.shape[0]}x{self.l})" if self._H_given else f"ones(({self.H.shape[0]}, 1)), the default"
+        return (f"RLQRFamily(n={self.design_plant.n}, m={self.design_plant.m}, l={self.l}, n_var={self.n_var}, H={H}, "
                 f"input_map={'none' if self.input_map is None else self.input_map.shape})")
 
 

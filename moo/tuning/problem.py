@@ -632,3 +632,5 @@ class TuningProblem(Problem):
     def __repr__(self) -> str:
         return (f"TuningProblem(family={self.family!r}, S={len(self.scenarios)}, n_var={self.n_var}, "
                 f"objectives={self.objective_names}, constraints={self.constraint_names})")
+
+    __str__ = __repr__                                  # not pymoo's table
