@@ -243,7 +243,7 @@ class RLQRSchedule:
     plant : Plant
         The nominal plant.
     info : Mapping
-        ``"mu"``, ``"alpha"``, ``"lambda"`` and ``"implementation"`` (as in
+        ``"mu"``, ``"alpha"``, ``"lambda"``, ``"H"`` and ``"implementation"`` (as in
         :func:`rlqr`'s table).
 
     See Also
@@ -309,7 +309,8 @@ def _start(P, name: str, d: Model, definite: bool) -> np.ndarray:
 
 
 def _info(d: Model, implementation: str) -> dict:
-    return {"mu": float(d.mu[0]), "alpha": d.alpha, "lambda": float(d.lam()[0]), "implementation": implementation}
+    return {"mu": float(d.mu[0]), "alpha": d.alpha, "lambda": float(d.lam()[0]), "H": frozen(d.H),
+            "implementation": implementation}
 
 
 def rlqr_gains(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None,
@@ -516,6 +517,7 @@ def rlqr(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, alp
         ``"mu"``                the penalty
         ``"alpha"``             the margin of ``lambda``
         ``"lambda"``            ``(1 + alpha) ||mu H'H||`` (0 without uncertainty)
+        ``"H"``                 (n, p) the ``H`` used (its default filled in)
         ``"implementation"``    ``"kkt"`` or ``"block"``
         ``"iterations"``        doubling (or recursion) steps
         ``"residual"``          relative change of ``P`` in one more recursion step
