@@ -255,3 +255,58 @@ def test_output_feedback_problems_refuse_mismatched_outputs_by_name():
     cont = rc.Plant(-np.eye(4), G0, None, C=C0)
     with pytest.raises(ValueError, match="SpectralRadius needs discrete-time plants"):
         tuning.TuningProblem(tuning.StaticOutputFeedbackFamily(cont), [cont], [tuning.SpectralRadius()])
+
+
+# -- LQG families ----------------------------------------------------------------------------------------------
+def test_lqg_family_is_dlqr_on_dlqe_by_the_separation_principle():
+    rng = np.random.default_rng(6)
+    plant = _random_plant(rng, 3, 2, 2)
+    fam = tuning.LQGFamily(plant, Bw=np.eye(3), log_bound=2.0)
+    assert fam.n_var == 3 + 2 + 3 + 2 and fam.order == 3
+    Z = rng.uniform(fam.xl, fam.xu, (4, fam.n_var))
+    res = fam.gains(Z)
+    assert res.ok.all()
+    Q, R, W, V = fam.weights(Z)
+    for b in range(4):
+        K = -control.dlqr(plant.F, plant.G, Q[b], R[b])[0]
+        Lp = control.dlqe(plant.F, np.eye(3), plant.C, W[b], V[b])[0]
+        want = np.r_[np.linalg.eigvals(plant.F + plant.G @ K), np.linalg.eigvals(plant.F - Lp @ plant.C)]
+        got = np.linalg.eigvals(res.controllers.closed_loops()[b])
+        np.testing.assert_allclose(np.sort_complex(got), np.sort_complex(want), rtol=1e-7, atol=1e-9)
+        # the current estimator's control law: u = K (xc + Lf (y - C xc)), Lf = P C' (C P C' + V)^-1
+        P = control.dlqe(plant.F, np.eye(3), plant.C, W[b], V[b])[1]
+        Lf = P @ plant.C.T @ np.linalg.inv(plant.C @ P @ plant.C.T + V[b])
+        np.testing.assert_allclose(res.controllers.Dc[b], K @ Lf, rtol=1e-7, atol=1e-10)
+
+
+def test_robust_lqg_family_equals_single_rlqr_and_robust_filter_designs():
+    from robustctl.synthesis.lqg import observer_controller
+
+    rng = np.random.default_rng(7)
+    plant = rc.Plant(F0, G0, DT, C=C0)
+    fam = tuning.RobustLQGFamily(plant, W=1e-3 * np.eye(4), V=[[1e-2]])
+    assert fam.n_var == 4 + 1 + 2
+    Z = np.c_[rng.uniform(0.0, 0.5, (3, 5)), rng.uniform(4.0, 36.0, (3, 2))]
+    res = fam.gains(Z)
+    EF, EG, mu, mu_f = fam.decode(Z)
+    for b in np.flatnonzero(res.ok):
+        reg = rc.rlqr(plant, EF[b], EG[b], mu[b], H=fam.H, check_stability=False)
+        est = rc.robust_kalman(plant, 1e-3 * np.eye(4), [[1e-2]], Bw=np.eye(4), H=fam.H, EF=EF[b], EG=EG[b],
+                               mu=mu_f[b])
+        one = observer_controller(reg.K, est)
+        for name in ("Ac", "Bc", "Cc", "Dc"):
+            np.testing.assert_allclose(getattr(res.controllers, name)[b], getattr(one, name), rtol=1e-6, atol=1e-9)
+    assert res.ok.sum() >= 2
+    # a design that cannot be computed is flagged (NaN controller, a reason), never raised for the population
+    wide = fam.gains(np.random.default_rng(0).uniform(fam.xl, fam.xu, (200, fam.n_var)))
+    failed = ~wide.ok
+    assert failed.any() and wide.ok.sum() > 100
+    assert set(wide.reason[failed]) == {"regulator: not converged"} and np.isnan(wide.controllers.Ac[failed]).all()
+
+
+def test_lqg_families_refuse_plants_they_cannot_serve():
+    with pytest.raises(ValueError, match="plant must have measured outputs"):
+        tuning.LQGFamily(rc.Plant(F0, G0, DT))
+    blind = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], DT, C=[[0.0, 1.0]])
+    with pytest.raises(ValueError, match="plant must be detectable"):
+        tuning.RobustLQGFamily(blind)

@@ -48,13 +48,14 @@ from .goals import (
     at_least,
     at_most,
 )
-from .output_feedback import FixedOrderFamily, PIDFamily, StaticOutputFeedbackFamily
+from .output_feedback import FixedOrderFamily, LQGFamily, PIDFamily, RobustLQGFamily, StaticOutputFeedbackFamily
 from .problem import TuningProblem, penalise
 from .selection import Selection, SelectionResult, monte_carlo_selection, select
 from .tune import TuningResult, select_front, tune
 
 __all__ = ["DesignFamily", "FamilyGains", "FamilyControllers", "RLQRFamily", "LQRFamily", "dlqr_gains",
-           "StaticOutputFeedbackFamily", "PIDFamily", "FixedOrderFamily", "TuningProblem", "penalise",
+           "StaticOutputFeedbackFamily", "PIDFamily", "FixedOrderFamily", "LQGFamily", "RobustLQGFamily",
+           "TuningProblem", "penalise",
            "tune", "TuningResult", "select_front", "select", "Selection", "SelectionResult", "monte_carlo_selection",
            "Goal", "Response", "StepTracking", "ErrorGoal", "PeakInput", "SettlingTime", "Overshoot", "SpectralRadius",
            "PoleRegion", "ControllerPoles", "H2Norm", "HinfNorm", "Variance", "RobustMargin", "Bound", "at_most",

@@ -12,7 +12,11 @@ sign:
   T_f)`` acting on ``e = r - y``, so ``K(z) = -C_{PID}(z)``;
 * :class:`FixedOrderFamily` - any controller of order ``k`` (MATLAB's
   ``tunableSS``), its poles parametrised inside a disc so that the search
-  stays well scaled.
+  stays well scaled;
+* :class:`LQGFamily` - the LQR on the Kalman filter's estimate, the weights
+  and noise covariances tuned;
+* :class:`RobustLQGFamily` - the RLQR on the robust filter's estimate, their
+  uncertainty model and penalties tuned (the paper's method with sensors).
 
 Default bounds come from the plant's scales: a gain from output ``i`` to
 input ``j`` ranges over ``+- gain_bound / (||G_j|| ||C_i||)`` (``G_j`` the
@@ -38,10 +42,11 @@ import numpy as np
 import robustctl as rc
 from robustctl.validation import check_plant, check_positive_scalar
 
-from ..validation import check_choice, check_int
-from .families import FamilyControllers, population
+from ..validation import as_matrix, check_choice, check_int
+from .families import FamilyControllers, dlqr_gains, population
 
-__all__ = ["StaticOutputFeedbackFamily", "PIDFamily", "FixedOrderFamily", "gain_scales"]
+__all__ = ["StaticOutputFeedbackFamily", "PIDFamily", "FixedOrderFamily", "LQGFamily", "RobustLQGFamily",
+           "gain_scales", "observer_controllers"]
 
 
 def gain_scales(plant: rc.Plant) -> np.ndarray:
@@ -493,3 +498,332 @@ class FixedOrderFamily(_OutputFamily):
     def __repr__(self) -> str:
         return (f"FixedOrderFamily(order={self.order}, n={self.n_states}, m={self.n_inputs}, p={self.n_outputs}, "
                 f"n_var={self.n_var})")
+
+
+def observer_controllers(plant: rc.Plant, K: np.ndarray, Fe: np.ndarray, Ge: np.ndarray, Lf: np.ndarray,
+                         J: np.ndarray) -> rc.ControllerBatch:
+    r"""The output feedbacks ``u = K x[k|k]`` of state feedbacks on filters' estimates, for stacks (filter form).
+
+    Batched :func:`robustctl.synthesis.lqg.observer_controller`: with
+    ``L_p = F_e L_f + J`` and ``M = I + K L_f D``,
+
+    .. math::
+
+        D_c = M^{-1} K L_f, \quad C_c = M^{-1} K (I - L_f C), \quad
+        A_c = F_e + G_e C_c - L_p (C + D C_c), \quad B_c = L_p (I - D D_c) + G_e D_c .
+
+    Parameters
+    ----------
+    plant : robustctl.Plant
+        With its output model ``C``, ``D``.
+    K : (B, m, n) ndarray
+        State feedbacks ``u = K x``.
+    Fe, Ge, Lf, J : (B, n, n), (B, n, m), (B, n, p), (B, n, p) ndarrays
+        The filters' models, filter gains and innovation terms
+        (:class:`robustctl.EstimatorBatch` of form ``"filter"``).
+
+    Returns
+    -------
+    robustctl.ControllerBatch
+        Controllers of order ``n``; NaN where ``M`` is singular or an input is not finite.
+
+    Examples
+    --------
+    The separation principle: the loop's poles are those of ``F + G K`` and
+    ``F - L_p C`` (python-control's ``dlqr`` and ``dlqe``):
+
+    >>> import numpy as np, control, robustctl as rc
+    >>> from moo.tuning.output_feedback import observer_controllers
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], 0.1, C=[[1.0, 0.0]])
+    >>> K = -control.dlqr(plant.F, plant.G, np.eye(2), [[1.0]])[0]
+    >>> est = rc.kalman_gains(plant, 1e-3 * np.eye(2), [[1e-2]], Bw=np.eye(2))
+    >>> batch = observer_controllers(plant, K[None], est.F, est.G, est.L, est.J)
+    >>> Lp = control.dlqe(plant.F, np.eye(2), plant.C, 1e-3 * np.eye(2), [[1e-2]])[0]
+    >>> want = np.r_[np.linalg.eigvals(plant.F + plant.G @ K), np.linalg.eigvals(plant.F - Lp @ plant.C)]
+    >>> bool(np.allclose(np.sort_complex(np.linalg.eigvals(batch.closed_loops()[0])), np.sort_complex(want)))
+    True
+    """
+    C, D = plant.output_matrices()
+    n, m, p = plant.n, plant.m, plant.p
+    with np.errstate(all="ignore"):
+        Lp = Fe @ Lf + J
+        M = np.eye(m) + K @ Lf @ D
+        ok = np.isfinite(M).all(axis=(1, 2)) & np.isfinite(Lp).all(axis=(1, 2)) & np.isfinite(K).all(axis=(1, 2))
+        if ok.any():
+            ok[ok] &= np.linalg.svd(M[ok], compute_uv=False)[:, -1] > 1e-12 * (1.0 + np.abs(M[ok]).max(axis=(1, 2)))
+        Ms = np.where(ok[:, None, None], M, np.eye(m))
+        KLf = np.where(ok[:, None, None], K @ Lf, 0.0)
+        Dc = np.linalg.solve(Ms, KLf)
+        Cc = np.linalg.solve(Ms, np.where(ok[:, None, None], K @ (np.eye(n) - Lf @ C), 0.0))
+        Ac = Fe + Ge @ Cc - Lp @ (C + D @ Cc)
+        Bc = Lp @ (np.eye(p) - D @ Dc) + Ge @ Dc
+    bad = ~ok[:, None, None]
+    return rc.ControllerBatch(plant, *(np.where(bad, np.nan, X) for X in (Ac, Bc, Cc, Dc)))
+
+
+def _combined(batch: rc.ControllerBatch, ok: np.ndarray, reason: np.ndarray) -> FamilyControllers:
+    """:func:`_result` with the designs' own flags (regulator, estimator) folded in."""
+    res = _result(batch)
+    ok_all = res.ok & ok
+    why = np.where(ok_all, "", np.where(ok, res.reason, reason)).astype(object)
+    if (~ok_all & res.ok).any():
+        mats = (batch.Ac, batch.Bc, batch.Cc, batch.Dc)
+        batch = rc.ControllerBatch(batch.plant, *(np.where(ok_all[:, None, None], M, np.nan) for M in mats))
+        return FamilyControllers(batch, ok_all, why)
+    return FamilyControllers(res.controllers, ok_all, why)
+
+
+class LQGFamily(_OutputFamily):
+    r"""LQG controllers of diagonal weights: the LQR on the steady-state Kalman filter's estimate.
+
+    ``z = (log10 diag Q (n), log10 diag R (m), log10 diag W (nw), log10 diag V (p))``:
+    the regulator's weights and the noise covariances the filter is designed
+    for (design knobs, as in loop-transfer recovery), all designs of a
+    population solved as stacks (:func:`~moo.tuning.dlqr_gains`,
+    :func:`robustctl.kalman_gains`), combined in the filter form
+    (:func:`observer_controllers`).
+
+    Parameters
+    ----------
+    plant : robustctl.Plant
+        Discrete time, with measured outputs; stabilisable and detectable.
+    Bw : (n, nw) array_like, optional
+        The process-noise input of the filter (default ``plant.Bw``, else the identity).
+    log_bound : float
+        Default bounds ``[-log_bound, log_bound]`` of every variable (default 4).
+
+    Attributes
+    ----------
+    n_var : int
+        ``n + m + nw + p``.
+    xl, xu : (n_var,) ndarray
+    order : int
+        ``n`` (the controller's order).
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``plant`` not a discrete-time plant with outputs, not stabilisable or
+        not detectable; ``Bw`` of the wrong shape; a non-positive ``log_bound``.
+
+    See Also
+    --------
+    RobustLQGFamily, robustctl.kalman_gains, moo.tuning.LQRFamily
+
+    Notes
+    -----
+    .. math::
+
+        K = \text{DLQR}(F, G; 10^{z_Q}, 10^{z_R}), \qquad
+        L_f = \text{Kalman}(F, B_w, C; 10^{z_W}, 10^{z_V}), \qquad
+        u = K\, \hat x_{k|k} .
+
+    References
+    ----------
+    .. [1] K. J. Astrom, *Introduction to Stochastic Control Theory*,
+       Academic Press 1970, Ch. 8 (LQG and the separation principle).
+
+    Examples
+    --------
+    ``z = 0`` is ``Q = I``, ``R = 1``, ``W = I``, ``V = 1``; the loop's poles
+    are the LQR's and the Kalman predictor's (python-control):
+
+    >>> import numpy as np, control
+    >>> import robustctl as rc
+    >>> from moo.tuning import LQGFamily
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], 0.1, C=[[1.0, 0.0]])
+    >>> fam = LQGFamily(plant)
+    >>> fam.n_var
+    6
+    >>> batch = fam.gains(np.zeros((1, 6))).controllers
+    >>> K = -control.dlqr(plant.F, plant.G, np.eye(2), [[1.0]])[0]
+    >>> Lp = control.dlqe(plant.F, np.eye(2), plant.C, np.eye(2), [[1.0]])[0]
+    >>> want = np.r_[np.linalg.eigvals(plant.F + plant.G @ K), np.linalg.eigvals(plant.F - Lp @ plant.C)]
+    >>> bool(np.allclose(np.sort_complex(np.linalg.eigvals(batch.closed_loops()[0])), np.sort_complex(want)))
+    True
+    """
+
+    def __init__(self, plant: rc.Plant, *, Bw=None, log_bound: float = 4.0):
+        self._set_plant(plant, "LQGFamily", discrete=True)
+        if not plant.has_outputs:
+            raise ValueError("plant must have measured outputs (C) for LQGFamily; without them use LQRFamily")
+        if not plant.is_stabilizable:
+            raise ValueError("plant must be stabilisable for LQGFamily")
+        if not plant.is_detectable:
+            raise ValueError("plant must be detectable (its unstable modes seen by C) for LQGFamily")
+        self.Bw = _noise_input(plant, Bw)
+        n, m, p, nw = plant.n, plant.m, plant.p, self.Bw.shape[1]
+        self._sizes = (n, m, nw, p)
+        self.order = n
+        self.n_var = n + m + nw + p
+        b = check_positive_scalar(log_bound, "log_bound")
+        self.xl, self.xu = np.full(self.n_var, -b), np.full(self.n_var, b)
+
+    def weights(self, Z) -> tuple[np.ndarray, ...]:
+        """``(Q, R, W, V)`` stacks (diagonal) of a population ``Z``."""
+        z = self._check(Z)
+        out, o = [], 0
+        with np.errstate(over="ignore"):
+            for size in self._sizes:
+                out.append(10.0 ** z[:, o:o + size, None] * np.eye(size))
+                o += size
+        return tuple(out)
+
+    def gains(self, Z) -> FamilyControllers:
+        """:class:`~moo.tuning.FamilyControllers` of a population ``Z`` (B, n_var)."""
+        Q, R, W, V = self.weights(Z)
+        K, _, k_ok = dlqr_gains(self.plant.F, self.plant.G, Q, R)
+        finite = np.isfinite(W).all(axis=(1, 2)) & np.isfinite(V).all(axis=(1, 2)) \
+            & (np.diagonal(V, axis1=1, axis2=2) > 0).all(axis=1)
+        eye_w, eye_p = np.eye(W.shape[-1]), np.eye(V.shape[-1])
+        est = rc.kalman_gains(self.plant, np.where(finite[:, None, None], W, eye_w),
+                              np.where(finite[:, None, None], V, eye_p), Bw=self.Bw, form="filter")
+        ok = k_ok & finite & np.asarray(est.ok, dtype=bool)
+        reason = np.where(~k_ok, "regulator not converged", np.where(~finite, "weights under- or overflow",
+                                                                    np.asarray(est.reason, dtype=object)))
+        batch = observer_controllers(self.plant, np.where(ok[:, None, None], K, np.nan), est.F, est.G, est.L,
+                                     est.J)
+        return _combined(batch, ok, reason)
+
+    def __repr__(self) -> str:
+        n, m, nw, p = self._sizes
+        return f"LQGFamily(n={n}, m={m}, p={p}, nw={nw}, n_var={self.n_var})"
+
+
+class RobustLQGFamily(_OutputFamily):
+    r"""Robust LQG: the RLQR on the robust filter's estimate, their uncertainty parameters tuned.
+
+    The paper's method for a plant with sensors: a decision vector is one
+    candidate uncertainty model ``[dF dG] = H Delta [E_F E_G]`` (shared by
+    the regulator and the filter, as :func:`robustctl.synthesis.lqg.rlqg`) and the two
+    penalties,
+
+    .. math::
+
+        z = \big(\operatorname{vec}_r E_F\ (l n),\ \operatorname{vec}_r E_G\ (l m),\
+        (\log_{10}\mu)^2,\ (\log_{10}\mu_f)^2\big),
+
+    the gain the steady-state RLQR of that model (:func:`robustctl.rlqr_gains`),
+    the estimator the steady-state robust filter (:func:`robustctl.robust_kalman_gains`,
+    filter form, penalty :math:`\mu_f`), combined as :func:`observer_controllers`.
+
+    Parameters
+    ----------
+    plant : robustctl.Plant
+        Discrete time, with measured outputs; stabilisable and detectable.
+    H : (n, l) array_like, optional
+        Uncertainty input; default ``ones((n, 1))`` (the paper's).
+    Q, R : array_like, optional
+        The RLQR's weights (default identities).
+    W, V : array_like, optional
+        The filter's noise covariances (default identities).
+    Bw : (n, nw) array_like, optional
+        The filter's process-noise input (default ``plant.Bw``, else the identity).
+    alpha : float
+        ``lambda = (1 + alpha) ||mu H'H||`` of both (default 0.1).
+    e_bound, log_mu_bound : float
+        Default upper bounds of the ``E`` entries (lower bound 0) and of both
+        ``(log10 mu)^2`` (default 100 and 100).
+
+    Attributes
+    ----------
+    n_var : int
+        ``l (n + m) + 2``.
+    xl, xu : (n_var,) ndarray
+    order : int
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :class:`LQGFamily`; ``H``, ``Q``, ``R``, ``W``, ``V`` of the wrong
+        shape (the message names the matrix), a non-positive ``alpha`` or bound.
+
+    See Also
+    --------
+    LQGFamily, moo.tuning.RLQRFamily, robustctl.synthesis.lqg.rlqg
+
+    References
+    ----------
+    .. [1] D. C. Morais et al., "Robust path-following control design of heavy
+       vehicles based on multiobjective evolutionary optimization", Expert
+       Systems with Applications 192 (2022) 116304.
+    .. [2] J. Y. Ishihara, M. H. Terra, J. P. Cerri, "Optimal robust filtering
+       for systems subject to uncertainties", Automatica 52, 2015.
+
+    Examples
+    --------
+    With no uncertainty (``E = 0``) and large penalties the robust LQG is the
+    LQG of the same weights:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo.tuning import LQGFamily, RobustLQGFamily
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], 0.1, C=[[1.0, 0.0]])
+    >>> robust = RobustLQGFamily(plant).gains(np.array([[0.0, 0.0, 0.0, 144.0, 144.0]])).controllers
+    >>> nominal = LQGFamily(plant).gains(np.zeros((1, 6))).controllers
+    >>> bool(np.allclose(robust.Ac, nominal.Ac, atol=1e-6)), bool(np.allclose(robust.Dc, nominal.Dc, atol=1e-6))
+    (True, True)
+    """
+
+    def __init__(self, plant: rc.Plant, *, H=None, Q=None, R=None, W=None, V=None, Bw=None, alpha: float = 0.1,
+                 e_bound: float = 100.0, log_mu_bound: float = 100.0):
+        self._set_plant(plant, "RobustLQGFamily", discrete=True)
+        if not plant.has_outputs:
+            raise ValueError("plant must have measured outputs (C) for RobustLQGFamily; without them use RLQRFamily")
+        if not plant.is_stabilizable:
+            raise ValueError("plant must be stabilisable for RobustLQGFamily")
+        if not plant.is_detectable:
+            raise ValueError("plant must be detectable (its unstable modes seen by C) for RobustLQGFamily")
+        n, m, p = plant.n, plant.m, plant.p
+        self.H = np.ones((n, 1)) if H is None else as_matrix(H, "H", rows=n, rows_what="the number of states")
+        self.l = self.H.shape[1]
+        self.Q = np.eye(n) if Q is None else as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states")
+        self.R = np.eye(m) if R is None else as_matrix(R, "R", rows=m, cols=m, rows_what="the number of inputs")
+        self.Bw = _noise_input(plant, Bw)
+        nw = self.Bw.shape[1]
+        self.W = np.eye(nw) if W is None else as_matrix(W, "W", rows=nw, cols=nw, rows_what="the columns of Bw")
+        self.V = np.eye(p) if V is None else as_matrix(V, "V", rows=p, cols=p, rows_what="the number of outputs")
+        self.alpha = check_positive_scalar(alpha, "alpha")
+        self.order = n
+        l = self.l
+        self.n_var = l * (n + m) + 2
+        self.xl = np.zeros(self.n_var)
+        self.xu = np.full(self.n_var, check_positive_scalar(e_bound, "e_bound"))
+        self.xu[-2:] = check_positive_scalar(log_mu_bound, "log_mu_bound")
+        self.gains(np.zeros((1, self.n_var)))                 # checks Q, R, W, V against the designs' own checks
+
+    def decode(self, Z) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(EF (B, l, n), EG (B, l, m), mu (B,), mu_filter (B,))`` of a population ``Z``."""
+        z = self._check(Z)
+        if np.any(z[:, -2:] < 0):
+            raise ValueError(f"the last two variables of Z, (log10 mu)^2, must be >= 0, got {z[:, -2:].min():g}")
+        B, l, n, m = z.shape[0], self.l, self.n_states, self.n_inputs
+        EF = z[:, :l * n].reshape(B, l, n).copy()
+        EG = z[:, l * n:l * (n + m)].reshape(B, l, m).copy()
+        with np.errstate(over="ignore"):
+            return EF, EG, 10.0 ** np.sqrt(z[:, -2]), 10.0 ** np.sqrt(z[:, -1])
+
+    def gains(self, Z) -> FamilyControllers:
+        """:class:`~moo.tuning.FamilyControllers` of a population ``Z`` (B, n_var)."""
+        EF, EG, mu, mu_f = self.decode(Z)
+        reg = rc.rlqr_gains(self.plant, EF, EG, mu, Q=self.Q, R=self.R, H=self.H, alpha=self.alpha)
+        est = rc.robust_kalman_gains(self.plant, self.W, self.V, Bw=self.Bw, H=self.H, EF=EF, EG=EG, mu=mu_f,
+                                     alpha=self.alpha, form="filter")
+        r_ok, e_ok = np.asarray(reg.ok, dtype=bool), np.asarray(est.ok, dtype=bool)
+        ok = r_ok & e_ok & np.isfinite(reg.K).all(axis=(1, 2))
+        reason = np.where(~r_ok, np.char.add("regulator: ", np.asarray(reg.reason, dtype=str)),
+                          np.char.add("filter: ", np.asarray(est.reason, dtype=str))).astype(object)
+        batch = observer_controllers(self.plant, np.where(ok[:, None, None], reg.K, np.nan), est.F, est.G, est.L,
+                                     est.J)
+        return _combined(batch, ok, reason)
+
+    def __repr__(self) -> str:
+        return (f"RobustLQGFamily(n={self.n_states}, m={self.n_inputs}, p={self.n_outputs}, l={self.l}, "
+                f"n_var={self.n_var})")
+
+
+def _noise_input(plant: rc.Plant, Bw) -> np.ndarray:
+    """``Bw`` (n rows), else ``plant.Bw``, else the identity (as :func:`robustctl.kalman`)."""
+    if Bw is not None:
+        return as_matrix(Bw, "Bw", rows=plant.n, rows_what="the number of states")
+    return np.eye(plant.n) if plant.Bw is None else np.array(plant.Bw)
