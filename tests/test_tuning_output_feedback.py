@@ -310,3 +310,18 @@ def test_lqg_families_refuse_plants_they_cannot_serve():
     blind = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], DT, C=[[0.0, 1.0]])
     with pytest.raises(ValueError, match="plant must be detectable"):
         tuning.RobustLQGFamily(blind)
+
+
+def test_a_tuned_output_feedback_result_gives_controllers_a_selection_and_a_figure():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    step = tuning.StepTracking(100, width=1, n=4)
+    prob = tuning.TuningProblem(tuning.PIDFamily(PLANT, terms="pi"), [PLANT], [step.error(), step.peak_input()])
+    res = tuning.tune(prob, evals=200, seed=0, pop_size=20)
+    ctrls = res.controllers()
+    assert len(ctrls) == len(res.X) and all(c.is_dynamic and c.method == "pid" and c.is_stabilizing() for c in ctrls)
+    sel = res.select(n_sims=20, seed=0)
+    assert sel.K is None and sel.controller.order == 1
+    np.testing.assert_allclose(sel.controller.Dc, res.gains.Dc[sel.index])
+    assert len(res.plot(sel).axes) == 2

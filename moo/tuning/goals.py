@@ -262,6 +262,8 @@ class Run:
     diverged : (B, S) bool ndarray
     T : int
     dt : float
+    result : robustctl.sim.SimulationResult or robustctl.sim.OutputFeedbackResult
+        The simulator's own result (everything it kept).
     """
 
     errors: np.ndarray | None
@@ -271,7 +273,12 @@ class Run:
     diverged: np.ndarray
     T: int
     dt: float
+    result: Any = None
 
+    @property
+    def states(self) -> np.ndarray:
+        """The plant's states ``x`` (B, S, T, n) (a run that kept its trajectories)."""
+        return self.result.states
 
 class Response:
     r"""A closed-loop response shared by the time-domain goals made from it.
@@ -468,11 +475,11 @@ class Response:
             res = sim.run(K, backend=self.backend)
             errors = res.errors
             run = Run(errors=errors, sq_error_sum=(errors * errors).sum(axis=2), inputs=res.inputs, reference=ref,
-                      diverged=res.diverged, T=T, dt=res.dt)
+                      diverged=res.diverged, T=T, dt=res.dt, result=res)
         else:
             r = sim.run(K, keep_trajectories=trajectories, backend=self.backend)
             run = Run(errors=r.errors, sq_error_sum=r.sq_error_sum, inputs=r.inputs, reference=ref,
-                      diverged=r.diverged, T=T, dt=float(key[0].dt or 0.0))
+                      diverged=r.diverged, T=T, dt=float(key[0].dt or 0.0), result=r)
         self._last = (key, K, run)
         return run
 

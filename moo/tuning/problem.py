@@ -214,7 +214,7 @@ class TuningProblem(Problem):
         the nadir of their acceptable non-dominated designs enlarged by 25 %
         of the front's extent, a point on the scale of good designs. If none
         of the sampled designs is acceptable, ``penalty`` on every objective
-        (valid, but far above good designs). :attr:`hv_ref_source` says which.
+        (valid, but far above good designs). ``hv_ref_source`` says which.
     molsp_ref_point : (n_obj,) array_like, optional
         MO-LSP's leader reference point (MO-LSP chooses its leaders among the
         designs that dominate it); default the sampled one of

@@ -138,7 +138,7 @@ class OutputFeedbackResult:
 
 
 class OutputFeedbackSimulator:
-    """Plants, reference and options of :func:`simulate_output_feedback`, checked once; :meth:`run` takes batches.
+    """Plants, reference and options of :func:`simulate_output_feedback`, checked once; then runs batches.
 
     Parameters
     ----------
