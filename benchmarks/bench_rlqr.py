@@ -37,6 +37,7 @@ import control
 import numpy as np
 
 import robustctl as rc
+from robustctl import _kkt
 from robustctl.models.truck import lqr_weights, truck_plant
 from robustctl.synthesis._rlqr import kernel, steady
 from robustctl.synthesis._rlqr.model import build
@@ -150,10 +151,10 @@ def doubling_rows(repeat: int, plant, Q, R, H, rng) -> None:
         A, Gs, Hs = steady.standard_form(d)
         active = steady.healthy(Hs) & steady.healthy(Gs)
         args = (A, Gs, Hs, steady.DOUBLING_TOL)
-        kernel.doubling(*args, steady.DOUBLING_MAX_STEPS, steady.DIVERGED, active)     # loads (or compiles) it
+        _kkt.doubling(*args, steady.DOUBLING_MAX_STEPS, active)     # loads (or compiles) it
         t_c, t_n = [], []
         for _ in range(repeat):
-            t_c.append(best_of(lambda: kernel.doubling(*args, steady.DOUBLING_MAX_STEPS, steady.DIVERGED,
+            t_c.append(best_of(lambda: _kkt.doubling(*args, steady.DOUBLING_MAX_STEPS,
                                                        active), 3))
             t_n.append(best_of(lambda: steady.doubling_loop(*args, active), 3))
         c, n = min(t_c), min(t_n)

@@ -122,7 +122,7 @@ def healthy(P: np.ndarray, bound: float = DIVERGED) -> np.ndarray:
 
 
 @jit
-def _lu_solve(A, b):
+def lu_solve(A, b):
     """Solve ``A x = b`` in place (``A`` (k, k) becomes its LU factors, ``b`` (k, c) the solution).
 
     Partial pivoting; returns False (``b`` then unspecified) when a pivot is exactly zero.
@@ -177,7 +177,7 @@ def _doubling(A, G, H, tol, max_steps, bound, tiny, steps, settled, active):
                     W[i, j] = s + (1.0 if i == j else 0.0)
                     sol[i, j] = a[i, j]
                     sol[i, n + j] = g[i, j]
-            if not _lu_solve(W, sol):
+            if not lu_solve(W, sol):
                 for i in range(n):
                     for j in range(2 * n):
                         sol[i, j] = np.nan

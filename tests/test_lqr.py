@@ -64,9 +64,16 @@ def test_lqr_bad_weights(kw, err, match):
         rc.design("lqr", plant, **kw)
 
 
-def test_lqr_rejects_continuous_plant():
-    with pytest.raises(ValueError, match="discrete-time"):
-        rc.lqr(rc.Plant(np.eye(2), np.ones((2, 1)), None))
+def test_continuous_lqr_against_python_control():
+    A, B = np.array([[0.0, 1.0], [2.0, -0.5]]), np.array([[0.0], [1.0]])
+    Q, R = np.diag([3.0, 0.2]), np.array([[0.5]])
+    ctrl = rc.lqr(rc.Plant(A, B, None), Q=Q, R=R)
+    K_pc, P_pc, _ = control.lqr(A, B, Q, R)
+    np.testing.assert_allclose(ctrl.K, -K_pc, rtol=1e-10)
+    np.testing.assert_allclose(ctrl.info["P"], P_pc, rtol=1e-10)
+    assert ctrl.is_stabilizing() and ctrl.info["residual"] < 1e-12
+    with pytest.raises(rc.ConvergenceError, match="continuous Riccati equation"):   # an undamped mode not weighted
+        rc.lqr(rc.Plant([[0.0, 1.0], [-1.0, 0.0]], [[0.0], [1.0]], None), Q=np.zeros((2, 2)))
 
 
 _WITHOUT_SLYCOT = r'''

@@ -37,6 +37,7 @@ import pytest
 from conftest import GENERIC_F, GENERIC_G
 
 import robustctl as rc
+from robustctl import _kkt
 from robustctl.models.truck import lqr_weights, truck_plant
 from robustctl.synthesis._rlqr import kernel, steady
 from robustctl.synthesis._rlqr.model import build
@@ -51,9 +52,9 @@ def _numpy_recursion(d, P0, tol, max_iter, diverged):
     return P, iterations, ~settled        # settled implies healthy, so ~active & healthy(P) == settled
 
 
-def _numpy_doubling(A, Gs, H, tol, max_steps, diverged, active):
-    """The numpy doubling loop in the kernel's calling convention."""
-    assert (max_steps, diverged) == (steady.DOUBLING_MAX_STEPS, steady.DIVERGED)
+def _numpy_doubling(A, Gs, H, tol, max_steps, active):
+    """The numpy doubling loop in the compiled one's calling convention (robustctl._kkt.doubling)."""
+    assert max_steps == steady.DOUBLING_MAX_STEPS
     return steady.doubling_loop(A, Gs, H, tol, active)
 
 
@@ -61,7 +62,7 @@ def _numpy_kernel(monkeypatch):
     """Replace every compiled RLQR routine by its numpy reference."""
     monkeypatch.setattr(kernel, "recursion", _numpy_recursion)
     monkeypatch.setattr(kernel, "kkt_step", kkt_step)
-    monkeypatch.setattr(kernel, "doubling", _numpy_doubling)
+    monkeypatch.setattr(_kkt, "doubling", _numpy_doubling)
 
 
 def _rel(a, b):
@@ -134,10 +135,10 @@ def test_lu_solve_matches_numpy_and_reports_exact_singularity():
     for k in (1, 2, 3, 5):
         A, b = rng.standard_normal((k, k)), rng.standard_normal((k, 4))
         A_, x = A.copy(), b.copy()
-        assert kernel._lu_solve(A_, x)
+        assert _kkt.lu_solve(A_, x)
         np.testing.assert_allclose(x, np.linalg.solve(A, b), rtol=1e-12, atol=1e-12)
     A = np.array([[1.0, 2.0], [2.0, 4.0]])                       # exactly singular: zero pivot
-    assert not kernel._lu_solve(A.copy(), np.ones((2, 1)))
+    assert not _kkt.lu_solve(A.copy(), np.ones((2, 1)))
     with pytest.raises(np.linalg.LinAlgError):
         np.linalg.solve(A, np.ones((2, 1)))
 
@@ -281,7 +282,7 @@ def _check_doubling(d, small, large=1e-9, tol=1e-13):
     A, Gs, Hs = steady.standard_form(d)
     active = steady.healthy(Hs) & steady.healthy(Gs)
     H_ref, st_ref, s_ref = steady.doubling_loop(A, Gs, Hs, tol, active)
-    H, st, s = kernel.doubling(A, Gs, Hs, tol, steady.DOUBLING_MAX_STEPS, steady.DIVERGED, active)
+    H, st, s = _kkt.doubling(A, Gs, Hs, tol, steady.DOUBLING_MAX_STEPS, active)
     with np.errstate(invalid="ignore"):
         blown = ~(np.abs(H).max(axis=(1, 2)) < 1e15) | ~(np.abs(H_ref).max(axis=(1, 2)) < 1e15)
     np.testing.assert_array_equal(s[~blown], s_ref[~blown])
@@ -329,7 +330,7 @@ def test_doubling_gives_nan_for_a_singular_design_only():
     H = np.stack([np.eye(n), -np.eye(n), 2 * np.eye(n)])          # I + Gs H = 0 for design 1
     active = np.ones(3, dtype=bool)
     H_ref, st_ref, s_ref = steady.doubling_loop(A, Gs, H, 1e-13, active)
-    H_k, st, s = kernel.doubling(A, Gs, H, 1e-13, steady.DOUBLING_MAX_STEPS, steady.DIVERGED, active)
+    H_k, st, s = _kkt.doubling(A, Gs, H, 1e-13, steady.DOUBLING_MAX_STEPS, active)
     np.testing.assert_array_equal(s, [True, False, True])
     np.testing.assert_array_equal(s, s_ref)
     np.testing.assert_array_equal(st, st_ref)
@@ -407,7 +408,7 @@ def _recursion_in_worker():
     out = rc.rlqr_gains(rc.Plant(GENERIC_F, GENERIC_G, 1.0), z[:, None, :3], z[:, None, 3:4],
                         [np.inf, 10 ** np.sqrt(z[1, 4])], max_iter=50)
     P, it, _ = k.recursion(_generic(z), np.eye(3), TOL, 50, steady.DIVERGED)
-    stats = [k._recursion.stats, k._doubling.stats]                # rlqr_gains ran both
+    stats = [k._recursion.stats, _kkt._doubling.stats]             # rlqr_gains ran both
     return (sum(sum(st.cache_hits.values()) >= 1 for st in stats), sum(sum(st.cache_misses.values()) for st in stats),
             P, it, out.K)
 

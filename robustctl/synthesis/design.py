@@ -15,6 +15,8 @@ METHODS = {
     "rlqr": "robustctl.synthesis.rlqr:rlqr",
     "hinf": "robustctl.synthesis.hinf:hinf",
     "h2": "robustctl.synthesis.h2:h2",
+    "lqg": "robustctl.synthesis.lqg:lqg",
+    "rlqg": "robustctl.synthesis.lqg:rlqg",
 }
 
 
@@ -32,10 +34,10 @@ def design(method: str, plant: Plant, *args, **kwargs) -> Controller:
     >>> ctrl = design("lqr", plant, Q=np.eye(4), R=[[1.0]])
     >>> ctrl.method, bool(np.array_equal(ctrl.K, lqr(plant, Q=np.eye(4), R=[[1.0]]).K))
     ('lqr', True)
-    >>> design("lqg", plant)
+    >>> design("lqq", plant)
     Traceback (most recent call last):
         ...
-    ValueError: method must name a design: unknown design method 'lqg'; valid: h2, hinf, lqr, rlqr
+    ValueError: method must name a design: unknown design method 'lqq'; valid: h2, hinf, lqg, lqr, rlqg, rlqr
     """
     if not isinstance(method, str) or method.lower() not in METHODS:
         raise ValueError(f"method must name a design: unknown design method {method!r}; "

@@ -21,8 +21,8 @@ the filtered estimate, ``u = K x_f`` (it uses ``y[k]`` at once); with
     A_c = F_e + G_e C_c - L_p (C + D C_c), \quad B_c = L_p (I - D D_c) + G_e D_c .
 
 The *predictor* form feeds back ``u = K x_c`` (``D_c = 0``, ``C_c = K``,
-``A_c = F_e + G_e K - L_p (C + D K)``, ``B_c = L_p``); it is also the form in
-continuous time, with ``L_p`` the Kalman gain. For the Kalman filter
+``A_c = F_e + G_e K - L_p (C + D K)``, ``B_c = L_p``); its matrices are also
+those of continuous time, with ``L_p`` the Kalman-Bucy gain. For the Kalman filter
 (``F_e = F``, ``G_e = G``) the closed-loop poles are those of ``F + G K`` and
 of ``F - L_p C`` (the separation principle).
 
@@ -42,7 +42,9 @@ from typing import Any
 
 import numpy as np
 
+from .._kkt import DEFAULT_ALPHA
 from .._validation import as_matrix, check_choice
+from ..errors import NotStabilizingError
 from ..estimation import kalman, robust_kalman
 from ..estimation.estimator import Estimator
 from ..systems.controller import Controller
@@ -117,7 +119,7 @@ def observer_controller(K, estimator: Estimator, *, method: str = "observer",
                   cols_what="the number of states")
     C, D = plant.output_matrices()
     Fe, Ge, Lp = estimator.F, estimator.G, estimator.L_predictor
-    if estimator.form == "filter":
+    if estimator.form == "filter" and plant.is_discrete:   # continuous time: the estimate itself is fed back
         Lf = estimator.L_filter
         Mi = np.eye(plant.m) + K @ Lf @ D
         if np.linalg.svd(Mi, compute_uv=False)[-1] <= 1e-12 * (1.0 + np.linalg.norm(K @ Lf @ D, 2)):
@@ -149,7 +151,8 @@ def lqg(plant: Plant, *, Q=None, R=None, W, V, Bw=None, N=None, form: str = "fil
     N : array_like, optional
         Cross-covariance of the process and measurement noises.
     form : {"filter", "predictor"}
-        Feed back ``x[k|k]`` (default) or ``x[k|k-1]``; continuous time has only the predictor.
+        Feed back ``x[k|k]`` (default) or ``x[k|k-1]``; in continuous time the
+        estimate of the Kalman-Bucy filter (``form`` is ignored).
 
     Returns
     -------
@@ -190,17 +193,18 @@ def lqg(plant: Plant, *, Q=None, R=None, W, V, Bw=None, N=None, form: str = "fil
     >>> K = -control.lqr(plant.F, plant.G, np.eye(2), [[1.0]])[0]
     >>> L = control.lqe(plant.F, np.eye(2), plant.C, np.eye(2), [[0.1]])[0]
     >>> bool(np.allclose(ctrl.Ac, plant.F + plant.G @ K - L @ plant.C)), bool(np.allclose(ctrl.Bc, L))
-    True
+    (True, True)
     """
     check_plant(plant)
     form = check_choice(form, "form", ("filter", "predictor"))
-    est = kalman(plant, W, V, Bw=Bw, N=N, form=form if plant.is_discrete else "predictor")
+    est = kalman(plant, W, V, Bw=Bw, N=N, form=form if plant.is_discrete else "filter")  # Kalman-Bucy: one form
     regulator = lqr(plant, Q=Q, R=R)
     return observer_controller(regulator, est, method="lqg", info={"lqr": regulator, "form": est.form})
 
 
 def rlqg(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, W, V, Bw=None, mu_filter=None,
-         HC=None, EC=None, alpha: float | None = None, form: str = "filter") -> Controller:
+         HC=None, EC=None, alpha: float = DEFAULT_ALPHA, form: str = "filter", check_stability: bool = True
+         ) -> Controller:
     r"""Robust LQG: the robust LQR on the robust filter's estimate, for one norm-bounded uncertainty.
 
     The paper's controller [1]_ for a plant with sensors: :func:`robustctl.rlqr`
@@ -220,10 +224,13 @@ def rlqg(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, W, 
         The filter's penalty parameter; default ``mu``.
     HC, EC : array_like, optional
         Uncertainty of the output matrix, ``dC = HC Delta2 EC``.
-    alpha : float, optional
-        ``lambda = (1 + alpha) ||mu H'H||`` for both; default each function's.
+    alpha : float, default 0.1
+        ``lambda = (1 + alpha) ||mu H'H||`` for both.
     form : {"filter", "predictor"}
         The estimate fed back (see :func:`observer_controller`).
+    check_stability : bool, default True
+        Raise :class:`~robustctl.NotStabilizingError` when the nominal loop
+        is not stable (``False`` returns the design anyway).
 
     Returns
     -------
@@ -233,7 +240,11 @@ def rlqg(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, W, 
 
     Raises
     ------
-    As :func:`robustctl.rlqr` and :func:`robustctl.robust_kalman`.
+    robustctl.NotStabilizingError
+        The robust LQR and the robust filter are each stable but their loop
+        is not (Notes), with ``check_stability`` True.
+    Others
+        As :func:`robustctl.rlqr` and :func:`robustctl.robust_kalman`.
 
     See Also
     --------
@@ -243,6 +254,15 @@ def rlqg(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, W, 
     -----
     With no uncertainty (``EF = 0``, ``EG = 0``) and a large ``mu`` both parts
     tend to their nominal counterparts, and the controller to the LQG.
+
+    The separation principle does not hold: the robust filter runs a
+    modified model ``(F_e, G_e)`` that treats ``EF x + EG u`` as a
+    pseudo-measurement of zero, weighted by ``lambda ~ mu`` (exact at
+    ``mu = inf``). With an input term ``EG`` that pseudo-measurement feeds
+    the control back into the estimate, and at a large ``mu_filter`` the loop
+    can be unstable although the regulator and the filter are each stable;
+    a smaller ``mu_filter``, or ``EG`` left out of the filter's model, is
+    then the remedy (the user guide measures it).
 
     References
     ----------
@@ -265,8 +285,15 @@ def rlqg(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, W, 
     """
     check_plant(plant, discrete_for="rlqg")
     form = check_choice(form, "form", ("filter", "predictor"))
-    extra = {} if alpha is None else {"alpha": alpha}
-    regulator = rlqr(plant, EF, EG, mu, Q=Q, R=R, H=H, **extra)
+    regulator = rlqr(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha)
     est = robust_kalman(plant, W, V, Bw=Bw, H=regulator.info["H"], EF=EF, EG=EG, HC=HC, EC=EC,
-                        mu=mu if mu_filter is None else mu_filter, form=form, **extra)
-    return observer_controller(regulator, est, method="rlqg", info={"rlqr": regulator, "form": form})
+                        mu=mu if mu_filter is None else mu_filter, alpha=alpha, form=form)
+    ctrl = observer_controller(regulator, est, method="rlqg", info={"rlqr": regulator, "form": form})
+    if check_stability and not ctrl.is_stabilizing():
+        radius = float(np.abs(ctrl.closed_loop_poles()).max())
+        raise NotStabilizingError(
+            f"the robust LQG loop is not stable (spectral radius {radius:.6g}) although the robust LQR and the "
+            f"robust filter each are: the filter's pseudo-measurement EF x + EG u = 0 at mu_filter = "
+            f"{est.info.get('mu', mu_filter if mu_filter is not None else mu)} feeds the input back into the "
+            "estimate; use a smaller mu_filter, or pass check_stability=False to get this design anyway")
+    return ctrl

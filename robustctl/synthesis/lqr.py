@@ -30,7 +30,14 @@ from .._validation import as_matrix, check_spd
 from ..errors import ConvergenceError
 from ..systems.controller import Controller
 from ..systems.plant import Plant, check_plant
-from ..systems.stability import UNSTABLE_TOL, check_stabilizable, immovable_modes, is_schur_stable, spectral_radius
+from ..systems.stability import (
+    UNSTABLE_TOL,
+    check_stabilizable,
+    immovable_modes,
+    is_schur_stable,
+    is_stable,
+    spectral_radius,
+)
 
 __all__ = ["lqr", "dare"]
 
@@ -211,12 +218,13 @@ def _dare(F, G, Q, R) -> tuple[np.ndarray, str, np.ndarray, float]:
 
 
 def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
-    r"""Discrete-time LQR state feedback ``u = K x`` (``K = -control.dlqr(...)[0]``).
+    r"""LQR state feedback ``u = K x`` (``K = -control.dlqr(...)[0]``, or ``-control.lqr`` in continuous time).
 
     Parameters
     ----------
     plant : Plant
-        Discrete-time plant.
+        Discrete-time plant, or continuous-time (``dt=None``: the continuous
+        Riccati equation, by scipy's ``solve_continuous_are``).
     Q : (n, n) array_like, optional
         State weight, symmetric positive semidefinite; default identity.
     R : (m, m) array_like, optional
@@ -240,8 +248,7 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
         e.g. ``(Q^1/2, F)`` has an unobservable mode on the unit circle (an
         integrator whose state ``Q`` does not weight); the message says why.
     ValueError
-        A continuous-time plant, weights of the wrong shape or not positive
-        (semi)definite.
+        Weights of the wrong shape or not positive (semi)definite.
 
     See Also
     --------
@@ -263,7 +270,9 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     stabilisable and ``(Q^1/2, F)`` has no unobservable mode on the unit
     circle [2]_. It is accepted when its residual, relative to the sum of
     the norms of the equation's terms (a backward error), is below 1e-8 and
-    ``F + G K`` is Schur stable.
+    ``F + G K`` is Schur stable. In continuous time ``P`` solves
+    ``A'P + PA - P B R^-1 B'P + Q = 0`` and ``K = -R^-1 B'P``, accepted on
+    the same relative residual and a stable ``A + B K``.
 
     References
     ----------
@@ -292,8 +301,32 @@ def lqr(plant: Plant, *, Q=None, R=None) -> Controller:
     >>> bool(np.abs(res).max() < 1e-9 * np.abs(P).max())
     True
     """
-    check_plant(plant, discrete_for="lqr")
+    check_plant(plant)
     Q, R = _weights(plant, Q, R)
     check_stabilizable(plant)
+    if not plant.is_discrete:
+        P, K, residual = _care(plant.F, plant.G, Q, R)
+        return Controller(K, "lqr", plant, {"P": P, "backend": "scipy", "residual": residual})
     P, backend, K, residual = _dare(plant.F, plant.G, Q, R)
     return Controller(K, "lqr", plant, {"P": P, "backend": backend, "residual": residual})
+
+
+def _care(A, B, Q, R) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(P, K, relative residual)`` of the continuous Riccati equation ``A'P + PA - PBR^-1B'P + Q = 0``."""
+    why = "(is (A, B) stabilisable and (Q^1/2, A) detectable on the imaginary axis?)"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            P = scipy.linalg.solve_continuous_are(A, B, Q, R)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError, Warning) as exc:
+        raise ConvergenceError(f"no stabilising solution of the continuous Riccati equation {why}; scipy: "
+                               f"{type(exc).__name__}: {exc}") from None
+    P = 0.5 * (P + P.T)
+    K = -np.linalg.solve(R, B.T @ P)
+    PBK = P @ B @ K
+    terms = 2 * np.linalg.norm(A.T @ P) + np.linalg.norm(PBK) + np.linalg.norm(Q)
+    residual = float(np.linalg.norm(A.T @ P + P @ A + PBK + Q) / max(terms, np.finfo(float).tiny))
+    if not (np.all(np.isfinite(P)) and residual < _RESIDUAL_TOL and is_stable(A + B @ K, discrete=False)):
+        raise ConvergenceError(f"no stabilising solution of the continuous Riccati equation {why}; scipy's has a "
+                               f"relative residual {residual:.3g}")
+    return P, K, residual

@@ -117,12 +117,13 @@ from typing import Any
 
 import numpy as np
 
+from .._kkt import DEFAULT_ALPHA
 from .._validation import as_matrix, check_bool, check_choice, check_int, check_positive_scalar, check_spd, frozen
 from ..errors import ConvergenceError, NotStabilizingError
 from ..systems.controller import Controller
 from ..systems.plant import Plant
 from ..systems.stability import STABILITY_MARGIN, check_stabilizable, is_schur_stable, spectral_radius
-from ._rlqr.model import DEFAULT_ALPHA, Model, build
+from ._rlqr.model import Model, build
 from ._rlqr.steady import DEFAULT_MAX_ITER, DEFAULT_TOL, steady_state
 from ._rlqr.step import block_steps, kkt_step, rlqr_step, rlqr_step_block
 

@@ -17,7 +17,7 @@ def noise_covariance(A, Bw, W, dt: float) -> np.ndarray:
     (``E w(t) w(s)' = W delta(t - s)``), the sampled state obeys
     ``x[k+1] = F x[k] + v[k]`` with ``F = e^{A dt}`` and ``v[k]`` white with
     covariance ``Wd`` below; a discrete plant with ``Bw = I`` and ``W = Wd``
-    is its exact model (e.g. for the Kalman filter, ``robustctl.kalman``).
+    is its exact model (e.g. for :func:`robustctl.kalman`).
 
     Parameters
     ----------

@@ -1,13 +1,15 @@
-"""Compiled (numba) kernels of the RLQR step, the plain recursion and the doubling steps.
+"""Compiled (numba) kernels of the RLQR step and the plain recursion.
 
-:func:`kkt_step`, :func:`recursion` and :func:`doubling` compute, design by
-design in one compiled loop, what ``robustctl.synthesis._rlqr.step.kkt_step``,
-``robustctl.synthesis._rlqr.steady.recursion`` and ``robustctl.synthesis._rlqr.steady.doubling_loop``
-compute with stacked numpy calls (those stay the references the tests
-compare with). On the small systems of the MOPs (``n = 3`` or 4, ``m = l = 1``
-or 2) numpy's cost is its per-call overhead, about 75 us per step whatever
-the batch; the kernel takes about 1 us per design and recursion step and
-0.4 us per design and doubling step (``benchmarks/bench_rlqr.py``).
+:func:`kkt_step` and :func:`recursion` compute, design by design in one
+compiled loop, what ``robustctl.synthesis._rlqr.step.kkt_step`` and
+``robustctl.synthesis._rlqr.steady.recursion`` compute with stacked numpy
+calls (those stay the references the tests compare with); the doubling steps
+are the compiled ``robustctl._kkt.doubling``, shared with the robust filter
+(its numpy reference is ``robustctl.synthesis._rlqr.steady.doubling_loop``).
+On the small systems of the MOPs (``n = 3`` or 4, ``m = l = 1`` or 2)
+numpy's cost is its per-call overhead, about 75 us per step whatever the
+batch; the kernel takes about 1 us per design and recursion step
+(``benchmarks/bench_rlqr.py``).
 
 Same arithmetic, same rules:
 
@@ -16,23 +18,21 @@ Same arithmetic, same rules:
   batch is ``soft``, the KKT solve, ``L = (I + S P)^-1 Lc``,
   ``P = sym(Q + K'RK + lambda^-1 nu'nu + Lc' Pt Lc)``); only the rounding of
   the sums and the solves differs from numpy/LAPACK (a few ulps per step);
-  the doubling step is that of ``doubling_loop``, with ``(I + Gs H)^-1 [A, Gs]``
-  by the same LU;
-* the solves are LU with partial pivoting (as LAPACK's ``getrf``: the first
-  largest pivot, multipliers scaled by the pivot's reciprocal); an exactly
-  zero pivot is a singular system and gives NaN for that solve's result of
-  that design only, as ``robustctl.synthesis._rlqr.step.solve`` does;
+* the solves are ``robustctl._kkt.lu_solve``, LU with partial pivoting (as
+  LAPACK's ``getrf``: the first largest pivot, multipliers scaled by the
+  pivot's reciprocal); an exactly zero pivot is a singular system and gives
+  NaN for that solve's result of that design only, as
+  ``robustctl._kkt.solve`` does;
 * the recursion stops a design when one step changes ``P`` by less than
   ``tol`` (relative Frobenius norm) or ``P`` is not healthy (an entry not
-  below ``robustctl.synthesis._rlqr.steady.DIVERGED`` in magnitude, or NaN), after
-  at most ``max_iter`` steps; the doubling likewise with its own ``tol``
-  (on ``H``) and ``max_steps``.
+  below ``robustctl._kkt.DIVERGED`` in magnitude, or NaN), after at most
+  ``max_iter`` steps.
 
 Compilation: ``cache=True``, ``nogil=True`` (:func:`robustctl._jit.jit`),
-two entry points (``_recursion``, whose single step is ``max_iter = 1``, and
-``_doubling``), each compiled once on a fresh clone (slice assignments cost
-twice as much to compile and are written as loops), then loaded from the
-cache in each new process (``benchmarks/bench_experiment.py`` measures both).
+one entry point (``_recursion``, whose single step is ``max_iter = 1``),
+compiled once on a fresh clone (slice assignments cost twice as much to
+compile and are written as loops), then loaded from the cache in each new
+process (``benchmarks/bench_experiment.py`` measures both).
 """
 
 from __future__ import annotations
@@ -40,49 +40,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..._jit import jit
+from ..._kkt import lu_solve
 from .model import Model
 from .step import Step
 
-__all__ = ["doubling", "kkt_step", "recursion"]
+__all__ = ["kkt_step", "recursion"]
 
 _TINY = np.finfo(float).tiny
-
-
-@jit
-def _lu_solve(A, b):
-    """Solve ``A x = b`` in place (``A`` (k, k) becomes its LU factors, ``b`` (k, c) the solution).
-
-    Partial pivoting; returns False (and leaves ``b`` unspecified) when a pivot is exactly zero.
-    """
-    k, c = b.shape
-    for j in range(k):
-        p, big = j, abs(A[j, j])
-        for i in range(j + 1, k):
-            if abs(A[i, j]) > big:
-                p, big = i, abs(A[i, j])
-        if A[p, j] == 0.0:
-            return False
-        if p != j:
-            for q in range(k):
-                A[j, q], A[p, q] = A[p, q], A[j, q]
-            for q in range(c):
-                b[j, q], b[p, q] = b[p, q], b[j, q]
-        r = 1.0 / A[j, j]
-        for i in range(j + 1, k):
-            f = A[i, j] * r
-            A[i, j] = f
-            for q in range(j + 1, k):
-                A[i, q] -= f * A[j, q]
-            for q in range(c):
-                b[i, q] -= f * b[j, q]
-    for j in range(k - 1, -1, -1):
-        r = 1.0 / A[j, j]
-        for q in range(c):
-            s = b[j, q]
-            for t in range(j + 1, k):
-                s -= A[j, t] * b[t, q]
-            b[j, q] = s * r
-    return True
 
 
 @jit
@@ -143,7 +107,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
     if soft:                                            # Pt = sym((I + P S)^-1 P)
         _eye_plus_product(P, S, M)
         _copy(P, Lc)
-        if not _lu_solve(M, Lc):
+        if not lu_solve(M, Lc):
             _fill(Lc, np.nan)
         for i in range(n):
             for j in range(n):
@@ -170,7 +134,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
             kkt[m + r, m + q] = -li * (1.0 if r == q else 0.0)
         for j in range(n):
             sol[m + r, j] = -EF[r, j]
-    if not _lu_solve(kkt, sol):
+    if not lu_solve(kkt, sol):
         _fill(sol, np.nan)
     _copy(sol, K)
     for i in range(n):                                  # Lc = F + G K
@@ -182,7 +146,7 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
     _copy(Lc, L)
     if soft:                                            # L = (I + S P)^-1 Lc
         _eye_plus_product(S, P, M)
-        if not _lu_solve(M, L):
+        if not lu_solve(M, L):
             _fill(L, np.nan)
     # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt; Pt, last read
     # for Lc'Pt, then takes (Lc'Pt) Lc
@@ -244,70 +208,6 @@ def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, ti
             act = not change < tol and _healthy(Pn, bound)
         iterations[b] = it
         active[b] = act
-
-
-@jit
-def _doubling(A, Gs, H, tol, max_steps, bound, tiny, steps, settled, active):
-    """The doubling loop of ``robustctl.synthesis._rlqr.steady.doubling`` for every ``active`` design.
-
-    ``A``, ``Gs``, ``H`` (B, n, n) are overwritten with each design's last iterate; per step
-    ``W = I + Gs H``, ``[WA, WG] = W^-1 [A, Gs]``, ``H <- sym(H + (A'H) WA)``, ``A <- A WA``,
-    ``Gs <- sym(Gs + (A WG) A')``, until ``H`` changes by less than ``tol`` or is not healthy.
-    """
-    n = H.shape[1]
-    W, sol, AH, AW, hn = np.empty((n, n)), np.empty((n, 2 * n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
-    for b in range(H.shape[0]):
-        a, g, h = A[b], Gs[b], H[b]
-        k = 0
-        while active[b] and k < max_steps:
-            k += 1
-            _eye_plus_product(g, h, W)
-            for i in range(n):
-                for j in range(n):
-                    sol[i, j] = a[i, j]
-                    sol[i, n + j] = g[i, j]
-            if not _lu_solve(W, sol):
-                _fill(sol, np.nan)
-            _product(a.T, h, AH)                          # h_new = sym(h + (a'h) WA)
-            _product(AH, sol[:, :n], hn)
-            for i in range(n):
-                for j in range(n):
-                    hn[i, j] = h[i, j] + hn[i, j]
-            for i in range(n):
-                for j in range(i, n):
-                    v = 0.5 * (hn[i, j] + hn[j, i])
-                    hn[i, j] = v
-                    hn[j, i] = v
-            ok = _healthy(hn, bound)
-            change = _relchange(hn, h, tiny) if ok else np.inf
-            _product(a, sol[:, n:], AW)                   # g = sym(g + (a WG) a')
-            _product(AW, a.T, W)
-            for i in range(n):
-                for j in range(n):
-                    W[i, j] = g[i, j] + W[i, j]
-            for i in range(n):
-                for j in range(n):
-                    g[i, j] = 0.5 * (W[i, j] + W[j, i])
-            _product(a, sol[:, :n], AW)                   # a = a WA
-            _copy(AW, a)
-            _copy(hn, h)
-            steps[b] += 1
-            settled[b] |= change < tol
-            active[b] = change >= tol and ok
-
-
-def doubling(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, max_steps: int, diverged: float,
-             active: np.ndarray):
-    """The doubling loop of ``robustctl.synthesis._rlqr.steady.doubling``, compiled, from ``(A, Gs, H)`` (B, n, n).
-
-    ``active``: the designs to iterate (the others are returned as given, 0 steps).
-    Returns ``(H, steps, settled)`` as the numpy loop does.
-    """
-    A, Gs, H = (np.array(x, dtype=float, order="C") for x in (A, Gs, H))
-    steps, settled = np.zeros(H.shape[0], dtype=np.int64), np.zeros(H.shape[0], dtype=bool)
-    _doubling(A, Gs, H, float(tol), int(max_steps), float(diverged), _TINY, steps, settled,
-              np.array(active, dtype=bool))
-    return H, steps.astype(int), settled
 
 
 def _args(d: Model):

@@ -6,16 +6,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._kkt import check_penalty
 from ..._validation import as_batch, as_float_array, as_matrix, check_positive_scalar
 from ...errors import RankConditionError
 from ...systems.plant import check_plant
 from ...systems.uncertainty import check_norm_bounded
 from ..lqr import _weights
 
-#: Default margin of ``lambda = (1 + alpha) ||mu H'H||``.
-DEFAULT_ALPHA = 0.1
-#: Smallest accepted penalty ``mu`` (``1/mu`` enters products with ``P``).
-MU_MIN = 1e-100
 #: ``EG`` has full row rank when its smallest singular value exceeds this times its largest.
 RANK_TOL = 1e-12
 
@@ -100,24 +97,6 @@ def _norm2(H: np.ndarray) -> float:
     return float(np.linalg.norm(H, 2) ** 2) if H.size else 0.0
 
 
-def _check_mu(mu, batch: bool) -> np.ndarray:
-    """Penalties in ``[MU_MIN, inf]``: a scalar, or (batch) a scalar or 1-D array."""
-    if mu is None:
-        raise TypeError("mu is required: a positive number (np.inf allowed)")
-    arr = as_float_array(mu, "mu")
-    if np.any(np.isnan(arr)):
-        raise ValueError("mu must not be NaN")
-    if np.any(arr <= 0):
-        raise ValueError(f"mu must be > 0 (np.inf allowed), got min {arr.min():g}")
-    if np.any(arr < MU_MIN):
-        raise ValueError(f"mu must be >= {MU_MIN:g} (or np.inf), got min {arr.min():g}")
-    if not batch and arr.shape != ():
-        raise TypeError(f"mu must be a scalar for rlqr (use rlqr_gains for batches), got shape {arr.shape}")
-    if arr.ndim > 1:
-        raise ValueError(f"mu must be a scalar or 1-D array of shape (B,), got shape {arr.shape}")
-    return np.atleast_1d(arr)
-
-
 def _uncertainty(plant, EF, EG, H, uncertainty):
     """``(EF, EG, H)`` from the explicit matrices or from ``uncertainty``, never both."""
     if uncertainty is None:
@@ -153,7 +132,7 @@ def build(plant, EF, EG, mu, *, Q, R, H, alpha, uncertainty=None, batch: bool) -
     EF = _as_designs(EF, "EF", (None, n), ("", "the number of states"), batch)
     l = EF.shape[1]
     EG = _as_designs(EG, "EG", (l, m), ("the rows of EF", "the number of inputs"), batch)
-    mu = _check_mu(mu, batch)
+    mu = check_penalty(mu, batch=batch, what="rlqr (use rlqr_gains for batches)")
     sizes = {EF.shape[0], EG.shape[0], mu.shape[0]} - {1}
     if len(sizes) > 1:
         raise ValueError(f"batch sizes differ: EF {EF.shape[0]}, EG {EG.shape[0]}, mu {mu.shape[0]}")

@@ -11,7 +11,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..._kkt import solve, sym
+from ... import _kkt
+from ..._kkt import DIVERGED, healthy, relchange, solve, stein, sym
 from ...systems.stability import is_schur_stable
 from .model import Model
 from .step import Step, kkt_step
@@ -20,8 +21,6 @@ from .step import Step, kkt_step
 DEFAULT_TOL = 1e-10
 #: Most steps of the plain recursion.
 DEFAULT_MAX_ITER = 10_000
-#: ``|P|`` beyond this: the recursion is diverging.
-DIVERGED = 1e250
 #: Doubling converges quadratically, so it runs well past ``tol``: to ``min(DOUBLING_RATIO * tol, DOUBLING_TOL)``.
 DOUBLING_RATIO = 1e-3
 DOUBLING_TOL = 1e-13
@@ -29,12 +28,8 @@ DOUBLING_TOL = 1e-13
 DOUBLING_MAX_STEPS = 64
 #: Newton corrections of a doubling result that missed the acceptance test.
 NEWTON_STEPS = 3
-#: Smith iteration for a Stein equation: stop when the increment is below this, relative to the largest entry.
-STEIN_TOL = 1e-17
-STEIN_MAX_SQUARINGS = 60
 
 StepFunction = Callable[[np.ndarray, Model], Step]
-_TINY = np.finfo(float).tiny
 
 
 class Evaluation(NamedTuple):
@@ -72,21 +67,6 @@ class SteadyState(NamedTuple):
     iterations: np.ndarray
     residual: np.ndarray
     reason: np.ndarray
-
-
-def _fro(X: np.ndarray) -> np.ndarray:
-    """Batched Frobenius norm (``np.linalg.norm(X, axis=(1, 2))`` without its Python overhead)."""
-    return np.sqrt(np.add.reduce(X * X, axis=(1, 2)))
-
-
-def relchange(P_new: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Relative change ``||P_new - P||_F / ||P_new||_F`` of every design."""
-    return _fro(P_new - P) / np.maximum(_fro(P_new), _TINY)
-
-
-def healthy(P: np.ndarray) -> np.ndarray:
-    """Designs whose ``P`` is finite and not diverging."""
-    return np.abs(P).max(axis=(1, 2)) < DIVERGED
 
 
 def evaluate(X: np.ndarray, d: Model, step: StepFunction) -> Evaluation:
@@ -164,11 +144,11 @@ def doubling(d: Model, tol: float):
     ``settled`` is False where ``H_k`` blew up or kept changing for
     ``DOUBLING_MAX_STEPS`` doublings (no stabilising fixed point). The
     standard form is built with numpy, the doubling steps run in the compiled
-    kernel (:func:`doubling_loop` is their numpy reference).
+    kernel shared with the robust filter (``robustctl._kkt.doubling``;
+    :func:`doubling_loop` is their numpy reference).
     """
-    from . import kernel as _kernel
     A, Gs, H = standard_form(d)
-    return _kernel.doubling(A, Gs, H, tol, DOUBLING_MAX_STEPS, DIVERGED, healthy(H) & healthy(Gs))
+    return _kkt.doubling(A, Gs, H, tol, DOUBLING_MAX_STEPS, healthy(H) & healthy(Gs))
 
 
 def standard_form(d: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -187,7 +167,7 @@ def standard_form(d: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def doubling_loop(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, active: np.ndarray):
     """The doubling steps of :func:`doubling` from :func:`standard_form`, with stacked numpy calls.
 
-    The reference of the compiled loop (``robustctl.synthesis._rlqr.kernel.doubling``, same
+    The reference of the compiled loop (``robustctl._kkt.doubling``, same
     operations in the same order). Returns ``(H, steps, settled)``.
     """
     A, Gs, H, active = A.copy(), Gs.copy(), H.copy(), active.copy()
@@ -212,18 +192,6 @@ def doubling_loop(A: np.ndarray, Gs: np.ndarray, H: np.ndarray, tol: float, acti
             settled[idx] |= change < tol
             active[idx] &= (change >= tol) & ok
     return H, steps, settled
-
-
-def stein(A: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """Solve ``X = A' X A + C`` (batched, ``rho(A) < 1``) by Smith's doubling iteration."""
-    X, Ak = C.copy(), A.copy()
-    for _ in range(STEIN_MAX_SQUARINGS):
-        inc = Ak.swapaxes(1, 2) @ X @ Ak
-        X = X + inc
-        Ak = Ak @ Ak
-        if np.all(np.abs(inc) <= STEIN_TOL * np.abs(X).max(axis=(1, 2), keepdims=True)):
-            break
-    return sym(X)
 
 
 def newton(d: Model, P: np.ndarray, tol: float) -> tuple[Evaluation, np.ndarray]:

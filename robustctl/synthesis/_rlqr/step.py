@@ -9,10 +9,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..._kkt import solve, sym
+from ..._kkt import DEFAULT_ALPHA, solve, sym
 from ..._validation import as_matrix, check_spd
 from ...systems.plant import Plant
-from .model import DEFAULT_ALPHA, Model, _norm2, build
+from .model import Model, _norm2, build
 
 
 class Step(NamedTuple):
