@@ -504,7 +504,7 @@ def observer_controllers(plant: rc.Plant, K: np.ndarray, Fe: np.ndarray, Ge: np.
                          J: np.ndarray) -> rc.ControllerBatch:
     r"""The output feedbacks ``u = K x[k|k]`` of state feedbacks on filters' estimates, for stacks (filter form).
 
-    Batched :func:`robustctl.synthesis.lqg.observer_controller`: with
+    Batched :func:`robustctl.observer_controller`: with
     ``L_p = F_e L_f + J`` and ``M = I + K L_f D``,
 
     .. math::
@@ -608,7 +608,7 @@ class LQGFamily(_OutputFamily):
 
     See Also
     --------
-    RobustLQGFamily, robustctl.kalman_gains, moo.tuning.LQRFamily
+    RobustLQGFamily, robustctl.lqg, robustctl.kalman_gains, moo.tuning.LQRFamily
 
     Notes
     -----
@@ -695,7 +695,7 @@ class RobustLQGFamily(_OutputFamily):
 
     The paper's method for a plant with sensors: a decision vector is one
     candidate uncertainty model ``[dF dG] = H Delta [E_F E_G]`` (shared by
-    the regulator and the filter, as :func:`robustctl.synthesis.lqg.rlqg`) and the two
+    the regulator and the filter, as :func:`robustctl.rlqg`) and the two
     penalties,
 
     .. math::
@@ -740,7 +740,7 @@ class RobustLQGFamily(_OutputFamily):
 
     See Also
     --------
-    LQGFamily, moo.tuning.RLQRFamily, robustctl.synthesis.lqg.rlqg
+    LQGFamily, moo.tuning.RLQRFamily, robustctl.rlqg
 
     References
     ----------
