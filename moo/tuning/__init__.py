@@ -1,12 +1,16 @@
-"""Tune a robust state feedback for your own plant: the paper's method as a tool.
+"""Tune a robust controller for your own plant: the paper's method as a tool, with the full state or with sensors.
 
-A *design family* maps a decision vector ``z`` to a gain (:class:`RLQRFamily`,
-:class:`LQRFamily`, or any object of the :class:`DesignFamily` protocol); a
-:class:`TuningProblem` scores every design of a population against a set of
-scenario plants with goals ``f(K, plants) -> (B,)`` (objectives; constraints
-hold where ``<= 0``); :func:`tune` runs a MOEA with MO-LSP on it and returns a
-:class:`TuningResult`, whose :meth:`~TuningResult.select` picks one design by
-the paper's Monte Carlo selection.
+A *design family* maps a decision vector ``z`` to a controller: a state
+feedback (:class:`RLQRFamily`, :class:`LQRFamily`) or a dynamic output
+feedback of the plant's measured outputs (:class:`StaticOutputFeedbackFamily`,
+:class:`PIDFamily`, :class:`FixedOrderFamily`, :class:`LQGFamily`,
+:class:`RobustLQGFamily`), or any object of the :class:`DesignFamily`
+protocol; a :class:`TuningProblem` scores every design of a population
+against a set of scenario plants with goals ``f(K, plants) -> (B,)``
+(objectives; constraints hold where ``<= 0``; ``K`` the gains or an
+:class:`robustctl.ControllerBatch`); :func:`tune` runs a MOEA with MO-LSP on
+it and returns a :class:`TuningResult`, whose :meth:`~TuningResult.select`
+picks one design by the paper's Monte Carlo selection.
 
 >>> import numpy as np, robustctl as rc
 >>> from moo import tuning

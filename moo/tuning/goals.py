@@ -1,29 +1,38 @@
-r"""Tuning goals: objectives and constraints on state-feedback gains over a set of plants.
+r"""Tuning goals: objectives and constraints on a population's closed loops over a set of plants.
 
-A goal is any callable ``goal(K, plants) -> (B,)`` float array: ``K`` of
-shape (B, m, n) holds B gains (convention ``u = K x``) that stabilise every
-scenario, ``plants`` is the scenario list (:class:`robustctl.Plant`, one
-``n``, ``m`` and ``dt``, discrete time). Smaller is better; a constraint holds
-where its value is ``<= 0``. The goals of this module are small frozen
-classes, each batched over the B designs and the S scenarios (stacked
-matrices, one compiled simulation), each reducing the scenarios with
-``over="mean"`` or ``"max"``, and each with
+A goal is any callable ``goal(K, plants) -> (B,)`` float array: ``K`` holds
+B designs that stabilise every scenario - the gains (B, m, n) of state
+feedbacks ``u = K x``, or an :class:`robustctl.ControllerBatch` of dynamic
+output feedbacks ``u = K(z) y`` - and ``plants`` is the scenario tuple
+(:class:`robustctl.Plant`, one ``n``, ``m`` and ``dt``; with an output
+feedback each carries the output model the controllers read). Smaller is
+better; a constraint holds where its value is ``<= 0``. The goals of this
+module take either kind of ``K``; they are small frozen classes, each
+batched over the B designs and the S scenarios (the closed loops of
+:mod:`moo.tuning.loops` in the states ``(x, x_c)``, one compiled
+simulation), each reducing the scenarios with ``over="mean"`` or ``"max"``,
+and each with
 
 * ``name`` - a label for tables and plots (``name=`` overrides it);
-* ``check(plants)`` - the goal's arguments against the plants (state index
-  out of range, reference of the wrong shape, ``Bw`` with other than ``n``
-  rows ...), a ``ValueError`` naming the argument; the tuning problem calls it
-  once, and every call repeats it (cheap) so a goal is safe on its own;
+* ``check(plants)`` - the goal's arguments against the plants (index out of
+  range, reference of the wrong shape, ``Bw`` with other than ``n`` rows, a
+  continuous plant for a goal that samples ...), a ``ValueError`` naming the
+  argument; the tuning problem calls it once, and every call repeats it
+  (cheap) so a goal is safe on its own;
 * ``measure(K, plants)`` - the goal's quantity in its own sense, to which the
   bounds of :func:`at_most` and :func:`at_least` refer. It equals the goal's
-  value except for :class:`RobustMargin`, a quantity to *maximise* that is
+  value except for the margins (:class:`RobustMargin`,
+  :class:`~moo.tuning.DiskMargin`), quantities to *maximise* that are
   minimised as ``1 / margin``.
 
-Time domain (one simulation per population, shared; :class:`Response`):
-from ``x[0] = x0`` the loop ``u[k] = sat(K (x[k] - r[k]))``,
-``x[k+1] = F x[k] + G u[k]`` runs ``T = steps`` samples on every scenario
-(:class:`robustctl.sim.simulator.LinearSimulator`, the compiled kernel), with the
-error ``e = x - r`` (``r = 0`` without a reference):
+Time domain (one simulation per population, shared; :class:`Response`,
+:class:`StepTracking`; discrete plants): from ``x[0] = x0`` (and
+``x_c = 0``) every design runs ``u[k] = sat(K(z) (y[k] - r[k]))``,
+``x[k+1] = F x[k] + G u[k]`` for ``T = steps`` samples on every scenario
+(``y = x`` and ``K(z) = K`` for a state feedback:
+:class:`robustctl.sim.simulator.LinearSimulator`; an output feedback:
+:func:`robustctl.sim.simulate_output_feedback`), with the error
+``e = y - r`` (``r = 0`` without a reference):
 
 ========================  ================================================  ==========
 goal                      per design and scenario                           ``over``
@@ -34,29 +43,38 @@ goal                      per design and scenario                           ``ov
 ``peak_input()``          ``max_k max_j |u_j[k]|``                          ``"max"``
 ``settling_time()``       ``dt k*``, ``k*`` the first sample from which     ``"mean"``
                           every ``|e_i|`` stays within ``tol max_k |e_i|``
+``overshoot()``           ``max_i max_k (y_i[k] - r_i[T-1]) / r_i[T-1]``,   ``"max"``
+                          clipped at 0
 ========================  ================================================  ==========
 
-(sums over the chosen states ``i``). Closed loop ``A = F + G K`` (per
-scenario, ``over="max"``):
+(sums over the chosen signals ``i``). Closed loop ``A_cl`` (``F + G K`` for a
+state feedback; per scenario, ``over="max"``):
 
-* :class:`SpectralRadius` - ``max |eig(A)|``;
+* :class:`SpectralRadius` - ``max |eig(A_cl)|`` (discrete plants);
 * :class:`PoleRegion` - ``max_z lambda_max(L + M z + M' conj(z))`` over the
   poles ``z`` and the regions' characteristic matrices (Chilali & Gahinet
   1996): ``<= 0`` with every pole inside; for a :class:`robustctl.Disk` it is
   ``max |z - c| - r``, the distance of the farthest pole beyond the circle;
+* :class:`ControllerPoles` - the controller's own poles (``max |eig(A_c)|``
+  or a region's violation);
 * :class:`H2Norm` - ``||T_zw||_2 = sqrt(trace(C_K P C_K'))`` of
-  ``x+ = A x + Bw w``, ``z = C_K x``, ``C_K = Cz + Dzu K``, with the
-  controllability Gramian ``P = A P A' + Bw Bw'`` (squared Smith iteration,
-  Smith 1968: ``P <- P + A_j P A_j'``, ``A_j <- A_j^2``);
-* :class:`HinfNorm` - ``||C_K (zI - A)^-1 Bw||_inf``, as ``1 / margin`` of
+  ``xi+ = A_cl xi + B_a w``, ``z = C_K xi``, ``C_K = [Cz 0] + Dzu K_u``, with the
+  controllability Gramian ``P = A_cl P A_cl' + B_a B_a'`` (:func:`gramians`:
+  the squared Smith iteration, Smith 1968; continuous plants through the
+  Cayley transform);
+* :class:`Variance` - the stationary variance of ``z`` under process noise
+  and measurement noise (the same Gramians);
+* :class:`HinfNorm` - ``||C_K (zI - A_cl)^-1 B_a||_inf``, as ``1 / margin`` of
   :func:`robustctl.robust_stability` with ``NormBounded(Bw, Cz, Dzu)`` (the
   small-gain value: one norm implementation in the project).
 
 Robustness: :class:`RobustMargin` - the certified margin of
 :func:`robustctl.robust_stability` against a :class:`robustctl.NormBounded`
 uncertainty about a nominal plant, ``1 / ||E (zI - A)^-1 H||_inf`` with
-``A = F + G K``, ``E = EF + EG K``; ``at_least(RobustMargin(unc), 1.0)`` is
-"certified for every ``||Delta|| <= 1``".
+``A = F + G K``, ``E = EF + EG K`` (the augmented loop for a dynamic
+controller); ``at_least(RobustMargin(unc), 1.0)`` is "certified for every
+``||Delta|| <= 1``". The loop margins (disk, gain and phase margins,
+sensitivity peaks) are in :mod:`moo.tuning.margins`.
 
 References
 ----------
