@@ -23,7 +23,7 @@ pytestmark = pytest.mark.skipif(bool(MISSING), reason=f"docs extra not installed
 
 # page -> (object id on it, a phrase of its docstring)
 PAGES = {
-    "robustctl.design": ("robustctl.design", "Design a state feedback"),
+    "robustctl.design": ("robustctl.design", "Design a controller"),
     "robustctl.rlqr_gains": ("robustctl.rlqr_gains", "Steady-state RLQR gains"),
     "robustctl.hinf": ("robustctl.hinf", "H-infinity"),
     "moo.molsp.molsp": ("moo.molsp.molsp", "MO-LSP"),

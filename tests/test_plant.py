@@ -130,7 +130,7 @@ def test_continuous_controller_stability():
 
 def test_design_dispatch_errors():
     plant = rc.Plant(np.eye(2) * 0.5, np.ones((2, 1)), 0.1)
-    with pytest.raises(ValueError, match="unknown design method 'pid'; valid: h2, hinf, lqg, lqr, rlqg, rlqr"):
+    with pytest.raises(ValueError, match="unknown design method 'pid'; valid: h2, h2hinf, hinf, lqg, lqr, rlqg, rlqr"):
         rc.design("pid", plant)
     with pytest.raises(TypeError, match=r"plant must be a robustctl\.Plant"):
         rc.design("lqr", np.eye(2))

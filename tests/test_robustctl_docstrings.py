@@ -20,9 +20,6 @@ MODULES = ("robustctl.validation", "robustctl.models.truck", "robustctl.models.p
 
 # Remove an entry when its file lands with numpydoc docstrings.
 PENDING = {
-    "robustctl.design": "robustctl/synthesis/design.py (design's METHODS table) is being documented on another branch",
-    "robustctl.HinfController": "robustctl/synthesis/hinf.py is being documented on another branch",
-    "robustctl.H2Controller": "robustctl/synthesis/h2.py is being documented on another branch",
     "robustctl.MarginsReport": "robustctl/analysis/margins_report.py is being documented on another branch",
 }
 

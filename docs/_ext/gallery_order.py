@@ -1,6 +1,7 @@
 """Order of the examples in the gallery (sphinx-gallery's ``within_subsection_order``)."""
 
-ORDER = ("plot_truck_overload.py", "plot_hinf_input_bound.py", "plot_truck_robust_analysis.py",
+ORDER = ("plot_truck_overload.py", "plot_hinf_input_bound.py", "plot_output_feedback_hinf.py",
+         "plot_truck_robust_analysis.py",
          "plot_molsp_zdt1.py", "plot_experiment_statistics.py", "plot_applied_selection.py")
 
 

@@ -6,6 +6,7 @@ them. The LMI syntheses import cvxpy on first use.
 
 from .design import design
 from .h2 import H2Controller, h2
+from .h2hinf import H2HinfController, h2hinf
 from .hinf import HinfController, hinf
 from .lqg import lqg, observer_controller, rlqg
 from .lqr import lqr
@@ -13,5 +14,5 @@ from .performance import lq_output
 from .rlqr import RLQRBatch, RLQRSchedule, rlqr, rlqr_gains, rlqr_schedule, rlqr_step, rlqr_step_block
 
 __all__ = ["design", "lqr", "rlqr", "rlqr_gains", "RLQRBatch", "rlqr_schedule", "RLQRSchedule", "rlqr_step",
-           "rlqr_step_block", "hinf", "HinfController", "h2", "H2Controller", "lqg", "rlqg", "observer_controller",
-           "lq_output"]
+           "rlqr_step_block", "hinf", "HinfController", "h2", "H2Controller", "h2hinf", "H2HinfController", "lqg",
+           "rlqg", "observer_controller", "lq_output"]

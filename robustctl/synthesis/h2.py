@@ -1,4 +1,9 @@
-r"""H2 state feedback by LMI optimisation (cvxpy + Clarabel), with optional pole regions.
+r"""H2 synthesis by LMI optimisation (cvxpy + Clarabel): state feedback and full-order output feedback.
+
+Output feedback (a plant with measured outputs) uses the LMIs of Scherer,
+Gahinet & Chilali (1997) in the variables, coordinates and reconstruction
+described in ``robustctl.synthesis.hinf`` (Output feedback); the rest of
+this docstring is the state feedback.
 
 Plant and gain as in :func:`robustctl.hinf` (``u = K x``)::
 
@@ -59,6 +64,8 @@ from ..systems.regions import Region, describe_regions
 from ._hinf import tolerances as tol
 from ._hinf.coordinates import Coordinates, channel_scales, normalised, recentred
 from ._hinf.lmis import Point, region_blocks, variables
+from ._hinf.output_problem import channel, dynamic_controller, output_problem, refuse, wants_output
+from ._hinf.output_synthesis import synthesise
 from ._hinf.problem import validate
 from .hinf import check_closed_loop
 
@@ -67,16 +74,49 @@ __all__ = ["h2", "H2Controller"]
 
 @dataclass(frozen=True, eq=False, repr=False)
 class H2Controller(Controller):
-    """An H2 state feedback ``u = K x`` with its guaranteed cost.
+    """An H2 controller, state feedback ``u = K x`` or output feedback ``u = K(z) y``, with its guaranteed cost.
 
-    Attributes
+    What :func:`robustctl.h2` returns; the constructor is that of
+    :class:`~robustctl.Controller` with the two bounds.
+
+    Parameters
     ----------
+    K : (m, n) array_like or None
+        State-feedback gain ``u = K x``; None for an output feedback.
+    method : str
+        Name of the design method.
+    plant : Plant
+        The plant it was designed for.
+    info : Mapping, optional
+        Diagnostics of the design (see the design function), stored read-only.
+    Ac, Bc, Cc, Dc : array_like, optional
+        Output feedback ``xc+ = Ac xc + Bc y``, ``u = Cc xc + Dc y`` (as in
+        :class:`~robustctl.Controller`).
     h2_bound : float
         ``||T_zw||_2 <= h2_bound`` for the plant (and every plant of the hull
         of ``vertices``): ``(1 + backoff) h2_opt``.
     h2_opt : float
         The optimal value of the LMI problem (for one plant without pole
-        regions: the H2-optimal, i.e. LQR, cost).
+        regions: the H2-optimal cost, the LQR's for state feedback and the
+        LQG controller's for output feedback).
+
+    See Also
+    --------
+    robustctl.h2
+
+    Examples
+    --------
+    The H2-optimal state feedback of a scalar plant is the LQR, whose cost
+    ``sqrt(P)`` comes from the scalar Riccati equation
+    ``P = 1 + 1.44 P - 1.44 P^2 / (1 + P)``, i.e. ``P^2 - 1.44 P - 1 = 0``,
+    of ``x+ = 1.2 x + u + w`` with unit weights:
+
+    >>> import numpy as np, robustctl as rc
+    >>> plant = rc.Plant([[1.2]], [[1.0]], 0.1)
+    >>> ctrl = rc.h2(plant, Bw=[[1.0]], Cz=[[1.0], [0.0]], Dzu=[[0.0], [1.0]])
+    >>> P = 0.72 + np.sqrt(0.72**2 + 1)     # the positive root
+    >>> isinstance(ctrl, rc.H2Controller), bool(abs(ctrl.h2_opt / np.sqrt(P) - 1) < 1e-5)
+    (True, True)
     """
 
     h2_bound: float = float("nan")
@@ -89,9 +129,18 @@ class H2Controller(Controller):
 
 
 def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: ArrayLike | None = None,
-       vertices: Sequence[Plant] | None = None, poles: Region | Sequence[Region] | None = None,
-       backoff: float = 1e-3, solver: str = "CLARABEL") -> H2Controller:
-    r"""H2 state feedback ``u = K x`` by LMI optimisation: minimise ``||T_zw||_2``.
+       Dyw: ArrayLike | None = None, vertices: Sequence[Plant] | None = None,
+       poles: Region | Sequence[Region] | None = None, backoff: float = 1e-3, solver: str = "CLARABEL",
+       feedback: str | None = None) -> H2Controller:
+    r"""H2 synthesis by LMI optimisation, state feedback ``u = K x`` or output feedback ``u = K(z) y``.
+
+    Minimises ``||T_zw||_2``. When the plant declares measured outputs
+    (``Plant(..., C=..., D=...)``), ``y = C x + D u + Dyw w`` and the result
+    is a full-order dynamic controller (``ctrl.Ac``, ``Bc``, ``Cc``, ``Dc``;
+    ``ctrl.K`` is None) from the LMIs of Scherer, Gahinet & Chilali (1997)
+    (see ``robustctl.synthesis.hinf`` for the variables and the
+    reconstruction); otherwise, or with ``feedback="state"``, the state
+    feedback below.
 
     Parameters
     ----------
@@ -106,19 +155,34 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     Dzw : (p, q) array_like, optional
         Feedthrough from ``w`` to ``z`` (default zero; must be zero in
         continuous time, where it makes the H2 norm infinite).
+    Dyw : (plant.p, q) array_like, optional
+        Output feedback: feedthrough from ``w`` to the measured outputs
+        (measurement noise; default zero).
     vertices : list of Plant, optional
         Further plants: the bound holds for every plant of the convex hull.
+        State feedback only.
     poles : Region or list of Region, optional
         Pole regions (:mod:`robustctl.systems.regions`) for the closed loop of every vertex.
     backoff : float, default 1e-3
         The gain is computed at ``(1 + backoff) h2_opt`` from a well-centred
-        strictly feasible point; ``0`` returns the optimal point's gain.
+        strictly feasible point; ``0`` returns the optimal point's gain
+        (state feedback only).
     solver : str, default "CLARABEL"
         cvxpy SDP solver.
+    feedback : {None, "state", "output"}, optional
+        ``None``: output feedback when the plant declares outputs, state
+        feedback otherwise; ``"state"`` asks for ``u = K x`` on a plant with
+        outputs.
 
     Returns
     -------
     H2Controller
+        Output feedback: ``Ac``, ``Bc``, ``Cc``, ``Dc`` (``K`` None),
+        ``h2_bound``, ``h2_opt`` and ``info`` with ``feedback``,
+        ``h2_norm_ratio`` inside ``certificate`` (the closed loop's H2 norm,
+        from its Gramian, over ``h2_bound``), ``gain_from``, ``margin``,
+        ``solves``, ``poles``, ``status``, ``solve_time``, ``iterations``,
+        ``backoff``. State feedback:
         ``K``, ``h2_bound``, ``h2_opt`` and ``info`` with ``h2_norms`` (the
         H2 norm of the closed loop at every vertex, from its Gramian),
         ``certificate``, ``margin``, ``solves``, ``X`` (the Lyapunov matrix,
@@ -151,7 +215,27 @@ def h2(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Array
     >>> loop = control.ss(plant.F + plant.G @ ctrl.K, np.eye(2), Cz + Dzu @ ctrl.K, 0, 0.1)
     >>> bool(np.isclose(control.norm(loop, 2), ctrl.h2_opt, rtol=1e-3))
     True
+
+    Output feedback: the H2 optimum of Example 7 of Scherer, Gahinet &
+    Chilali (1997), 7.7484 (the value python-control's example quotes),
+    and the H2 norm of python-control's closed loop is below the bound:
+
+    >>> A = [[0.0, 10.0, 2.0], [-1.0, 1.0, 0.0], [0.0, 2.0, -5.0]]
+    >>> plant = rc.Plant(A, [[0.0], [1.0], [0.0]], None, C=[[0.0, 1.0, 0.0]])
+    >>> Bw, Cz, Dzu = [[1.0], [0.0], [1.0]], [[0.0, 1, 0], [0, 0, 1], [0, 0, 0]], [[0.0], [0.0], [1.0]]
+    >>> ctrl = rc.h2(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dyw=[[2.0]])
+    >>> round(ctrl.h2_opt, 4)
+    7.7484
+    >>> P = control.ss(A, np.hstack([Bw, plant.G]), np.vstack([Cz, plant.C]), [[0, 0], [0, 0], [0, 1], [2, 0]])
+    >>> bool(control.norm(P.lft(ctrl.controller_statespace()), 2) <= ctrl.h2_bound)
+    True
     """
+    if wants_output(plant, feedback, Dyw):
+        refuse(vertices=vertices)
+        pb = output_problem(plant, "h2", (channel(plant, Bw, Cz, Dzu, Dzw, Dyw),), gamma=None, backoff=backoff,
+                            poles=poles, solver=solver)
+        res = synthesise(pb)
+        return dynamic_controller(H2Controller, "h2", plant, res, pb, h2_bound=res.h2_bound, h2_opt=res.h2_opt)
     # the validation stage of the H-infinity synthesis, without its H-infinity-only options
     problem = validate(plant, Bw=Bw, Cz=Cz, Dzu=Dzu, Dzw=Dzw, vertices=vertices, gamma=None, u_max=None,
                        w_energy=None, backoff=backoff, extended=False, solver=solver, poles=poles)
