@@ -258,9 +258,14 @@ class RecordSelection:
                 f"front={len(self.front)})")
 
 
-def _margin(problem, K: np.ndarray | None) -> float | None:
+def _margin(problem, K: np.ndarray | rc.Controller) -> float | None:
+    """The certified margin of a gain or of a dynamic controller against the problem's ``uncertainty``, if any."""
     uncertainty = getattr(problem, "uncertainty", None)
-    if K is None or not isinstance(uncertainty, rc.NormBounded) or not np.all(np.isfinite(K)):
+    if not isinstance(uncertainty, rc.NormBounded):
+        return None
+    if isinstance(K, rc.Controller):
+        return _plain(rc.robust_stability(K, uncertainty).margin)
+    if not np.all(np.isfinite(K)):
         return None
     return _plain(rc.robust_stability((design_plant(problem), K), uncertainty).margin)
 
@@ -321,7 +326,8 @@ def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=Non
         labels = tuple(str(i + 1) for i in range(len(front)))
         if K is None:
             return RecordSelection(front=front, rule=rule, labels=labels, best=int(best), index=index, z=z, K=None,
-                                   counts=np.asarray(counts), n_sims=n_sims, margin=None, controller=sel.controller)
+                                   counts=np.asarray(counts), n_sims=n_sims, margin=_margin(problem, sel.controller),
+                                   controller=sel.controller)
     K = np.array(K, dtype=float)
     return RecordSelection(front=front, rule=rule, labels=tuple(labels), best=int(best), index=index, z=z, K=K,
                            counts=np.asarray(counts), n_sims=n_sims, margin=_margin(problem, K))

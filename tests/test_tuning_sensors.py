@@ -45,7 +45,9 @@ def _goals():
 
 
 def problem():
-    return tuning.TuningProblem(tuning.StaticOutputFeedbackFamily(PLANT), SCENARIOS, _goals())
+    prob = tuning.TuningProblem(tuning.StaticOutputFeedbackFamily(PLANT), SCENARIOS, _goals())
+    prob.uncertainty = rc.NormBounded.from_plants(PLANT, SCENARIOS)     # select reports the certified margin
+    return prob
 
 
 def pid_problem():
@@ -99,3 +101,6 @@ def test_a_plant_with_one_sensor_tuned_by_the_api_and_the_cli(helicopter, factor
     assert chosen["K"] is None and chosen["index"] == sel.index
     np.testing.assert_allclose(np.array(chosen["controller"]["Dc"]), ctrl.Dc, rtol=1e-12)
     assert "K(z): order" in results[1][2]
+    if factory == "problem":
+        assert chosen["margin"] == pytest.approx(rc.robust_stability(ctrl, prob.uncertainty).margin, rel=1e-12)
+        assert "certified robust margin" in results[1][2]
