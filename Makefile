@@ -1,5 +1,5 @@
 # Two commands do all the set-up on a fresh clone (Python 3.11 + make):
-#   make repro   - create .venv if missing, install, run the main job
+#   make repro   - create .venv if missing, install, run the main jobs (the MSE table, full state and with sensors)
 #   make test    - same set-up with test extras, the lint and type gate (make lint), then the whole test suite
 #   make docs    - same set-up with the docs extras, build the HTML site (docs/_build/html)
 PYTHON ?= python3
@@ -29,6 +29,7 @@ $(DSTAMP): pyproject.toml | $(PY)
 
 repro: $(STAMP)
 	$(PY) paper_repro/mse_table.py --out out
+	$(PY) paper_repro/mse_table_sensors.py --out out
 
 # The gate: ruff (rules in pyproject.toml) and mypy (cache in .venv): ~11 s with a cold cache, ~1 s warm.
 lint: $(TSTAMP)

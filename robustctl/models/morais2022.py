@@ -60,6 +60,18 @@ of the reproduction (:func:`get_setup` by name):
     initial state ``[0, 0, 0.3, -0.1]`` and the weights ``Q = diag(1, 1,
     25000, 100)``, ``R = 67070 I2`` on the doubled column.
 
+The truck with sensors
+----------------------
+The paper's controllers on the truck that measures its yaw rate, lateral
+displacement and orientation error (:func:`robustctl.models.truck.sensor_plant`,
+noise :class:`robustctl.models.truck.TruckSensors`) and feeds back an
+estimate (``paper_repro/mse_table_sensors.py``). The filters' process noise,
+:func:`sensor_filter_noise`, is a steering disturbance as large as the
+payload mismatch of the table (0-300 %) makes the steady steering in the
+path's tightest bend; the robust filter's uncertainty is the appendix's
+printed model (:func:`algebraic_uncertainty`, ``H``, ``EF`` and one of the
+equal ``EG`` entries on the single steering input).
+
 Not taken from the code: its sampling time (0.01 s; the paper's 0.1 s is
 kept), its Tustin discretisation (ZOH kept), its per-column saturation at
 0.22 rad (the paper's 0.45 rad on the steering angle is kept), its
@@ -88,14 +100,14 @@ import numpy as np
 
 from .._validation import as_batch, check_choice, frozen
 from . import truck
-from .path import LaneChange, ReferencePath, Straight
+from .path import LaneChange, ReferencePath, Straight, default_route
 from .pathfollow import DEFAULT_SETUP, PathFollowingSetup
 
 __all__ = [
     "RLQR_MOP_Z", "PRINTED_EF", "PRINTED_EG", "PRINTED_LOG10_MU_SQ", "algebraic_uncertainty",
     "uncertainty_from_z", "AUTHORS_Q_DIAG", "AUTHORS_R_DOUBLED", "AUTHORS_X0", "CODE_EG", "CODE_GAMMA",
     "authors_weights", "code_manoeuvre", "SETUPS", "get_setup", "MSE_OVERLOADS", "MSE_OBJECTIVES",
-    "MSE_CONTROLLERS", "PRINTED_MSE",
+    "MSE_CONTROLLERS", "PRINTED_MSE", "sensor_filter_noise",
 ]
 
 # -- the paper's printed values ---------------------------------------------------------------
@@ -446,3 +458,71 @@ def get_setup(setup: str | PathFollowingSetup) -> PathFollowingSetup:
     if setup not in SETUPS:
         raise ValueError(f"unknown setup {setup!r}; valid: {', '.join(SETUPS)}")
     return SETUPS[setup]
+
+
+# -- the truck with sensors -------------------------------------------------------------------
+
+
+def sensor_filter_noise(path: ReferencePath | None = None, *, overloads=MSE_OVERLOADS,
+                        params: truck.TruckParameters | None = None) -> tuple[np.ndarray, np.ndarray]:
+    r"""The process noise of the MSE table's filters: a steering disturbance as large as the payload mismatch.
+
+    The filters run on the nominal (0 %) model while the truck carries up to
+    the table's largest overload. In steady cornering on a bend of
+    curvature ``kappa`` the truck at an overload ``k`` needs the steering
+    ``alpha_per_kappa(k) kappa`` (:func:`robustctl.models.truck.steady_state_cornering`);
+    the filters take the largest difference from the nominal model's, in
+    the path's tightest bend, as the standard deviation of a white
+    disturbance on the steering input.
+
+    Parameters
+    ----------
+    path : ReferencePath, optional
+        The course (default :func:`robustctl.models.path.default_route`).
+    overloads : sequence of float
+        The payload range [%] (default the table's, :data:`MSE_OVERLOADS`).
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
+
+    Returns
+    -------
+    Bw : (4, 1) ndarray
+        The nominal model's steering input ``G``.
+    W : (1, 1) ndarray
+        ``sigma^2``.
+
+    Raises
+    ------
+    ValueError, TypeError
+        Negative or non-numeric overloads, ``path`` not a ReferencePath.
+
+    Notes
+    -----
+    .. math::
+
+        \sigma = \max_k |\alpha_\kappa(k) - \alpha_\kappa(0)| \, \max_t |\kappa(t)| .
+
+    Examples
+    --------
+    The steering of the steady-cornering references at 300 % and at 0 %,
+    in the route's tightest bend (200 m), differ by ``sigma``, about 0.1 rad:
+
+    >>> import numpy as np
+    >>> from robustctl.models import morais2022, truck
+    >>> from robustctl.models.path import default_route
+    >>> Bw, W = morais2022.sensor_filter_noise()
+    >>> kappa = np.abs(default_route().kappa).max()
+    >>> steering = [truck.reference_states(np.array([kappa]), ov)[1][0] for ov in (0.0, 300.0)]
+    >>> bool(np.isclose(np.sqrt(W[0, 0]), steering[1] - steering[0])), round(float(np.sqrt(W[0, 0])), 3)
+    (True, 0.101)
+    >>> bool(np.array_equal(Bw, truck.truck_plant(0.0).G))
+    True
+    """
+    path = default_route() if path is None else path
+    if not isinstance(path, ReferencePath):
+        raise TypeError(f"path must be a robustctl.models.path.ReferencePath, got {type(path).__name__}")
+    ovs = np.atleast_1d(truck.check_overload(overloads, "overloads"))
+    nominal = truck.steady_state_cornering(0.0, params=params)[1]
+    mismatch = max(abs(truck.steady_state_cornering(float(ov), params=params)[1] - nominal) for ov in ovs)
+    sigma = mismatch * float(np.abs(path.kappa).max())
+    return truck.truck_plant(0.0, params=params).G, np.array([[sigma**2]])

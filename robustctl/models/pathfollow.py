@@ -36,6 +36,11 @@ its authors' code are in :mod:`robustctl.models.morais2022`.
 
 :class:`PathFollowing` discretises the scenarios and builds the reference
 once (an optimiser's problem keeps one); :func:`simulate` is the one-call form.
+:meth:`PathFollowing.run_estimated` closes the loop on an estimate of the
+state instead: a Kalman or robust filter (:mod:`robustctl.estimation`) of the
+nominal model fed with noisy measurements ``y = C x + v`` (the truck's
+sensors: :func:`robustctl.models.truck.sensor_plant`) and the applied
+steering angle.
 The simulation itself, the divergence rule and the backends are those of
 :mod:`robustctl.sim.simulator`. A law that also feeds back the previous steering
 angle (``K_input``, e.g. :mod:`robustctl.synthesis.hinf_game`'s delayed
@@ -58,14 +63,25 @@ from typing import Any, Literal
 
 import numpy as np
 
-from .._validation import as_batch, as_float_array, check_bool, check_choice, check_positive_scalar
+from .._validation import (
+    as_batch,
+    as_float_array,
+    as_matrix,
+    as_rng,
+    check_bool,
+    check_choice,
+    check_int,
+    check_positive_scalar,
+    check_spd,
+)
+from ..estimation.estimator import Estimator
 from ..sim.simulator import DEFAULT_BOUND, LinearSimulator, SimulationResult, check_gains
 from ..systems.input_memory import InputMemoryFeedback
 from . import truck as _truck
 from .path import ReferencePath
 
-__all__ = ["PathFollowing", "PathFollowingResult", "PathFollowingSetup", "DEFAULT_SETUP", "simulate",
-           "DEFAULT_INITIAL_ERROR"]
+__all__ = ["PathFollowing", "PathFollowingResult", "EstimatedPathFollowingResult", "PathFollowingSetup",
+           "DEFAULT_SETUP", "simulate", "DEFAULT_INITIAL_ERROR"]
 
 #: Initial path-following error of the default set-up: the truck starts 1 m to the
 #: left of the path, parallel to it, at steady speed ([ydot, psidot, rho, theta]).
@@ -329,6 +345,89 @@ class PathFollowingResult(SimulationResult):
         return X, Y, psi
 
 
+@dataclass(frozen=True, eq=False, repr=False)
+class EstimatedPathFollowingResult(PathFollowingResult):
+    """A :class:`PathFollowingResult` of the loop on an estimate (:meth:`PathFollowing.run_estimated`).
+
+    The scenario axis holds every payload scenario once per draw of the
+    measurement noise, the draw fastest: scenario ``s * draws + d`` is the
+    ``s``-th overload with the ``d``-th noise sequence (the same sequences
+    at every overload). ``errors`` and :meth:`mse` are those of the true
+    state, ``x - x_ref``; ``estimates`` is the estimate the controller fed
+    back, ``xhat - x_ref``.
+
+    Parameters
+    ----------
+    estimates : ndarray, optional
+        The attribute below.
+    draws : int
+        Noise sequences per payload scenario.
+    form : str
+        The estimator's form.
+    **fields
+        The fields of :class:`PathFollowingResult`.
+
+    Attributes
+    ----------
+    estimates : (B, S * draws, T, 4) ndarray or None
+        ``xhat[k] - x_ref[k]`` (None if trajectories were not kept).
+    draws : int
+    form : {"filter", "predictor"}
+        ``xhat[k] = x[k|k]`` (``"filter"``) or ``x[k|k-1]`` (``"predictor"``).
+
+    See Also
+    --------
+    PathFollowing.run_estimated : produces it.
+
+    Examples
+    --------
+    Two noise draws at two overloads make four scenarios; :meth:`mse_by_draw`
+    splits them again:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from robustctl.models import truck
+    >>> from robustctl.models.path import ReferencePath
+    >>> from robustctl.models.pathfollow import PathFollowing
+    >>> sensors = truck.TruckSensors()
+    >>> est = rc.kalman(truck.sensor_plant(0.0), [[0.01]], sensors.covariance(0.1), Bw=truck.truck_plant(0.0).G)
+    >>> Q, R = truck.lqr_weights()
+    >>> K = rc.lqr(truck.truck_plant(0.0), Q=Q, R=R).K
+    >>> res = PathFollowing(ReferencePath.straight(10.0), [0.0, 100.0]).run_estimated(K, est, draws=2, rng=0,
+    ...                                                                                 backend="numpy")
+    >>> res.overloads, res.mse().shape, res.mse_by_draw().shape
+    ((0.0, 0.0, 100.0, 100.0), (1, 4, 4), (1, 2, 2, 4))
+    >>> bool(np.allclose(res.estimation_errors, res.estimates - res.errors))
+    True
+    """
+
+    estimates: np.ndarray | None = None
+    draws: int = 1
+    form: str = "filter"
+
+    def mse_by_draw(self, target: Literal["reference", "zero"] = "reference") -> np.ndarray:
+        """:meth:`mse` with the scenarios split into payloads and draws, shape (B, S, draws, 4).
+
+        Parameters
+        ----------
+        target : {"reference", "zero"}
+            As in :meth:`mse`.
+
+        Returns
+        -------
+        (B, S, draws, 4) ndarray
+        """
+        m = self.mse(target)
+        return m.reshape(m.shape[0], -1, self.draws, m.shape[-1])
+
+    @property
+    def estimation_errors(self) -> np.ndarray:
+        """``xhat - x``, shape (B, S * draws, T, 4)."""
+        self._need_trajectories()
+        assert self.estimates is not None                 # kept with the errors
+        return self.estimates - self.errors
+
+
 def _scenarios(overloads, T: int) -> tuple:
     """Normalise ``overloads`` to a tuple of floats / (T,) arrays."""
     if isinstance(overloads, (str, bytes)) or overloads is None:
@@ -350,6 +449,69 @@ def _scenarios(overloads, T: int) -> tuple:
                                  f"(the path's samples), got {a.shape}")
             out.append(a)
     return tuple(out)
+
+
+def _measurement_noise(noise, V, draws, rng, est: Estimator, T: int, p: int) -> np.ndarray:
+    """The noise samples (N, T, p): ``noise`` as given, or ``draws`` white normal sequences of covariance ``V``."""
+    if noise is not None:
+        if V is not None or rng is not None or not (isinstance(draws, int) and draws == 1):
+            raise ValueError("give either noise (the samples) or V, draws and rng (drawn here), not both")
+        v = as_float_array(noise, "noise")
+        v = v[None] if v.ndim == 2 else v
+        if v.ndim != 3 or v.shape[1:] != (T, p) or v.shape[0] == 0:
+            raise ValueError(f"noise must have shape ({T}, {p}) or (draws, {T}, {p}) (the path's samples, the "
+                             f"estimator's outputs), got shape {np.shape(noise)}")
+        if not np.all(np.isfinite(v)):
+            raise ValueError("noise must have finite entries (found NaN or inf)")
+        return v
+    if V is None:
+        V = est.info.get("V")
+        if V is None:
+            raise ValueError("V: the estimator records no measurement covariance; give V (or noise)")
+    V = check_spd(as_matrix(V, "V", rows=p, cols=p, rows_what="the estimator's outputs",
+                            cols_what="the estimator's outputs"), "V", semidefinite=True)
+    draws = check_int(draws, "draws")
+    lam, U = np.linalg.eigh(V)
+    root = (U * np.sqrt(np.clip(lam, 0.0, None))) @ U.T              # the symmetric square root of V
+    return as_rng(rng, "rng").standard_normal((draws, T, p)) @ root
+
+
+def _estimator_loop(est: Estimator, F, G, w, w_nominal, v, e0, eh0):
+    """The truck and the estimator as one linear loop in ``(x, xhat)`` (:meth:`PathFollowing.run_estimated`).
+
+    ``F`` (S, [T,] 4, 4), ``G`` (S, [T,] 4, 1) and ``w`` (S, T, 4) are the true trucks and their curvature
+    input, ``w_nominal`` (T, 4) the estimator's, ``v`` (N, T, p) the noise, ``e0`` (S, 4) the initial errors and
+    ``eh0`` (S, N, 4) the priors ``x[0|-1] - x_ref[0]``. Returns ``F_a`` (S N, [T,] 8, 8), ``G_a``, ``w_a``
+    (S N, T, 8) and the initial errors (S N, 8) of the scenarios ``s N + d``, with ``xhat = x[k|k]`` (filter) or
+    ``x[k|k-1]`` (predictor) as the second state.
+    """
+    C = est.plant.output_matrices()[0]
+    p, N = C.shape[0], v.shape[0]
+    I4 = np.eye(4)
+    if est.form == "filter":
+        Lf = est.L_filter
+        ICL = np.eye(p) - C @ Lf
+        if np.linalg.svd(ICL, compute_uv=False)[-1] <= 1e-12:
+            raise ValueError("estimator: I - C L_filter is singular, so the innovation is not a function of the "
+                             "filtered estimate; use form='predictor'")
+        Je = est.J @ np.linalg.inv(ICL)                       # J e_k = Je (C x_k + v_k - C x[k|k])
+        Psi = I4 - Lf @ C
+        A21, A22, B2 = Psi @ Je @ C + Lf @ C @ F, Psi @ (est.F - Je @ C), Psi @ est.G + Lf @ C @ G
+        v_next = np.concatenate([v[:, 1:], np.zeros_like(v[:, :1])], axis=1)   # the last one is never used
+        w2 = (w_nominal @ Psi.T + (w @ (Lf @ C).T)[:, None] + (v @ (Psi @ Je).T + v_next @ Lf.T)[None])
+        eh0 = eh0 + ((e0 @ C.T)[:, None] + v[None, :, 0] - eh0 @ C.T) @ Lf.T
+    else:
+        Lp = est.L_predictor
+        A21, A22, B2 = np.broadcast_to(Lp @ C, F.shape), est.F - Lp @ C, np.broadcast_to(est.G, G.shape)
+        w2 = np.broadcast_to(w_nominal + (v @ Lp.T)[None], (w.shape[0], N, *w.shape[1:]))
+    Fa = np.zeros((*F.shape[:-2], 8, 8))
+    Fa[..., :4, :4], Fa[..., 4:, :4], Fa[..., 4:, 4:] = F, A21, A22
+    Ga = np.concatenate([G, np.broadcast_to(B2, G.shape)], axis=-2)
+    wa = np.concatenate([np.broadcast_to(w[:, None], w2.shape), w2], axis=-1)
+    xa0 = np.concatenate([np.broadcast_to(e0[:, None], eh0.shape), eh0], axis=-1)
+    S = F.shape[0]
+    return (np.repeat(Fa, N, axis=0), np.repeat(Ga, N, axis=0), wa.reshape(S * N, *wa.shape[2:]),
+            xa0.reshape(S * N, 8))
 
 
 class PathFollowing:
@@ -487,8 +649,9 @@ class PathFollowing:
             F, G, x_ref, u_ff=u_ff[:, None], w=w, x0=x0, u_limit=steer_limit, input_map=input_map, bound=bound,
             objectives=_truck.OBJECTIVE_STATES, state_names=_truck.STATE_NAMES, dt=p.dt)
         self._memory: LinearSimulator | None = None    # the plant augmented by the previous steering angle
-        self._memory_args = dict(F=F, G=G, x_ref=x_ref, u_ff=u_ff, w=w, x0=np.asarray(x0, dtype=float),
-                                 steer_limit=steer_limit, bound=bound, dt=p.dt)
+        self._loop = dict(F=F, G=G, x_ref=x_ref, u_ff=u_ff, w=w, x0=np.asarray(x0, dtype=float),
+                          steer_limit=steer_limit, bound=bound, dt=p.dt, input_map=input_map,
+                          w_nominal=_truck.discretise(nominal_overload, params=p)[2][0] * path.kappa[:, None])
         self.path = path
         self.overloads = scen
 
@@ -505,7 +668,7 @@ class PathFollowing:
     def _memory_simulator(self) -> LinearSimulator:
         """``[x; alpha_prev]``: ``F_a = [[F, 0], [0, 0]]``, ``G_a = [G; 1]`` (built on first use)."""
         if self._memory is None:
-            a = self._memory_args
+            a = self._loop
             F, G = a["F"], a["G"]
             Fa = np.zeros((*F.shape[:-2], 5, 5))
             Fa[..., :4, :4] = F
@@ -627,6 +790,169 @@ class PathFollowing:
                                  "saturated_steps")
             stacked[f.name] = np.concatenate([a, b])[order] if batched and a is not None else a
         return PathFollowingResult(**stacked)
+
+    def run_estimated(self, K, estimator: Estimator, *, noise=None, V=None, draws: int = 1, rng=None,
+                      xhat0=None, keep_trajectories: bool = True, nan_gains: Literal["raise", "flag"] = "raise",
+                      backend: Literal["numba", "numpy"] = "numba") -> EstimatedPathFollowingResult:
+        r"""Simulate B gains fed back on an estimate of the state from noisy measurements, on every scenario.
+
+        The controller sees ``y = C x + v`` (the estimator's ``C``, e.g. the
+        sensors of :func:`robustctl.models.truck.sensor_plant`), not the state:
+        ``u = sat(M K (xhat - x_ref) + u_ff)``, with ``xhat`` the estimate that
+        ``estimator`` makes from ``y`` and the applied (saturated) steering
+        angle. The estimator runs on its own (nominal) model at every
+        scenario: the true truck is the scenario's, the estimator is not told.
+
+        Parameters
+        ----------
+        K : (m, 4) or (B, m, 4) array_like
+            Gains with ``u = K e`` (``m`` > 1 needs the simulator's ``input_map``).
+        estimator : Estimator
+            A discrete-time estimator of the truck with one steering input
+            (``n = 4``, ``m = 1``) and the path's ``dt``, from
+            :func:`robustctl.kalman` or :func:`robustctl.robust_kalman`; its
+            ``form`` says which estimate is fed back: ``x[k|k]``
+            (``"filter"``) or ``x[k|k-1]`` (``"predictor"``).
+        noise : (T, p) or (draws, T, p) array_like, optional
+            Measurement noise samples ``v[0] .. v[T-1]`` (any sequence: a
+            colored or biased error too). Default: drawn here, white normal of
+            covariance ``V``.
+        V : (p, p) array_like, optional
+            Covariance of the drawn noise (symmetric positive semidefinite;
+            zero: noiseless sensors). Default the estimator's design ``V``.
+        draws : int
+            Noise sequences drawn, each run at every scenario (the same
+            sequences at every overload).
+        rng : None, int or Generator
+            Seed of the draws (:func:`numpy.random.default_rng`).
+        xhat0 : (4,) array_like, optional
+            The estimator's prior ``x[0|-1] - x_ref[0]``. Default: from the
+            first measurement, ``pinv(C) (y[0] - C x_ref[0])`` (the measured
+            states as measured, the others at the reference).
+        keep_trajectories : bool
+            False keeps only the MSE sums.
+        nan_gains : {"raise", "flag"}
+            As :meth:`run`.
+        backend : {"numba", "numpy"}
+            The compiled kernel (default) or the numpy reference of
+            :class:`~robustctl.sim.LinearSimulator`.
+
+        Returns
+        -------
+        EstimatedPathFollowingResult
+            Scenarios ``s * draws + d`` (the ``s``-th overload with the
+            ``d``-th noise sequence): ``errors`` (B, S * draws, T, 4) of the
+            true state, ``estimates`` of the estimate, ``mse()`` and
+            ``mse_by_draw()`` (B, S, draws, 4).
+
+        Raises
+        ------
+        TypeError
+            ``estimator`` is not an :class:`~robustctl.estimation.estimator.Estimator`.
+        ValueError
+            An estimator of another plant size, sampling time or of
+            continuous time; gains of the wrong shape or of several rows
+            without an input map; ``noise`` of the wrong shape or with
+            non-finite entries, or given with ``V``, ``draws`` or ``rng``;
+            ``V`` not symmetric positive semidefinite; ``xhat0`` not 4
+            numbers.
+
+        See Also
+        --------
+        run : the loop on the true state.
+        robustctl.observer_controller : the same loop as a dynamic controller.
+
+        Notes
+        -----
+        With ``e = y - C xhat_{k|k-1} - D u`` the innovation, ``L_f``, ``F_e``,
+        ``G_e``, ``J`` the estimator's (:class:`~robustctl.estimation.estimator.Estimator`)
+        and ``E_0 kappa_k`` the curvature input of the nominal model, the loop
+        is [1]_
+
+        .. math::
+
+            x_{k|k} = x_{k|k-1} + L_f e_k, \qquad
+            x_{k+1|k} = F_e x_{k|k} + G_e \alpha_k + J e_k + E_0 \kappa_k, \qquad
+            \alpha_k = \operatorname{sat}(M K (\hat x_k - x^{ref}_k) + \alpha^{ff}_k),
+
+        with ``xhat_k = x_{k|k}`` (filter) or ``x_{k|k-1}`` (predictor), and
+        the truck's ``x_{k+1} = F_s x_k + G_s alpha_k + E_s kappa_k``. It is
+        simulated as one linear loop in ``(x, xhat)`` on
+        :class:`~robustctl.sim.LinearSimulator` (filter form: ``e_k =
+        (I - C L_f)^{-1} (C x_k + v_k - C x_{k|k})``); the divergence bound
+        applies to both parts.
+
+        References
+        ----------
+        .. [1] G. F. Franklin, J. D. Powell, M. L. Workman, *Digital Control
+           of Dynamic Systems*, 3rd ed., Addison-Wesley 1998, Sec. 8.6.
+
+        Examples
+        --------
+        With noiseless sensors and the estimator started at the true state,
+        a Kalman filter of the nominal model tracks the nominal truck
+        exactly as the loop on the true state does:
+
+        >>> import numpy as np
+        >>> import robustctl as rc
+        >>> from robustctl.models import truck
+        >>> from robustctl.models.path import ReferencePath
+        >>> from robustctl.models.pathfollow import PathFollowing
+        >>> est = rc.kalman(truck.sensor_plant(0.0), [[0.01]], truck.TruckSensors().covariance(0.1),
+        ...                 Bw=truck.truck_plant(0.0).G)
+        >>> Q, R = truck.lqr_weights()
+        >>> K = rc.lqr(truck.truck_plant(0.0), Q=Q, R=R).K
+        >>> runs = PathFollowing(ReferencePath.from_curvature(np.full(200, 1 / 300.0)), 0.0)
+        >>> sensed = runs.run_estimated(K, est, V=np.zeros((3, 3)), xhat0=runs.setup.x0, backend="numpy")
+        >>> exact = runs.run(K, backend="numpy")
+        >>> bool(np.allclose(sensed.errors, exact.errors, rtol=0, atol=1e-12))
+        True
+        """
+        a = self._loop
+        est = self._check_estimator(estimator)
+        C = est.plant.output_matrices()[0]
+        v = _measurement_noise(noise, V, draws, rng, est, self.T, C.shape[0])
+        Kb, bad = check_gains(K, 4, nan_gains)
+        if Kb.shape[1] > 1 and a["input_map"] is None:
+            raise ValueError(f"K has {Kb.shape[1]} rows but the truck has one steering input: give the "
+                             f"PathFollowing an input_map (e.g. robustctl.models.truck.DOUBLED_INPUT_MAP)")
+        e0 = np.broadcast_to(a["x0"], (self.S, 4))
+        if xhat0 is None:                                     # the measured states as measured, the others at 0
+            eh0 = (e0 @ C.T)[:, None] + v[None, :, 0]
+            eh0 = eh0 @ np.linalg.pinv(C).T
+        else:
+            eh0 = np.broadcast_to(as_batch(as_float_array(xhat0, "xhat0"), "xhat0", (4,)), (self.S, v.shape[0], 4))
+        Fa, Ga, wa, xa0 = _estimator_loop(est, a["F"], a["G"], a["w"], a["w_nominal"], v, e0, eh0)
+        sim = LinearSimulator(
+            Fa, Ga, np.concatenate([a["x_ref"], a["x_ref"]], axis=-1), u_ff=a["u_ff"][:, None], w=wa, x0=xa0,
+            u_limit=a["steer_limit"], input_map=a["input_map"], bound=a["bound"],
+            objectives=_truck.OBJECTIVE_STATES, dt=a["dt"])
+        Ka = np.concatenate([np.zeros_like(Kb), Kb], axis=2)     # u = K (xhat - x_ref)
+        Ka[bad] = np.nan                                          # flagged by the simulator
+        res = sim.run(Ka, keep_trajectories=keep_trajectories, nan_gains=nan_gains, backend=backend)
+        fields = vars(res).copy()
+        both = fields["errors"]
+        for name in ("errors", "sq_error_sum", "sq_state_sum", "x_ref"):
+            if fields[name] is not None:
+                fields[name] = fields[name][..., :4]
+        fields["state_names"] = _truck.STATE_NAMES
+        N = v.shape[0]
+        return EstimatedPathFollowingResult(
+            **fields, path=self.path, overloads=tuple(ov for ov in self.overloads for _ in range(N)),
+            estimates=None if both is None else both[..., 4:], draws=N, form=est.form)
+
+    def _check_estimator(self, estimator) -> Estimator:
+        if not isinstance(estimator, Estimator):
+            raise TypeError(f"estimator must be a robustctl Estimator (robustctl.kalman, robustctl.robust_kalman), "
+                            f"got {type(estimator).__name__}")
+        plant, dt = estimator.plant, self._loop["dt"]
+        if not plant.is_discrete or abs(plant.dt - dt) > 1e-12 * dt:
+            raise ValueError(f"estimator must be a discrete-time estimator at the path's dt = {dt:g} s, got "
+                             f"{'a continuous-time one' if not plant.is_discrete else f'dt = {plant.dt:g} s'}")
+        if (plant.n, plant.m) != (4, 1):
+            raise ValueError(f"estimator must be designed on the truck with one steering input (n = 4, m = 1, e.g. "
+                             f"robustctl.models.truck.sensor_plant), got n = {plant.n}, m = {plant.m}")
+        return estimator
 
     def _run_with_memory(self, K, K_input, keep, nan_gains, backend) -> PathFollowingResult:
         if self._given_map:

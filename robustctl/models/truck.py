@@ -26,6 +26,14 @@ Eq. 1 also has ``theta' = psidot`` with no path term: the path enters here as
 the known disturbance ``-v kappa`` on ``theta'`` (``E = [0, 0, 0, -v]^T``),
 which is zero on a straight path, so Eq. 1 is recovered there.
 
+Sensors
+-------
+The paper's controllers feed back the whole state. The truck with sensors
+(:func:`sensor_plant`) measures its yaw rate (a MEMS gyroscope) and its
+lateral displacement and orientation error (RTK GNSS with dual-antenna
+heading, against the map of the path), not its lateral velocity; the noise
+levels, from data sheets, are :class:`TruckSensors`'.
+
 Mass and inertia at an overload
 -------------------------------
 The parameter table lists the vehicle mass ``m = 16030 kg`` and, separately,
@@ -66,6 +74,7 @@ __all__ = [
     "STEER_LIMIT", "continuous_model", "truck_plant", "discretise", "steady_state_cornering",
     "reference_states", "AlgebraicUncertainty", "algebraic_uncertainty", "check_overload",
     "MAX_ERRORS", "MAX_STEER", "lqr_weights", "DOUBLED_INPUT_MAP", "open_loop_reference",
+    "SENSOR_NAMES", "SENSOR_OUTPUTS", "TruckSensors", "sensor_plant",
 ]
 
 #: State names, in the model's order.
@@ -890,3 +899,218 @@ def lqr_weights(*, doubled: bool = False) -> tuple[np.ndarray, np.ndarray]:
     Q = np.diag(1.0 / np.square(MAX_ERRORS))
     r = 1.0 / MAX_STEER**2
     return Q, (2.0 * r * np.eye(2) if doubled else np.array([[r]]))
+
+
+# -- sensors ----------------------------------------------------------------------------------
+
+#: The measured states of the truck with sensors, in the order of :data:`SENSOR_OUTPUTS`:
+#: the yaw rate (gyroscope), the lateral displacement and the orientation error (RTK GNSS
+#: position and dual-antenna heading against the map of the path). The lateral velocity is not measured.
+SENSOR_NAMES = ("psidot", "rho", "theta")
+#: State index of each measured output (:data:`STATE_NAMES` order).
+SENSOR_OUTPUTS = (1, 2, 3)
+# CEP = sigma sqrt(2 ln 2) for a circular normal (the median of a Rayleigh law); the median
+# of |e| for a normal e is sigma times the normal quantile 0.75.
+_CEP_PER_SIGMA = float(np.sqrt(2.0 * np.log(2.0)))
+_MEDIAN_ABS_PER_SIGMA = 0.6744897501960817
+
+
+@dataclass(frozen=True)
+class TruckSensors:
+    r"""Noise levels of the truck's sensors, from published data sheets (the defaults).
+
+    The truck measures its yaw rate with a MEMS gyroscope and its lateral
+    displacement ``rho`` and orientation error ``theta`` with an RTK GNSS
+    receiver pair with dual-antenna heading, against a map of the path
+    (:data:`SENSOR_NAMES`); the lateral velocity is not measured.
+    :meth:`covariance` turns the data-sheet figures into the covariance of
+    the white measurement noise sampled every ``dt``.
+
+    Parameters
+    ----------
+    gyro_noise_density, position_cep, heading_error_50 : float
+        The attributes below; each positive and finite.
+
+    Attributes
+    ----------
+    gyro_noise_density : float
+        Rate noise density of the gyroscope [deg/s/sqrt(Hz)]. Default
+        ``5e-3``: 5 mdps/sqrt(Hz), the ST ISM330DHCX 6-axis MEMS IMU
+        (industrial grade, -40 to +105 degC) [1]_ (Table 3, ``Rn``,
+        high-performance mode, independent of the range and the output
+        rate).
+    position_cep : float
+        Horizontal position error of the RTK fix, circular error probable
+        [m] (the radius that holds half of the fixes). Default ``0.02``: the
+        u-blox ZED-F9P's ``0.01 m + 1 ppm CEP`` [2]_ at 10 km from the base
+        station.
+    heading_error_50 : float
+        Heading error that half of the fixes stay within [deg]. Default
+        ``0.4``: the u-blox ZED-F9H rover on a ZED-F9P moving base, ``0.4
+        deg 50 %`` for a 1 m antenna baseline [3]_ (the error falls about
+        as one over the baseline).
+
+    Raises
+    ------
+    ValueError, TypeError
+        A level that is not a positive finite number.
+
+    See Also
+    --------
+    sensor_plant : the truck with these outputs.
+
+    Notes
+    -----
+    Each sensor's error is taken white, independent of the others and of
+    zero mean: the gyroscope's bias is taken calibrated (it is estimated at
+    standstill in practice) and the slow, correlated part of the RTK
+    errors is not modelled. The standard deviations of one sample, sampled
+    every ``dt`` [s]:
+
+    * the gyroscope averaged over the sample (equivalent noise bandwidth
+      ``1 / (2 dt)``): :math:`\sigma_{\dot\psi} = N_\omega / \sqrt{2\,dt}`;
+    * one horizontal axis of a circular normal position error, whose CEP is
+      the median of a Rayleigh law: :math:`\sigma_\rho = CEP / \sqrt{2 \ln 2}`;
+    * a normal heading error whose absolute value has the median
+      :math:`h_{50}`: :math:`\sigma_\theta = h_{50} / \Phi^{-1}(0.75)`,
+      :math:`\Phi^{-1}(0.75) = 0.6745`.
+
+    The default levels give, at ``dt = 0.1`` s, :math:`\sigma_{\dot\psi} =
+    1.95 \cdot 10^{-4}` rad/s, :math:`\sigma_\rho = 0.0170` m and
+    :math:`\sigma_\theta = 0.0103` rad (0.59 deg).
+
+    References
+    ----------
+    .. [1] STMicroelectronics, "ISM330DHCX: iNEMO inertial module with
+       machine learning core", datasheet DS13012, Rev 6, Table 3.
+    .. [2] u-blox, "ZED-F9P high precision GNSS module, Integration
+       manual", UBX-18010802, Sec. 2.1.2 (RTK: 0.01 m + 1 ppm CEP).
+    .. [3] u-blox, "ZED-F9H u-blox F9 module for heading applications,
+       Integration manual", UBX-19030120, R05, 2022, Sec. 2.1.1 (0.4 deg
+       50 % for 1 m baseline).
+
+    Examples
+    --------
+    The standard deviations at the paper's 0.1 s sampling, checked against
+    scipy's Rayleigh and half-normal laws (the CEP and the 50 % heading
+    error are their medians):
+
+    >>> import numpy as np
+    >>> from scipy import stats
+    >>> from robustctl.models.truck import TruckSensors
+    >>> sensors = TruckSensors()
+    >>> s_gyro, s_rho, s_theta = sensors.std(0.1)
+    >>> bool(np.isclose(stats.rayleigh.median(scale=s_rho), sensors.position_cep))
+    True
+    >>> bool(np.isclose(np.degrees(stats.halfnorm.median(scale=s_theta)), sensors.heading_error_50))
+    True
+    >>> bool(np.isclose(np.degrees(s_gyro), 5e-3 / np.sqrt(0.2)))
+    True
+    >>> sensors.covariance(0.1).shape
+    (3, 3)
+    """
+
+    gyro_noise_density: float = 5e-3
+    position_cep: float = 0.02
+    heading_error_50: float = 0.4
+
+    def __post_init__(self):
+        for f in fields(self):
+            check_positive_scalar(getattr(self, f.name), f.name)
+
+    def std(self, dt: float) -> np.ndarray:
+        """Standard deviations of one sample of ``[psidot, rho, theta]`` [rad/s, m, rad] (class Notes).
+
+        Parameters
+        ----------
+        dt : float
+            Sampling time [s].
+
+        Returns
+        -------
+        (3,) ndarray
+            In the order of :data:`SENSOR_NAMES`.
+
+        Raises
+        ------
+        ValueError, TypeError
+            ``dt`` not a positive number.
+        """
+        dt = check_positive_scalar(dt, "dt")
+        return np.array([np.radians(self.gyro_noise_density) / np.sqrt(2.0 * dt),
+                         self.position_cep / _CEP_PER_SIGMA,
+                         np.radians(self.heading_error_50) / _MEDIAN_ABS_PER_SIGMA])
+
+    def covariance(self, dt: float) -> np.ndarray:
+        """The measurement noise covariance ``V = diag(std(dt)**2)`` (3, 3) of :func:`sensor_plant`'s outputs.
+
+        Parameters
+        ----------
+        dt : float
+            Sampling time [s].
+
+        Returns
+        -------
+        (3, 3) ndarray
+            Diagonal: the sensors' errors are independent.
+
+        Raises
+        ------
+        ValueError, TypeError
+            ``dt`` not a positive number.
+        """
+        return np.diag(self.std(dt) ** 2)
+
+
+def sensor_plant(overload: float = 0.0, *, params: TruckParameters | None = None) -> Plant:
+    r"""The truck of :func:`truck_plant` with its measured outputs ``y = [psidot, rho, theta]``.
+
+    Parameters
+    ----------
+    overload : float
+        Payload overload in percent.
+    params : TruckParameters, optional
+        Defaults to the paper's parameters.
+
+    Returns
+    -------
+    Plant
+        ``F``, ``G`` of :func:`truck_plant` (one steering input) and ``C``
+        (3, 4) selecting the states :data:`SENSOR_OUTPUTS`; ``D = 0``. The
+        noise levels of the outputs are :class:`TruckSensors`'.
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`truck_plant`.
+
+    See Also
+    --------
+    TruckSensors : the measurement noise.
+    robustctl.kalman : a filter of these outputs.
+
+    Notes
+    -----
+    .. math::
+
+        y_k = C x_k + v_k, \qquad C = \begin{bmatrix} 0 & 1 & 0 & 0 \\
+        0 & 0 & 1 & 0 \\ 0 & 0 & 0 & 1 \end{bmatrix},
+
+    so the lateral velocity is seen only through the dynamics: ``(C, F)``
+    is observable (``rho' = ydot + v theta``).
+
+    Examples
+    --------
+    The outputs see every state: the observability matrix has full rank
+    (python-control's ``obsv``):
+
+    >>> import numpy as np, control
+    >>> from robustctl.models.truck import sensor_plant
+    >>> plant = sensor_plant(100.0)
+    >>> plant
+    Plant(n=4, m=1, p=3, dt=0.1)
+    >>> int(np.linalg.matrix_rank(control.obsv(plant.F, plant.C)))
+    4
+    """
+    plant = truck_plant(overload, params=params)
+    return Plant(plant.F, plant.G, plant.dt, C=np.eye(4)[list(SENSOR_OUTPUTS)])

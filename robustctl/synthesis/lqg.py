@@ -11,8 +11,9 @@ estimator (:class:`robustctl.estimation.estimator.Estimator`, from
     e = y - C x_c - D u, \quad x_f = x_c + L_f e, \quad
     x_c^+ = F_e x_f + G_e u + J e ,
 
-with ``L_p = F_e L_f + J`` its predictor gain. The *filter* form feeds back
-the filtered estimate, ``u = K x_f`` (it uses ``y[k]`` at once); with
+with ``L_p = F_e L_f + J`` its predictor gain [2]_. The *filter* form feeds back
+the filtered estimate, ``u = K x_f`` (it uses ``y[k]`` at once, the current
+estimator of [1]_); with
 ``M = (I + K L_f D)^{-1}``
 
 .. math::
