@@ -100,12 +100,7 @@ def test_section_parser_finds_the_numpydoc_sections():
     assert takes_parameters(int.__add__) is True and takes_parameters(lambda: 0) is False
 
 
-ROBUSTCTL_PENDING = pytest.mark.xfail(
-    strict=False, reason="robustctl's public docstrings are being brought to numpydoc form on another branch "
-                         "(issue 32, item 2); this turns into a pass when that lands")
-
-
-@pytest.mark.parametrize("package", [pytest.param("robustctl", marks=ROBUSTCTL_PENDING), "moo"])
+@pytest.mark.parametrize("package", ["robustctl", "moo"])
 def test_public_docstrings_have_parameters_and_a_checked_example(package):
     objects = public_objects(package)
     assert objects, f"{package} has no public functions or classes in its __all__ lists"

@@ -120,11 +120,13 @@ filtering for uncertain linear systems", IEEE TAC 39(9), 1994.
 from __future__ import annotations
 
 from .cost import guaranteed_cost, robust_hinf_bound
+from .loop_margins import LoopMargins, disk_ranges, loop_margins
 from .margins_report import MarginsReport, margins_report
 from .results import CostBound, CostBoundBatch, HinfBound, RobustStability, RobustStabilityBatch, WorstCase
 from .robust_stability import robust_stability
 from .worst_case import worst_case
 
 __all__ = ["robust_stability", "guaranteed_cost", "robust_hinf_bound", "worst_case", "margins_report",
+           "loop_margins", "disk_ranges",
            "RobustStability", "RobustStabilityBatch", "CostBound", "CostBoundBatch", "HinfBound", "WorstCase",
-           "MarginsReport"]
+           "MarginsReport", "LoopMargins"]

@@ -34,12 +34,18 @@ and keeps the norm and the storage function. Where ``sigma_max(G(-1))``
 exceeds ``sigma_max(G(1))`` the loop ``(-A, B, -C)`` (the same norm,
 ``z -> -z``) is transformed instead, so that ``Dc`` is the smaller of the
 two and ``R = gamma^2 I - Dc'Dc`` stays far from singular near the peak.
-For the Riccati equation: the stabilising solution of
+A feedthrough ``D`` (:func:`hinf_norm` takes one) enters ``M(gamma)`` as
+above; in continuous time the level set starts from ``sigma_max(D)`` (the
+gain at ``w = inf``) too, and where that exceeds ``sigma_max(G(0))`` it runs
+on ``G(1/s)``, realised by ``(A^-1, A^-1 B, -C A^-1, D - C A^-1 B)`` (the
+same singular values at ``w`` and ``1 / w``, feedthrough ``G(0)``), for the
+same reason as the flip. For the Riccati equation: the stabilising solution of
 the continuous bounded-real Riccati equation of ``(Ac, Bc, Cc, Dc)`` is the
 stabilising solution ``P`` of the discrete one,
 ``P = A'PA + C'C + A'PB (gamma^2 I - B'PB)^-1 B'PA``. ``A + I`` is
-invertible for a Schur-stable ``A``. The singular values themselves are
-always evaluated on the original realisation (at ``z = exp(j theta)``).
+invertible for a Schur-stable ``A``. The singular values of a discrete
+loop are evaluated on its original realisation (at ``z = exp(j theta)``),
+those of an inverted continuous one on ``G(1/s)``.
 
 Riccati: the stabilising solution at a level ``gamma > ||G||_inf`` is
 ``P = X2 X1^-1`` from the ``n`` eigenvectors ``[X1; X2]`` of ``M(gamma)``
@@ -89,8 +95,10 @@ __all__ = ["hinf_norm", "bounded_real_riccati", "sigma_max", "eigvals", "eigvals
 
 #: Relative accuracy of the norm: the value ``g`` returned has ``g <= ||G|| <= (1 + 2 TOL) g``.
 TOL = 1e-10
-# An eigenvalue of M counts as imaginary when |Re| <= _IMAG (|lambda| + 1e-3 rho(M)).
-_IMAG = 1e-6
+# An eigenvalue of M counts as imaginary when |Re| <= _IMAG (|lambda| + 1e-3 rho(M)). Generous on purpose: a
+# false one only adds a test frequency (the midpoints of a true interval stay in it), while two nearly equal
+# crossings near a sharp peak come out with |Re| up to ~1e-4 |lambda| (1e-6 stopped 4e-3 below the norm).
+_IMAG = 1e-3
 _MAX_ITER = 60
 
 
@@ -186,12 +194,12 @@ def _stable_subspace(M, n: int):
     return np.take_along_axis(ev.real, order, axis=1), np.take_along_axis(V, order[:, None, :n], axis=2)
 
 
-def _cayley(A, B, C, flip=None):
+def _cayley(A, B, C, flip=None, D=None):
     """``(Ac, Bc, Cc, Dc)`` of the bilinear transform ``z = (1 + s) / (1 - s)`` (stacks).
 
     Where ``flip`` (S,) is True, of ``z = -(1 + s) / (1 - s)`` instead: the
-    transform of ``(-A, B, -C)``, which has the same norm and storage
-    functions, with ``Dc = G(1)`` instead of ``G(-1)``.
+    transform of ``(-A, B, -C, D)``, which has the same norm and storage
+    functions, with ``Dc = G(1)`` instead of ``G(-1)``. ``D`` None means zero.
     """
     if flip is not None and flip.any():
         sgn = np.where(flip, -1.0, 1.0)[:, None, None]
@@ -200,7 +208,20 @@ def _cayley(A, B, C, flip=None):
     I = np.eye(n)
     Mi = solve(A + I, np.broadcast_to(I, A.shape))
     MiB = Mi @ B
-    return Mi @ (A - I), np.sqrt(2.0) * MiB, np.sqrt(2.0) * (C @ Mi), -(C @ MiB)
+    Dc = -(C @ MiB) if D is None else D - C @ MiB
+    return Mi @ (A - I), np.sqrt(2.0) * MiB, np.sqrt(2.0) * (C @ Mi), Dc
+
+
+def _invert(A, B, C, D, flip):
+    """``(A^-1, A^-1 B, -C A^-1, D - C A^-1 B)`` (the realisation of ``G(1/s)``) where ``flip`` (S,) is True."""
+    if not flip.any():
+        return A, B, C, D
+    Ai = solve(A[flip], np.broadcast_to(np.eye(A.shape[-1]), A[flip].shape))
+    Bi, Ci = Ai @ B[flip], C[flip] @ Ai
+    A, B, C, D = A.copy(), B.copy(), C.copy(), D.copy()
+    A[flip], D[flip] = Ai, D[flip] - C[flip] @ Bi
+    B[flip], C[flip] = Bi, -Ci
+    return A, B, C, D
 
 
 def _hamiltonian(A, B, C, D, gamma):
@@ -223,12 +244,17 @@ def _hamiltonian(A, B, C, D, gamma):
     return np.concatenate([top, bottom], axis=-2)
 
 
-def sigma_max(A, B, C, points):
-    """``sigma_max(C (sI - A)^-1 B)`` at complex ``points`` (B, k) for stacks (B, n, n), (B, n, p), (B, l, n)."""
+def sigma_max(A, B, C, points, D=None):
+    """``sigma_max(D + C (sI - A)^-1 B)`` at complex ``points`` (B, k) for stacks (B, n, n), (B, n, p), (B, l, n).
+
+    ``D`` (B, l, p) None means zero.
+    """
     n = A.shape[-1]
     M = points[:, :, None, None] * np.eye(n) - A[:, None]
     rhs = np.broadcast_to(B[:, None], (*points.shape, *B.shape[1:])).astype(complex)
     T = C[:, None] @ np.linalg.solve(M, rhs)
+    if D is not None:
+        T = T + D[:, None]
     return _smax(T)
 
 
@@ -277,8 +303,8 @@ def _start(lam, discrete: bool):
     return np.concatenate([zero, np.where(lam[rows, k].imag > 0, np.abs(lam[rows, k]), 0.0)[:, None]], axis=1)
 
 
-def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
-    """``||G_b||_inf`` of each stable loop of a stack (D = 0).
+def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None, D=None):
+    """``||G_b||_inf`` of each stable loop of a stack.
 
     Parameters
     ----------
@@ -288,6 +314,10 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
         Relative accuracy (module docstring).
     poles : (S, n) ndarray, optional
         The eigenvalues of ``A`` if already known.
+    D : (S, l, p) ndarray, optional
+        The feedthrough (None: zero). In continuous time the level set then
+        starts from ``sigma_max(D)`` too (the gain at ``w = inf``, reported
+        as the peak frequency ``inf`` where it is the norm).
 
     Returns
     -------
@@ -304,10 +334,11 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
     c = np.sqrt((C * C).sum(axis=(1, 2)))
     live = (b > 0) & (c > 0)
     if not live.all():
-        gain, freq = np.zeros(S), np.zeros(S)
+        gain = np.zeros(S) if D is None else _smax(D)
+        freq = np.zeros(S)
         if live.any():
             g, w, it = hinf_norm(A[live], B[live], C[live], discrete=discrete, tol=tol,
-                                 poles=None if poles is None else poles[live])
+                                 poles=None if poles is None else poles[live], D=None if D is None else D[live])
             gain[live], freq[live] = g, w
             return gain, freq, it
         return gain, freq, 0
@@ -315,14 +346,21 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
     B, C = B * f, C / f
     rows = np.arange(S)
     w0 = _start(eigvals(A) if poles is None else poles, discrete)
-    sig = sigma_max(A, B, C, np.exp(1j * w0) if discrete else 1j * w0)
+    sig = sigma_max(A, B, C, np.exp(1j * w0) if discrete else 1j * w0, D)
+    if D is not None and not discrete:
+        w0 = np.concatenate([w0, np.full((S, 1), np.inf)], axis=1)
+        sig = np.concatenate([sig, _smax(D)[:, None]], axis=1)
     k = np.argmax(sig, axis=1)
     lb, peak = sig[rows, k], w0[rows, k]
     flip = np.zeros(S, dtype=bool)
     if discrete:
         # Dc of the transform is G(-1), or G(1) where flipped: the smaller keeps R = gamma^2 I - Dc'Dc far from singular
         flip = sig[:, 1] > sig[:, 0]
-        Ah, Bh, Ch, Dh = _cayley(A, B, C, flip)
+        Ah, Bh, Ch, Dh = _cayley(A, B, C, flip, D)
+    elif D is not None:
+        # where sigma_max(G(inf)) > sigma_max(G(0)), the level set runs on G(1/s) (feedthrough G(0)), for that reason
+        flip = sig[:, -1] > sig[:, 0]
+        Ah, Bh, Ch, Dh = _invert(A, B, C, D, flip)
     else:
         Ah, Bh, Ch, Dh = A, B, C, None
     active = rows
@@ -337,9 +375,10 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
         keep = count > 0
         if not keep.any():
             break
-        act = active
+        act, hk = active, ham
         if not keep.all():
             imag, ev, count, act = imag[keep], ev[keep], count[keep], active[keep]
+            hk = tuple(None if M is None else M[keep] for M in ham)
         wi = np.where(imag, np.abs(ev.imag), np.inf)
         wi = np.sort(wi, axis=1)[:, :int(count.max())]
         wi = np.concatenate([np.zeros((wi.shape[0], 1)), wi], axis=1)
@@ -348,10 +387,13 @@ def hinf_norm(A, B, C, *, discrete: bool, tol: float = TOL, poles=None):
         mid = np.where(valid, mid, 0.0)
         if discrete:
             mid = _theta(mid, flip[act])
-            pts = np.exp(1j * mid)
-        else:
-            pts = 1j * mid
-        sv = np.where(valid, sigma_max(A[act], B[act], C[act], pts), -np.inf)
+            sv = sigma_max(A[act], B[act], C[act], np.exp(1j * mid), None if D is None else D[act])
+        else:   # on the realisation of the Hamiltonian: G(1/s) has the singular values of G(s) at w = 1 / mid
+            sv = sigma_max(hk[0], hk[1], hk[2], 1j * mid, hk[3])
+            if flip.any():
+                with np.errstate(divide="ignore"):
+                    mid = np.where(flip[act][:, None], 1.0 / mid, mid)
+        sv = np.where(valid, sv, -np.inf)
         j = np.argmax(sv, axis=1)
         r = np.arange(sv.shape[0])
         best = sv[r, j]

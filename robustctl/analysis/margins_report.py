@@ -1,8 +1,12 @@
-"""Certified robust-stability margins of several controllers against named uncertainty models.
+"""Certified robust-stability margins of several controllers against named uncertainty models, and their loop margins.
 
 :func:`margins_report` runs :func:`robustctl.robust_stability` for
-every (controller, model) pair and returns a :class:`MarginsReport`, a small
-table with text, Markdown and CSV writers. A model is a norm-bounded
+every (controller, model) pair and :func:`robustctl.loop_margins` for every
+controller (its nominal loop broken at the plant input), and returns a
+:class:`MarginsReport`, two small tables with text, Markdown and CSV writers.
+The two kinds of margin differ: the robust-stability margin is a radius of a
+model of the uncertainty; the loop margins (disk, gain and phase margins,
+sensitivity peaks) are properties of the nominal loop's frequency response. A model is a norm-bounded
 uncertainty ``[dF dG] = H Delta [EF EG]`` (margin: the largest ``r`` with
 stability certified for every ``||Delta|| <= r``, the small-gain value
 ``1 / ||E (zI - A)^-1 H||_inf``) or a polytope, given by its vertices besides
@@ -26,7 +30,7 @@ import csv
 import io
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, cast
@@ -39,6 +43,7 @@ from ..systems.controller import Controller
 from ..systems.input_memory import InputMemoryFeedback
 from ..systems.plant import Plant, check_plant
 from ..systems.uncertainty import NormBounded
+from .loop_margins import LoopMargins, loop_margins
 
 if TYPE_CHECKING:                      # robustctl.analysis re-exports this module: import it lazily
     from .results import RobustStability
@@ -47,13 +52,17 @@ __all__ = ["MarginsReport", "margins_report"]
 
 _TITLE = ("Certified robust-stability margins (robustctl.robust_stability): the largest r with stability "
           "certified for r x the uncertainty; >= 1 certifies it all")
+_LOOP_TITLE = ("Loop margins at the plant input (robustctl.loop_margins, skew 0): disk margin with the gains and "
+               "phases it allows at once; classical gain and phase margins; peaks of S and T")
+_LOOP_COLUMNS = ("disk margin", "disk gains", "disk phase [deg]", "gain margin", "phase margin [deg]", "S peak",
+                 "T peak")
 
 
 @dataclass(frozen=True, eq=False, repr=False)
 class MarginsReport:
-    """Result of :func:`margins_report`: one certificate per controller and model.
+    """Result of :func:`margins_report`: one certificate per controller and model, and each controller's loop margins.
 
-    Attributes
+    Parameters
     ----------
     controllers : tuple of str
         Row names, in the order given.
@@ -62,11 +71,40 @@ class MarginsReport:
     results : Mapping
         ``results[controller][model]``: the :class:`~robustctl.RobustStability`,
         or a string ``"n/a (reason)"`` where the analysis raised.
+    loops : Mapping, optional
+        ``loops[controller]``: the :class:`~robustctl.LoopMargins` of its
+        nominal loop at the plant input, or ``"n/a (reason)"``.
+
+    Attributes
+    ----------
+    margin : (controllers, models) ndarray
+        The robust-stability margins (NaN where not available).
+    certified : (controllers, models) bool ndarray
+        ``margin >= 1`` certified.
+
+    See Also
+    --------
+    margins_report : makes it.
+
+    Examples
+    --------
+    One gain ``u = -0.6 x`` of a scalar plant ``x+ = 1.1 x + u`` with an
+    uncertainty ``dF = 0.5 Delta``: the closed loop is ``a = 0.5`` and the
+    margin the small-gain value ``1 / max |0.5 / (z - a)| = (1 - a) / 0.5 = 1``
+    (at ``z = 1``); its loop ``L = 0.6 / (z - 1.1)`` crosses the negative
+    real axis at ``z = -1`` with ``L = -0.6 / 2.1``, a gain margin of 3.5:
+
+    >>> import robustctl as rc
+    >>> plant = rc.Plant([[1.1]], [[1.0]], 0.1)
+    >>> report = rc.margins_report(plant, {"K": [[-0.6]]}, {"dF": rc.NormBounded([[0.5]], [[1.0]], [[0.0]])})
+    >>> round(float(report.margin[0, 0]), 6), round(report.loops["K"].gain_margin, 6)
+    (1.0, 3.5)
     """
 
     controllers: tuple[str, ...]
     models: tuple[str, ...]
     results: Mapping[str, Mapping[str, RobustStability | str]]
+    loops: Mapping[str, LoopMargins | str] = field(default_factory=lambda: MappingProxyType({}))
 
     @property
     def margin(self) -> np.ndarray:
@@ -87,19 +125,44 @@ class MarginsReport:
         m = self.results[controller][model]
         return m if isinstance(m, str) else f"{m.margin:.3g}{' (certified)' if m.certified else ''}"
 
+    def loop_cells(self, controller: str) -> tuple[str, ...]:
+        """The loop-margin entries of one controller as text (the columns of :meth:`loops_to_markdown`; worst loop).
+
+        The disk margin is the simultaneous one; the gain margin of several
+        loops is the one closest to 1 (in ``|log|``), the phase margin the
+        smallest in absolute value.
+        """
+        lm = self.loops.get(controller, "n/a (not computed)")
+        if isinstance(lm, str):
+            return (lm, *("" for _ in _LOOP_COLUMNS[1:]))
+        g = lm.gain_range
+        gm, pm = _worst_loop(lm)
+        return (f"{lm.alpha:.3g}", f"{g[0]:.3g} to {g[1]:.3g}", f"+-{lm.phase_range:.3g}", f"{gm:.3g}", f"{pm:.3g}",
+                f"{lm.S_peak:.3g}", f"{lm.T_peak:.3g}")
+
     def to_text(self) -> str:
-        """A fixed-width table with a title line (for a terminal or a log)."""
+        """Fixed-width tables with title lines (for a terminal or a log): the margins, then the loop margins."""
         wn = max(18, *(len(c) + 1 for c in self.controllers))
         wm = max(26, *(len(k) + 2 for k in self.models))
         head = f"{'controller':<{wn}}" + "".join(f"{k:>{wm}}" for k in self.models)
         lines = [_TITLE, head, "-" * len(head)]
         lines += [f"{c:<{wn}}" + "".join(f"{self.cell(c, k):>{wm}}" for k in self.models) for c in self.controllers]
+        if self.loops:
+            head = f"{'controller':<{wn}}" + "".join(f"{k:>20}" for k in _LOOP_COLUMNS)
+            lines += ["", _LOOP_TITLE, head, "-" * len(head)]
+            lines += [f"{c:<{wn}}" + "".join(f"{v:>20}" for v in self.loop_cells(c)) for c in self.controllers]
         return "\n".join(lines)
 
     def to_markdown(self) -> str:
         """A Markdown table: one row per controller, one column per model (ends with a newline)."""
         lines = ["| controller | " + " | ".join(self.models) + " |", "|---|" + "---:|" * len(self.models)]
         lines += [f"| {c} | " + " | ".join(self.cell(c, k) for k in self.models) + " |" for c in self.controllers]
+        return "\n".join(lines) + "\n"
+
+    def loops_to_markdown(self) -> str:
+        """The loop margins as a Markdown table: one row per controller (ends with a newline)."""
+        lines = ["| controller | " + " | ".join(_LOOP_COLUMNS) + " |", "|---|" + "---:|" * len(_LOOP_COLUMNS)]
+        lines += [f"| {c} | " + " | ".join(self.loop_cells(c)) + " |" for c in self.controllers]
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path: str | os.PathLike | None = None) -> str:
@@ -116,15 +179,46 @@ class MarginsReport:
                 m = self.results[c][k]
                 w.writerow([c, k, "" if isinstance(m, str) else f"{m.margin:.6g}",
                             "" if isinstance(m, str) else bool(m.certified)])
-        text = buf.getvalue()
-        if path is not None:
-            with open(Path(path), "w", newline="") as fh:
-                fh.write(text)
-        return text
+        return _written(buf.getvalue(), path)
+
+    def loops_to_csv(self, path: str | os.PathLike | None = None) -> str:
+        r"""CSV of the loop margins, one row per controller; written to ``path`` if given.
+
+        Columns ``controller,disk_margin,disk_gain_min,disk_gain_max,disk_phase_deg,gain_margin,phase_margin_deg,
+        S_peak,T_peak`` (the entries of :meth:`loop_cells`, to 6 significant digits); empty where not available.
+        """
+        buf = io.StringIO()
+        w = csv.writer(buf)
+        w.writerow(["controller", "disk_margin", "disk_gain_min", "disk_gain_max", "disk_phase_deg", "gain_margin",
+                    "phase_margin_deg", "S_peak", "T_peak"])
+        for c in self.controllers:
+            lm = self.loops.get(c)
+            if not isinstance(lm, LoopMargins):
+                w.writerow([c, *("" for _ in range(8))])
+                continue
+            gm, pm = _worst_loop(lm)
+            w.writerow([c, *(f"{v:.6g}" for v in (lm.alpha, *lm.gain_range, lm.phase_range, gm, pm, lm.S_peak,
+                                                  lm.T_peak))])
+        return _written(buf.getvalue(), path)
 
     def __repr__(self) -> str:
         return (f"MarginsReport(controllers={len(self.controllers)}, models={list(self.models)},\n"
                 f"margin=\n{np.array2string(self.margin, precision=4)})")
+
+
+def _worst_loop(lm: LoopMargins) -> tuple[float, float]:
+    """The gain margin closest to 1 (in ``|log|``) and the phase margin smallest in absolute value over the loops."""
+    gm, pm = np.atleast_1d(lm.gain_margin), np.atleast_1d(lm.phase_margin)
+    with np.errstate(divide="ignore"):
+        g = gm[np.argmin(np.where(np.isnan(gm), np.inf, np.abs(np.log(gm))))]
+    return float(g), float(pm[np.argmin(np.where(np.isnan(pm), np.inf, np.abs(pm)))])
+
+
+def _written(text: str, path: str | os.PathLike | None) -> str:
+    if path is not None:
+        with open(Path(path), "w", newline="") as fh:
+            fh.write(text)
+    return text
 
 
 def _model(name: str, model) -> NormBounded | list[Plant]:
@@ -153,12 +247,15 @@ def _law(name: str, law, plant: Plant) -> InputMemoryFeedback | Controller:
 
 def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controller | InputMemoryFeedback],
                    models: Mapping[str, NormBounded | Sequence[Plant]]) -> MarginsReport:
-    """Certified robust-stability margins of each controller against each named uncertainty model.
+    """Certified robust-stability margins of each controller against each named uncertainty model, and loop margins.
 
     For every pair, :func:`robustctl.robust_stability` of the loop
     ``(plant, K)`` (module docstring): ``uncertainty=model`` for a
     :class:`~robustctl.NormBounded`, ``vertices=model`` for a sequence of
-    plants. A pair whose analysis raises (:class:`~robustctl.RobustCtlError`
+    plants. For every controller, :func:`robustctl.loop_margins` of its
+    nominal loop broken at the plant input (a law with input memory: on the
+    plant augmented by the previous input, where ``u`` is still the loop's
+    input). An analysis that raises (:class:`~robustctl.RobustCtlError`
     or ``ValueError``, e.g. an infeasible certificate) is reported as
     ``"n/a (reason)"`` instead of stopping the report.
 
@@ -176,8 +273,10 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
     Returns
     -------
     MarginsReport
-        ``margin`` and ``certified`` arrays (controllers, models) and the
-        writers ``to_text()``, ``to_markdown()``, ``to_csv(path)``.
+        ``margin`` and ``certified`` arrays (controllers, models), ``loops``
+        (the :class:`~robustctl.LoopMargins` of each controller) and the
+        writers ``to_text()`` (both tables), ``to_markdown()``,
+        ``to_csv(path)``, ``loops_to_markdown()``, ``loops_to_csv(path)``.
 
     Examples
     --------
@@ -201,6 +300,16 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
     True
     >>> print(report.to_markdown().splitlines()[0])
     | controller | payload 0-300 % | steering |
+
+    The loop margins of the LQR, its loop built by hand for python-control
+    (``u = K x``: ``L = -K (zI - F)^-1 G``):
+
+    >>> import control
+    >>> L = control.ss(plant.F, plant.G, -rc.lqr(plant).K, 0, plant.dt)
+    >>> bool(abs(control.stability_margins(L)[1] - report.loops["LQR"].phase_margin) < 1e-6)
+    True
+    >>> print(report.loops_to_markdown().splitlines()[2])
+    | LQR | 1.07 | 0.301 to 3.32 | +-56.5 | 3.89 | 56.6 | 1.35 | 1.27 |
     """
     from .robust_stability import robust_stability
 
@@ -212,7 +321,12 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
     laws = {str(c): _law(str(c), law, plant) for c, law in controllers.items()}
     checked = {str(k): _model(str(k), m) for k, m in models.items()}
     results: dict[str, Mapping[str, RobustStability | str]] = {}
+    loops: dict[str, LoopMargins | str] = {}
     for name, law in laws.items():
+        try:
+            loops[name] = loop_margins(law if isinstance(law, Controller) else (law.augmented_plant(plant), law.gain))
+        except (RobustCtlError, ValueError) as exc:
+            loops[name] = f"n/a ({str(exc).splitlines()[0][:60]})"
         row: dict[str, RobustStability | str] = {}
         for key, model in checked.items():
             try:
@@ -229,4 +343,4 @@ def margins_report(plant: Plant, controllers: Mapping[str, ArrayLike | Controlle
             except (RobustCtlError, ValueError) as exc:
                 row[key] = f"n/a ({str(exc).splitlines()[0][:60]})"
         results[name] = MappingProxyType(row)
-    return MarginsReport(tuple(laws), tuple(checked), MappingProxyType(results))
+    return MarginsReport(tuple(laws), tuple(checked), MappingProxyType(results), MappingProxyType(loops))

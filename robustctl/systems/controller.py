@@ -329,7 +329,7 @@ class ControllerBatch:
     r"""A stack of ``B`` controllers of one plant: ``xc+ = Ac[b] xc + Bc[b] y``, ``u = Cc[b] xc + Dc[b] y``.
 
     What a population of a tuning family is, and what the batched analyses
-    (:func:`robustctl.robust_stability`, ``robustctl.loop_margins``, ...)
+    (:func:`robustctl.robust_stability`, :func:`robustctl.loop_margins`, ...)
     take. A stack of state feedbacks ``u = K[b] x`` is
     :meth:`ControllerBatch.from_gains`; ``(plant, K)`` always means state feedback.
 
