@@ -52,6 +52,7 @@ from .goals import (
     at_least,
     at_most,
 )
+from .margins import DiskMargin, Margins, SensitivityPeak
 from .output_feedback import FixedOrderFamily, LQGFamily, PIDFamily, RobustLQGFamily, StaticOutputFeedbackFamily
 from .problem import TuningProblem, penalise
 from .selection import Selection, SelectionResult, monte_carlo_selection, select
@@ -62,5 +63,5 @@ __all__ = ["DesignFamily", "FamilyGains", "FamilyControllers", "RLQRFamily", "LQ
            "TuningProblem", "penalise",
            "tune", "TuningResult", "select_front", "select", "Selection", "SelectionResult", "monte_carlo_selection",
            "Goal", "Response", "StepTracking", "ErrorGoal", "PeakInput", "SettlingTime", "Overshoot", "SpectralRadius",
-           "PoleRegion", "ControllerPoles", "H2Norm", "HinfNorm", "Variance", "RobustMargin", "Bound", "at_most",
-           "at_least"]
+           "PoleRegion", "ControllerPoles", "H2Norm", "HinfNorm", "Variance", "RobustMargin", "DiskMargin", "Margins",
+           "SensitivityPeak", "Bound", "at_most", "at_least"]
