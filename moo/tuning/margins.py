@@ -7,19 +7,14 @@ scenario for the whole population (state feedbacks ``(plant, K)`` or a
 convention for the loop transfer: ``L = -K(z) P(z)`` at the input,
 ``L = -P(z) K(z)`` at the output, ``S = (I + L)^{-1}``, ``T = I - S``.
 
-=========================  ===============================================  ==========
-goal                       per design and scenario                          ``over``
-=========================  ===============================================  ==========
-``DiskMargin()``           the disk margin ``alpha`` (minimised as           ``"max"``
-                           ``1 / alpha``; :meth:`~DiskMargin.measure`
-                           is ``alpha``)
-``Margins(gain_db, ...)``  how far the loop is from the required margins:    ``"max"``
-                           ``alpha_req / alpha`` (disk) or the largest of
-                           ``GM_req / GM`` and ``PM_req / PM`` (classical);
-                           ``<= 1`` where they are met
-``SensitivityPeak(...)``   ``||S||_inf`` or ``||T||_inf`` (optionally        ``"max"``
-                           weighted: ``max_w |W(jw)| sigma_max(S(jw))``)
-=========================  ===============================================  ==========
+* :class:`DiskMargin` - the disk margin ``alpha`` (minimised as
+  ``1 / alpha``; :meth:`DiskMargin.measure` is ``alpha``), the worst
+  scenario (``over="max"``) or their mean;
+* :class:`Margins` - how far the loop is from required margins,
+  ``alpha_req / alpha`` (disk) or the largest of ``GM_req / GM`` and
+  ``PM_req / PM`` (classical): ``<= 1`` where they are met;
+* :class:`SensitivityPeak` - ``||S||_inf`` or ``||T||_inf``, optionally
+  weighted (``max_w |W(jw)| sigma_max(S(jw))``).
 
 References
 ----------
