@@ -91,7 +91,7 @@ R. A. Smith, "Matrix equation XA + BX = C", SIAM J. Appl. Math. 16(1), 1968.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, Literal, cast
 
 import numpy as np
@@ -110,7 +110,7 @@ from robustctl.validation import (
     check_real,
 )
 
-from .loops import Controllers, Loops, check_controllers, closed_loops, count, is_output_feedback, plant_outputs
+from .loops import Controllers, Loops, check_controllers, closed_loops, count, is_output_feedback, with_outputs
 
 __all__ = ["Goal", "Response", "StepTracking", "Run", "ErrorGoal", "PeakInput", "SettlingTime", "Overshoot",
            "SpectralRadius", "PoleRegion", "ControllerPoles", "H2Norm", "HinfNorm", "Variance", "RobustMargin",
@@ -145,10 +145,7 @@ def _loops(K, plants) -> tuple[Controllers, list[rc.Plant], Loops]:
 
 def _with_outputs(plant: rc.Plant, K: Controllers) -> rc.Plant:
     """``plant`` with the output model the controllers read (an output feedback's batch plant's, if it has none)."""
-    if not is_output_feedback(K) or plant.has_outputs:
-        return plant
-    C, D = plant_outputs(plant, K)
-    return replace(plant, C=C, D=D)
+    return with_outputs(plant, K.plant) if is_output_feedback(K) else plant
 
 
 def _discrete(plants, what: str, hint: str = "") -> list[rc.Plant]:

@@ -22,7 +22,7 @@ the same plant tuple, build the loops once.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from typing_extensions import TypeIs
 
 __all__ = ["Loops", "closed_loops", "stability", "check_controllers", "take", "count", "is_output_feedback",
-           "plant_outputs"]
+           "plant_outputs", "with_outputs"]
 
 Controllers = np.ndarray | rc.ControllerBatch
 
@@ -90,6 +90,14 @@ def take(controllers: Controllers, idx) -> Controllers:
     out = np.array(np.asarray(controllers)[idx], dtype=float)
     out.flags.writeable = False
     return out
+
+
+def with_outputs(plant: rc.Plant, source: rc.Plant) -> rc.Plant:
+    """``plant`` itself if it has an output model, else ``plant`` with ``source``'s ``C`` and ``D``."""
+    if plant.has_outputs:
+        return plant
+    C, D = source.output_matrices()
+    return replace(plant, C=C, D=D)
 
 
 def plant_outputs(plant: rc.Plant, controllers: Controllers) -> tuple[np.ndarray, np.ndarray]:

@@ -30,7 +30,6 @@ value as their objectives, so they are infeasible too.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import replace
 from typing import Any
 
 import moocore
@@ -43,7 +42,7 @@ from robustctl.validation import check_positive_scalar
 from ..validation import as_float_array, as_matrix, check_choice, check_int
 from .families import DesignFamily, FamilyControllers, FamilyGains, bound_vector, check_bounds, population
 from .goals import check_scenarios
-from .loops import Controllers, check_controllers, closed_loops, count, is_output_feedback, take
+from .loops import Controllers, check_controllers, closed_loops, count, is_output_feedback, take, with_outputs
 from .loops import stability as loop_stability
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
@@ -143,16 +142,10 @@ def _goals(goals, kind: str) -> tuple[list, list[str]]:
 
 def _with_outputs(plants: Sequence[rc.Plant], plant: rc.Plant) -> list[rc.Plant]:
     """The scenarios as an output feedback reads them: ``plant``'s ``C``, ``D`` where a scenario has none."""
-    out = []
     for i, p in enumerate(plants):
-        if p.has_outputs:
-            if p.p != plant.p:
-                raise ValueError(f"scenarios[{i}] has p={p.p} outputs, the family's controllers read p={plant.p}")
-            out.append(p)
-        else:
-            C, D = plant.output_matrices()
-            out.append(replace(p, C=C, D=D))
-    return out
+        if p.has_outputs and p.p != plant.p:
+            raise ValueError(f"scenarios[{i}] has p={p.p} outputs, the family's controllers read p={plant.p}")
+    return [with_outputs(p, plant) for p in plants]
 
 
 def _finite(K: Controllers) -> np.ndarray:
@@ -236,6 +229,10 @@ class TuningProblem(Problem):
     hv_ref_source : str
         Where ``hv_ref_point`` comes from: ``"given"``, ``"sampled designs"``
         or ``"penalty"`` (no sampled design was acceptable).
+    feedback : {"state", "output"}
+        The family's kind: the goals get gains (B, m, n) or an
+        :class:`robustctl.ControllerBatch`; for an output feedback the
+        scenarios without an output model get the family plant's ``C``, ``D``.
     last_flags : (B,) object ndarray
         Why each design of the last evaluated population was penalised
         (``""`` for none): the family's reason, ``"unstable"``, or
@@ -317,9 +314,9 @@ class TuningProblem(Problem):
         if isinstance(plant, rc.Plant) and plant.dt != self.scenarios[0].dt:
             raise ValueError(f"family.plant has dt={plant.dt} but the scenarios have dt={self.scenarios[0].dt}: "
                              "design the family on a plant of the scenarios' sampling time")
-        if self.feedback == "output":
-            assert isinstance(plant, rc.Plant)
-            self.scenarios = _with_outputs(self.scenarios, plant)
+        self._outputs_of = plant if self.feedback == "output" else None      # the C, D the controllers read
+        if self._outputs_of is not None:
+            self.scenarios = _with_outputs(self.scenarios, self._outputs_of)
         self.objectives, self.objective_names = _goals(objectives, "objectives")
         if not self.objectives:
             raise ValueError("objectives must not be empty")
@@ -415,8 +412,7 @@ class TuningProblem(Problem):
                                  f"family), got {fg!r}")
             batch = fg.controllers
             check_controllers(batch, self.scenarios, "family.gains(...).controllers")
-            mats = (batch.Ac, batch.Bc, batch.Cc, batch.Dc)
-            ok = np.asarray(fg.ok, dtype=bool) & np.all([np.isfinite(M).all(axis=(1, 2)) for M in mats], axis=0)
+            ok = np.asarray(fg.ok, dtype=bool) & _finite(batch)
             return FamilyControllers(batch, ok, np.asarray(fg.reason, dtype=object))
         K = np.asarray(getattr(fg, "K", None), dtype=float)
         if K.shape != (B, self.n_inputs, self.n_states):
@@ -453,8 +449,8 @@ class TuningProblem(Problem):
         if scenarios is None:
             return self._plants
         plants = check_scenarios(scenarios, "scenarios", continuous=not self.scenarios[0].is_discrete)
-        if self.feedback == "output":
-            plants = _with_outputs(plants, getattr(self.family, "plant"))  # noqa: B009 - checked in __init__
+        if self._outputs_of is not None:
+            plants = _with_outputs(plants, self._outputs_of)
         return tuple(plants)
 
     def closed_loops(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
