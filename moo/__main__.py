@@ -4,16 +4,16 @@
 
     python -m moo run --problem {generic,applied,zdt1..6,dtlz1..7} [--n-obj M] [--setup S]
                       --algorithm NAME [--molsp [--max-leaders K]] --seed S
-                      --evals N [--pop-size P] --out FILE.json
+                      --evals N [--pop-size P] --out FILE.json [--quiet]
     python -m moo experiment --problem P [--n-obj M] [--setup S] [--algorithms all|a,b] --runs N
                       --evals E [--max-leaders K] [--pop-size P] [--seed BASE] --out DIR
                       [--executor {process,dask}] [--workers W] [--scheduler ADDRESS]
-                      [--keep-going]
+                      [--keep-going] [--quiet]
     python -m moo stats DIR [--out FILE.csv|.md|.tex] [--ranks-out FILE.csv|.md|.tex]
                       [--runs-out FILE.csv] [--alpha A]
     python -m moo plot DIR --out FIGDIR [--format png,pdf]
     python -m moo select SOURCE --problem P [--n-obj M] [--setup S] [--algorithm NAME [--molsp]]
-                      [--n-sims N] --seed S [--out FILE.json]
+                      [--n-sims N] --seed S [--out FILE.json] [--quiet]
 
 ``--problem`` and ``--algorithm``/``--algorithms`` take a registry name or the
 import path ``package.module:factory`` of a user's problem or MOEA (see
@@ -67,7 +67,18 @@ Exit codes (the same for every command):
   no run of it;
 * 130 - interrupted (Ctrl-C); the records already written stay.
 
-Progress bars go to stderr when stderr is a terminal.
+On a terminal (stderr), ``run``, ``experiment`` and ``select`` show a progress
+bar (tqdm) while they work, and ``run`` and ``experiment`` end with one summary
+line (the front's size, its hypervolume and the reference point's source,
+the best value of each objective, where the results were written); with
+``--quiet``, or when stderr is not a terminal (a log, a pipe), they print
+nothing but errors (``select`` prints its choice on stdout in any case).
+
+Algorithm names (``--algorithm``, ``--algorithms``; ``all`` is the ten MOEAs
+of the study): ``nsga2`` is NSGA-II with the paper's operators, not pymoo's
+defaults; ``pymoo-nsga2`` is pymoo's own NSGA-II; ``ga`` is a single-objective
+genetic algorithm for problems with one objective (``python -m moo run -h``
+lists every name with its meaning).
 """
 
 from __future__ import annotations
@@ -81,16 +92,20 @@ import traceback
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager, nullcontext
 
-from moo.algorithms import ALGORITHMS
+from moo.algorithms import ALGORITHM_NOTES, ALGORITHMS, MORE_ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
 from moo.problems import PROBLEMS
-from moo.store import DISK_ERRORS
+from moo.progress import ProgressBar, front_summary
+from moo.store import DISK_ERRORS, SettingsMismatchError
 
 __all__ = ["main"]
 
 _PROG = "python -m moo"
 
 _SETUP_HELP = "set-up of the applied problem: ours (default) or authors (the authors' published code)"
+_QUIET_HELP = "no progress bar and no summary line (the default when stderr is not a terminal)"
+_ALGORITHM_NAMES = "algorithms (all: the ten of the study):\n" + "\n".join(
+    f"  {name:<12} {note}" for name, note in ALGORITHM_NOTES.items())
 _EXIT_CODES = """exit codes: 0 done; 1 the work failed (a run raised, or the executor failed; records
 already written stay, rerun to resume); 2 bad arguments (nothing run); 130 interrupted"""
 
@@ -104,9 +119,9 @@ class _Parser(argparse.ArgumentParser):
         raise _UsageError(message)
 
 
-def _subparser(sub, name: str, help_text: str, example: str) -> argparse.ArgumentParser:
+def _subparser(sub, name: str, help_text: str, example: str, more: str = "") -> argparse.ArgumentParser:
     return sub.add_parser(name, help=help_text, description=help_text,
-                          epilog=f"example:\n  {example}\n\n{_EXIT_CODES}",
+                          epilog=f"example:\n  {example}\n\n{more + chr(10) * 2 if more else ''}{_EXIT_CODES}",
                           formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
@@ -123,22 +138,24 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     r = _subparser(sub, "run", "one run of a MOEA on a problem, recorded as JSON",
-                   f"{_PROG} run --problem applied --algorithm nsga3 --molsp --seed 1 --evals 10000 --out run.json")
+                   f"{_PROG} run --problem applied --algorithm nsga3 --molsp --seed 1 --evals 10000 --out run.json",
+                   _ALGORITHM_NAMES)
     r.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}, or package.module:factory")
     r.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
     r.add_argument("--setup", default=None, help=_SETUP_HELP)
     r.add_argument("--algorithm", required=True,
-                   help=f"one of {', '.join(ALGORITHMS)}, or package.module:factory")
+                   help=f"one of {', '.join([*ALGORITHMS, *MORE_ALGORITHMS])} (see below), or package.module:factory")
     r.add_argument("--molsp", action="store_true", help="add MO-LSP to the algorithm")
     r.add_argument("--max-leaders", type=int, default=None, help="MO-LSP cap on candidates per generation")
     r.add_argument("--seed", type=int, required=True, help="seed (integer >= 0)")
     r.add_argument("--evals", type=int, required=True, help="evaluation budget")
     r.add_argument("--pop-size", type=int, default=POP_SIZE, help=f"population size (default {POP_SIZE})")
     r.add_argument("--out", required=True, help="output JSON file (checked before the run)")
+    r.add_argument("--quiet", action="store_true", help=_QUIET_HELP)
 
     e = _subparser(sub, "experiment", "a resumable grid of runs: algorithms x {plain, MO-LSP} x seeds",
                    f"{_PROG} experiment --problem generic --algorithms nsga2,nsga3 --runs 50 --evals 10000 "
-                   "--out results/generic --executor dask --workers 2")
+                   "--out results/generic --executor dask --workers 2", _ALGORITHM_NAMES)
     e.add_argument("--problem", required=True, help=f"one of {', '.join(PROBLEMS)}, or package.module:factory")
     e.add_argument("--n-obj", type=int, default=None, help="number of objectives (DTLZ; default 3)")
     e.add_argument("--setup", default=None, help=_SETUP_HELP)
@@ -159,6 +176,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="address of a running Dask scheduler (with --executor dask), e.g. tcp://HOST:8786")
     e.add_argument("--keep-going", action="store_true",
                    help="record a failed run (with its traceback) and go on; default: stop at the first failure")
+    e.add_argument("--quiet", action="store_true", help=_QUIET_HELP)
 
     s = _subparser(sub, "stats", "indicators and statistics (ANOVA/Tukey, Wilcoxon-Holm, Friedman/Nemenyi)",
                    f"{_PROG} stats results/generic --out table.tex --ranks-out ranks.md --runs-out runs.csv")
@@ -195,6 +213,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--n-sims", type=int, default=1000, help="number of simulations (default 1000, the paper's)")
     c.add_argument("--seed", type=int, required=True, help="seed of the draws (integer >= 0)")
     c.add_argument("--out", default=None, help="write the selection to FILE.json (checked before the work)")
+    c.add_argument("--quiet", action="store_true", help="no progress bar (the default when stderr is not a terminal)")
     return parser
 
 
@@ -216,30 +235,26 @@ def _flagged(message: str) -> str:
     return message.replace("molsp=True", "--molsp")
 
 
+#: The settings of a results directory (:mod:`moo.store`) by the flags that set them.
+_SETTING_FLAGS = {"budget": "--evals", "pop_size": "--pop-size", "max_leaders": "--max-leaders",
+                  "base_seed": "--seed", "seed": "--seed", "problem": "--problem", "n_obj": "--n-obj",
+                  "setup": "--setup", "algorithm": "--algorithms", "molsp": "the MO-LSP variant"}
+
+
+def _settings_message(exc: SettingsMismatchError) -> str:
+    """A settings mismatch with the settings named by their flags (``--evals 40 (this grid: 60)``)."""
+    return exc.message(_SETTING_FLAGS)
+
+
 @contextmanager
 def _usage() -> Iterator[None]:
     """Turn the library's argument errors (raised before any work) into usage errors."""
     try:
         yield
+    except SettingsMismatchError as exc:
+        raise _UsageError(_settings_message(exc)) from None
     except (ValueError, TypeError, NotImplementedError) as exc:
         raise _UsageError(_flagged(str(exc))) from None
-
-
-class _Progress:
-    """A one-line progress bar on stderr."""
-
-    def __init__(self, label: str, width: int = 30):
-        self.label, self.width = label, width
-
-    def __call__(self, done: int, total: int) -> None:
-        frac = min(done / total, 1.0)
-        bar = "#" * round(frac * self.width)
-        sys.stderr.write(f"\r{self.label} [{bar:<{self.width}}] {done}/{total} evals")
-        sys.stderr.flush()
-
-    def close(self) -> None:
-        sys.stderr.write("\n")
-        sys.stderr.flush()
 
 
 def _error(message: str, code: int) -> int:
@@ -263,20 +278,22 @@ def _cmd_run(args) -> int:
         out = check_output_file(args.out, "--out")
         job = prepare(args.problem, args.algorithm, seed=args.seed, evals=args.evals, n_obj=args.n_obj,
                       molsp=args.molsp, pop_size=args.pop_size, max_leaders=args.max_leaders, setup=args.setup)
-    bar = _Progress(f"{args.algorithm}{'+molsp' if args.molsp else ''} {args.problem} s{args.seed}") \
-        if sys.stderr.isatty() else None
+    bar = ProgressBar(f"{args.algorithm}{'+molsp' if args.molsp else ''} {args.problem} s{args.seed}",
+                      unit="evals", total=args.evals, enabled=False if args.quiet else None)
     try:
-        result = job.run(progress=bar)
+        with bar:
+            result = job.run(progress=bar)
     except Exception as exc:  # noqa: BLE001 - the CLI's boundary: traceback, then one line naming it
         return _failure(exc, "the run failed")
-    finally:
-        if bar is not None:
-            bar.close()
     record = result.to_dict()
     try:
         write_json_atomic(out, record)
     except OSError as exc:
         return _error(f"cannot write {out} ({_os_reason(exc)}); {_keep_elsewhere(record, out)}", 1)
+    if bar.enabled:
+        names = getattr(job.problem, "objective_names", None) or [f"f{j + 1}" for j in range(result.F.shape[1])]
+        source = getattr(job.problem, "hv_ref_source", "the problem's hv_ref_point")
+        print(front_summary(result.F, names, result.hv, source, str(out)), file=sys.stderr)
     return 0
 
 
@@ -312,7 +329,7 @@ def _keep_elsewhere(record: dict, out) -> str:
 def _cmd_experiment(args) -> int:
     from moo.executors import open_executor
     from moo.experiment import RunFailedError, prepare
-    from moo.store import ResultsDirBusyError, SettingsMismatchError
+    from moo.store import ResultsDirBusyError
 
     if args.molsp_max_leaders is not None:
         if args.max_leaders is not None:
@@ -324,13 +341,14 @@ def _cmd_experiment(args) -> int:
         grid = prepare(args.problem, args.algorithms, runs=args.runs, evals=args.evals, out=args.out,
                        n_obj=args.n_obj, base_seed=args.seed, pop_size=args.pop_size,
                        max_leaders=args.max_leaders, setup=args.setup)
-    if grid.skipped:
+    show = not args.quiet and sys.stderr.isatty()
+    if grid.skipped and show:
         retry = f", {grid.retried} failed before and retried" if grid.retried else ""
         print(f"{grid.skipped} of {len(grid.specs)} runs already done in {grid.out} (skipped); "
               f"{len(grid.todo)} to run{retry}", file=sys.stderr)
     try:
         with executor if grid.todo else nullcontext() as ex:    # nothing to run: no cluster to start
-            report = grid.run(ex, keep_going=args.keep_going)
+            report = grid.run(ex, keep_going=args.keep_going, progress=show)
     except RunFailedError as exc:
         return _error(f"{exc}; the records written stay, rerun to resume", 1)
     except ConnectionError as exc:
@@ -343,10 +361,11 @@ def _cmd_experiment(args) -> int:
     except ResultsDirBusyError as exc:
         return _error(str(exc), 2)
     except SettingsMismatchError as exc:
-        return _error(_flagged(str(exc)), 2)
+        return _error(_settings_message(exc), 2)
     except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the experiment stopped (the records written stay, rerun to resume)")
-    print(report, file=sys.stderr)
+    if show:
+        print(report.summary(), file=sys.stderr)
     if report.failed:
         more = f" and {len(report.failed) - 1} more" if len(report.failed) > 1 else ""
         return _error(f"{len(report.failed)} of {report.total} runs failed; tracebacks in "
@@ -460,7 +479,8 @@ def _cmd_select(args) -> int:
         records = load_source(args.source)
         front = front_from_records(records, problem, problem_name=name, algorithm=algorithm, molsp=molsp)
     try:
-        sel = select_on_front(problem, front, n_sims=args.n_sims, seed=args.seed)
+        with ProgressBar("select", unit="plants", enabled=False if args.quiet else None) as bar:
+            sel = select_on_front(problem, front, n_sims=args.n_sims, seed=args.seed, progress=bar)
     except Exception as exc:  # noqa: BLE001 - as in _cmd_run
         return _failure(exc, "the selection failed")
     where = "" if sel.index is None else f" ({sel.front.origin[sel.index][0]}, row {sel.front.origin[sel.index][1]})"
@@ -471,7 +491,11 @@ def _cmd_select(args) -> int:
     print(f"  rule: {rule}; {args.n_sims} simulations, seed {args.seed}")
     print(f"  wins: {sel.wins}/{sel.n_sims} ({100 * sel.share:.1f} %)")
     print(f"  z = {_vector(sel.z)}")
-    print(f"  K = {_vector(sel.K).replace(chr(10), chr(10) + '      ')}")
+    if sel.K is not None:
+        print(f"  K = {_vector(sel.K).replace(chr(10), chr(10) + '      ')}")
+    elif sel.controller is not None:
+        print(f"  K(z): order {sel.controller.order}, "
+              f"Dc = {_vector(sel.controller.Dc).replace(chr(10), chr(10) + '      ')}")
     if sel.margin is not None:
         print(f"  certified robust margin (NormBounded uncertainty): {sel.margin:.6g}")
     if out is not None:

@@ -88,6 +88,7 @@ from moo.algorithms import ALGORITHMS
 from moo.algorithms.operators import POP_SIZE
 from moo.executors import POOL_RESTARTS, RestartingPool, open_executor
 from moo.factories import build_problem, check_algorithm_name, check_problem_name
+from moo.progress import ProgressBar
 from moo.store import (
     FAILED_SUFFIX,
     CorruptRecordError,
@@ -162,6 +163,12 @@ class ExperimentReport:
         fails = f", {len(self.failed)} failed" if self.failed else ""
         return (f"ExperimentReport({self.out}: {self.total} runs, {self.skipped} already done, "
                 f"{self.completed} run now{fails} in {self.wall_time:.1f} s)")
+
+    def summary(self) -> str:
+        """One line: the runs done now, before and failed, and where the records are."""
+        fails = f", {len(self.failed)} failed" if self.failed else ""
+        return (f"experiment: {self.completed} of {self.total} runs done now, {self.skipped} already done{fails}, "
+                f"in {self.wall_time:.1f} s; records in {self.out}")
 
 
 class RunFailedError(RuntimeError):
@@ -338,33 +345,13 @@ def _execute(spec: RunSpec) -> dict:
 
 # ---------------------------------------------------------------------------- the driver
 
-class _Progress:
-    """``[done/total runs] elapsed, ETA`` on one stderr line (ETA over the whole grid)."""
-
-    def __init__(self, total: int, skipped: int):
-        self.total, self.skipped, self.start = total, skipped, time.perf_counter()
-
-    def update(self, done_now: int, failed: int, label: str) -> None:
-        elapsed = time.perf_counter() - self.start
-        remaining = self.total - self.skipped - done_now
-        eta = f"{elapsed / done_now * remaining:.0f} s" if done_now else "?"
-        fails = f", {failed} failed" if failed else ""
-        sys.stderr.write(f"\r[{self.skipped + done_now}/{self.total} runs{fails}] elapsed {elapsed:.0f} s, "
-                         f"ETA {eta}  {label:<40.40}")
-        sys.stderr.flush()
-
-    def close(self) -> None:
-        sys.stderr.write("\n")
-        sys.stderr.flush()
-
-
 @dataclass
 class _Recorder:
     """Writes what the runs return (records, failure records) and keeps count."""
 
     out: Path
     keep_going: bool
-    bar: _Progress | None
+    bar: ProgressBar | None
     completed: int = 0
     failed: list[Path] = field(default_factory=list)
 
@@ -376,7 +363,8 @@ class _Recorder:
         else:
             self.keep(spec, rec)
         if self.bar is not None:
-            self.bar.update(self.completed + len(self.failed), len(self.failed), spec.label)
+            self.bar.postfix(f"{len(self.failed)} failed, last {spec.label}" if self.failed else spec.label)
+            self.bar(self.bar.done + 1)
         if failed and not self.keep_going:
             raise RunFailedError(spec, self.failed[-1], rec["error"])
 
@@ -468,8 +456,8 @@ class PreparedExperiment:
         keep_going : bool
             Record a failed run and go on (default: stop at the first failure).
         progress : bool, optional
-            ``runs done/total``, the failures and an ETA on stderr; default:
-            only when stderr is a terminal.
+            A progress bar of the runs (tqdm: done/total, the failures, an
+            ETA) on stderr; default: only when stderr is a terminal.
 
         Raises
         ------
@@ -492,21 +480,19 @@ class PreparedExperiment:
             # another writer may have added runs between prepare() and the lock
             todo = [s for s in self.todo if s not in self.expected or not _is_done(s, self.out, self.expected[s])]
             skipped = len(self.specs) - len(todo)
-            show = sys.stderr.isatty() if progress is None else bool(progress)
-            bar = _Progress(len(self.specs), skipped) if show else None
-            recorder = _Recorder(self.out, bool(keep_going), bar)
+            bar = ProgressBar("experiment", unit="runs", total=len(self.specs), initial=skipped,
+                              enabled=None if progress is None else bool(progress))
+            recorder = _Recorder(self.out, bool(keep_going), bar if bar.enabled else None)
             start = time.perf_counter()
             try:
-                if bar is not None:
-                    bar.update(0, 0, "")
+                bar(skipped)
                 if executor is None:
                     for spec in todo:
                         recorder.add(spec, _execute(spec))
                 else:
                     _run_on(executor, todo, recorder)
             finally:
-                if bar is not None:
-                    bar.close()
+                bar.close()
         return ExperimentReport(out=self.out, total=len(self.specs), skipped=skipped,
                                 completed=recorder.completed, wall_time=time.perf_counter() - start,
                                 failed=tuple(recorder.failed))

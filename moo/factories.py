@@ -166,6 +166,6 @@ def check_problem_name(name: object) -> str:
 
 def check_algorithm_name(name: object) -> str:
     """The record key of an algorithm: a registry name in lower case, an import path as given."""
-    from moo.algorithms import ALGORITHMS
+    from moo.algorithms import ALGORITHMS, MORE_ALGORITHMS
 
-    return _record_key(name, ALGORITHMS, f"unknown algorithm {name!r} in algorithms")
+    return _record_key(name, {**ALGORITHMS, **MORE_ALGORITHMS}, f"unknown algorithm {name!r} in algorithms")

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -196,8 +197,10 @@ class RecordSelection:
         Its row of the front (None for an extra design of the paper's rule).
     z : (n_var,) ndarray
         Its decision vector (NaN for the paper's nominal LQR).
-    K : (m, n) ndarray
-        Its gain ``u = K x``.
+    K : (m, n) ndarray or None
+        Its gain ``u = K x`` (None for an output feedback: see ``controller``).
+    controller : robustctl.Controller or None
+        The chosen controller of an output-feedback problem (None for a state feedback).
     counts : (D,) int ndarray
         Simulations won by each candidate.
     n_sims : int
@@ -213,10 +216,11 @@ class RecordSelection:
     best: int
     index: int | None
     z: np.ndarray
-    K: np.ndarray
+    K: np.ndarray | None
     counts: np.ndarray
     n_sims: int
     margin: float | None
+    controller: rc.Controller | None = None
 
     @property
     def wins(self) -> int:
@@ -240,7 +244,10 @@ class RecordSelection:
             "rule": self.rule, "n_sims": self.n_sims, "records": list(self.front.records),
             "n_front": len(self.front), "n_designs": len(self.labels), "label": self.label, "index": self.index,
             "record": None if origin is None else origin[0], "record_row": None if origin is None else origin[1],
-            "z": [_plain(v) for v in self.z], "K": [[_plain(v) for v in row] for row in self.K],
+            "z": [_plain(v) for v in self.z],
+            "K": None if self.K is None else [[_plain(v) for v in row] for row in self.K],
+            "controller": None if self.controller is None else {
+                name: np.asarray(getattr(self.controller, name)).tolist() for name in ("Ac", "Bc", "Cc", "Dc")},
             "F": None if self.index is None else self.front.F[self.index].tolist(),
             "wins": self.wins, "share": self.share, "margin": self.margin,
             "labels": list(self.labels), "counts": self.counts.tolist(),
@@ -251,9 +258,14 @@ class RecordSelection:
                 f"front={len(self.front)})")
 
 
-def _margin(problem, K: np.ndarray) -> float | None:
+def _margin(problem, K: np.ndarray | rc.Controller) -> float | None:
+    """The certified margin of a gain or of a dynamic controller against the problem's ``uncertainty``, if any."""
     uncertainty = getattr(problem, "uncertainty", None)
-    if not isinstance(uncertainty, rc.NormBounded) or not np.all(np.isfinite(K)):
+    if not isinstance(uncertainty, rc.NormBounded):
+        return None
+    if isinstance(K, rc.Controller):
+        return _plain(rc.robust_stability(K, uncertainty).margin)
+    if not np.all(np.isfinite(K)):
         return None
     return _plain(rc.robust_stability((design_plant(problem), K), uncertainty).margin)
 
@@ -286,8 +298,12 @@ def select_from_records(records: list[dict], problem, *, problem_name: str, algo
     return select_on_front(problem, front, n_sims=n_sims, seed=seed)
 
 
-def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=None) -> RecordSelection:
-    """The selection of :func:`select_from_records` on a front already pooled (:func:`front_from_records`)."""
+def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=None,
+                    progress: Callable[[int, int], None] | None = None) -> RecordSelection:
+    """The selection of :func:`select_from_records` on a front already pooled (:func:`front_from_records`).
+
+    ``progress(done, total)`` follows the simulated plants (the paper's rule: all at once).
+    """
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"select needs a moo.tuning.TuningProblem, got a {type(problem).__name__}")
     n_sims = check_int(n_sims, "n_sims", 1)
@@ -295,15 +311,23 @@ def select_on_front(problem, front: RecordFront, *, n_sims: int = 1000, seed=Non
     from .tuning.tune import select_front
 
     if is_paper_problem(problem):                                           # the paper's: their own rule
+        if progress is not None:
+            progress(0, n_sims)
         ds = select_design(problem, front.X, n_sims=n_sims, seed=seed)
+        if progress is not None:
+            progress(n_sims, n_sims)
         best = ds.best
         index = best if ds.designs.kinds[best] == "front" else None
         K, z, labels, counts, rule = ds.designs.K[best], ds.z, ds.designs.labels, ds.result.counts, "paper"
     else:
-        sel = select_front(problem, front.X, front.F, n_sims=n_sims, seed=seed)
+        sel = select_front(problem, front.X, front.F, n_sims=n_sims, seed=seed, progress=progress)
         best = index = sel.index
         K, z, counts, rule = sel.K, front.X[index].copy(), sel.counts, "scenarios"
         labels = tuple(str(i + 1) for i in range(len(front)))
-    return RecordSelection(front=front, rule=rule, labels=tuple(labels), best=int(best), index=index, z=z,
-                           K=np.array(K, dtype=float), counts=np.asarray(counts), n_sims=n_sims,
-                           margin=_margin(problem, np.asarray(K, dtype=float)))
+        if K is None:
+            return RecordSelection(front=front, rule=rule, labels=labels, best=int(best), index=index, z=z, K=None,
+                                   counts=np.asarray(counts), n_sims=n_sims, margin=_margin(problem, sel.controller),
+                                   controller=sel.controller)
+    K = np.array(K, dtype=float)
+    return RecordSelection(front=front, rule=rule, labels=tuple(labels), best=int(best), index=index, z=z, K=K,
+                           counts=np.asarray(counts), n_sims=n_sims, margin=_margin(problem, K))

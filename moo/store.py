@@ -60,6 +60,7 @@ import json
 import math
 import os
 import re
+import stat
 import tempfile
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -102,13 +103,27 @@ class ResultsDirBusyError(ValueError):
 
 
 class SettingsMismatchError(ValueError):
-    """A run or a grid whose settings differ from those of the results directory (the message names them)."""
+    """A run or a grid whose settings differ from those of the results directory (the message names them).
+
+    ``where``, ``wrong`` (``(setting, recorded, this grid's)`` triples) and
+    ``remedy`` are kept, so that a caller can name the settings its own way
+    (the command line names its flags: ``--evals`` for ``budget``).
+    """
+
+    def __init__(self, where: str, wrong, remedy: str, names: dict[str, str] | None = None):
+        self.where, self.wrong, self.remedy = where, [tuple(w) for w in wrong], remedy
+        super().__init__(self.message(names))
+
+    def message(self, names: dict[str, str] | None = None) -> str:
+        """The message, each setting called by ``names.get(setting, setting)``."""
+        names = names or {}
+        what = ", ".join(f"{names.get(k, k)} {got!r} (this grid: {want!r})" for k, got, want in self.wrong)
+        return f"{self.where} {what}; {self.remedy}"
 
 
 def settings_mismatch(where: str, wrong, remedy: str) -> SettingsMismatchError:
     """The error for ``where`` holding other settings; ``wrong`` lists ``(name, recorded, this grid's)``."""
-    what = ", ".join(f"{k} {got!r} (this grid: {want!r})" for k, got, want in wrong)
-    return SettingsMismatchError(f"{where} {what}; {remedy}")
+    return SettingsMismatchError(where, wrong, remedy)
 
 
 class CorruptRecordError(ValueError):
@@ -158,15 +173,34 @@ def _umask() -> int:
     return mask
 
 
+def _special(path: Path) -> bool:
+    """Whether ``path`` exists (through any symbolic link) and is not a regular file: a device, a FIFO, a socket."""
+    try:
+        return not stat.S_ISREG(os.stat(path).st_mode) and not stat.S_ISDIR(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+def _resolved(path: Path) -> Path:
+    """``path`` with its symbolic links followed: the file a write replaces (the link itself stays)."""
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on a clean exit it replaces ``path`` atomically.
 
     For writers that take a file name (``Figure.savefig``). The temporary
     file keeps ``path``'s suffix; it gets the usual mode (``0666 & ~umask``).
-    On any error it is removed and ``path`` is left as it was.
+    On any error it is removed and ``path`` is left as it was. A symbolic
+    link is written through (its target is replaced, the link stays); a
+    device or a FIFO (``/dev/stdout``) is written directly, never replaced.
     """
     path = Path(path)
+    if _special(path):
+        yield path
+        return
+    path = _resolved(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}")
     try:
         try:
@@ -185,9 +219,17 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
     """Write ``text`` to ``path`` atomically (temp file in the same directory, fsync, rename).
 
     The directory is created if needed. On any failure (a full disk: ``OSError``) the temporary file
-    is removed and ``path`` is left as it was.
+    is removed and ``path`` is left as it was. A symbolic link is written through (its target is
+    replaced atomically, the link stays); a device or a FIFO (``/dev/stdout``, ``/dev/null``) is
+    written directly, never replaced (a write that fails there, ``/dev/full``, raises ``OSError``).
     """
     path = Path(path)
+    if _special(path):
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+        return
+    path = _resolved(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
         fh.write(text)
@@ -455,14 +497,20 @@ def check_output_file(path: str | os.PathLike, name: str = "out") -> Path:
     """``path`` as a :class:`~pathlib.Path`, checked before any work to be writable as a file.
 
     Not empty, not a directory, its directory existing and writable (tried with a temporary
-    file, so that read-only or virtual file systems such as ``/proc`` are caught).
+    file, so that read-only or virtual file systems such as ``/proc`` are caught). A symbolic
+    link is checked at its target; a device or a FIFO (``/dev/stdout``) must be writable (it is
+    written through, never replaced).
     """
     if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
         raise ValueError(f"{name} must be a file path, got {path!r}")
     path = Path(path)
     if path.is_dir():
         raise ValueError(f"{name}: {str(path)!r} is a directory, not a file")
-    parent = path.absolute().parent
+    if _special(path):
+        if not os.access(path, os.W_OK):
+            raise ValueError(f"{name}: {str(path)!r} is not writable")
+        return path
+    parent = _resolved(path).absolute().parent
     if not parent.is_dir():
         raise ValueError(f"{name}: directory {str(parent)!r} does not exist")
     _probe_directory(parent, name)

@@ -98,7 +98,27 @@ def test_progress_bar_on_a_terminal(tmp_path, monkeypatch, capsys):
                       "--pop-size", "20")
     err = capsys.readouterr().err
     assert code == 0
-    assert "\r" in err and "/100 evals" in err and err.endswith("\n")
+    assert "\r" in err and "/100 [" in err and "evals/s" in err             # the tqdm bar, then its line cleared
+    summary = err.rsplit("\r", 1)[-1].strip()                             # one summary line at the end
+    rec = json.loads((tmp_path / "out.json").read_text())
+    assert summary.startswith(f"front: {len(rec['F'])} designs, hypervolume {rec['hv']:.6g} (reference: ")
+    assert summary.endswith(f"written to {tmp_path / 'out.json'}") and summary.count("\n") == 0
+
+
+def test_quiet_prints_nothing_on_a_terminal(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    code, _ = run_cli(tmp_path, "--problem", "zdt1", "--algorithm", "nsga2", "--seed", "0", "--evals", "100",
+                      "--pop-size", "20", "--quiet")
+    assert code == 0 and capsys.readouterr().err == ""
+
+
+def test_help_explains_the_algorithm_names(capsys):
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    out = capsys.readouterr().out
+    assert "nsga2        NSGA-II (Deb et al. 2002) with the paper's operators" in out and "not pymoo's defaults" in out
+    assert "pymoo-nsga2  pymoo's own NSGA-II, pymoo's default operators" in out
+    assert "ga           a single-objective genetic algorithm" in out
 
 
 @pytest.mark.parametrize("args, message", [

@@ -130,18 +130,20 @@ def dask_processes(tmp_path):
         yield address
 
 
-def test_cli_on_dask_scheduler_and_two_workers(tmp_path, serial, dask_processes, capsys):
+def test_cli_on_dask_scheduler_and_two_workers(tmp_path, serial, dask_processes, capsys, monkeypatch):
     out = tmp_path / "res"
     cmd = [sys.executable, "-m", "moo", "experiment", *CLI_GRID, "--out", str(out), "--executor", "dask",
            "--scheduler", dask_processes]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO, timeout=180, check=False)
     assert proc.returncode == 0, proc.stderr
     assert _content(out) == serial
-    from moo.__main__ import main  # the rerun in-process (no second start-up)
+    assert proc.stderr == ""                             # stderr is not a terminal: quiet
+    from moo.__main__ import main  # the rerun in-process (no second start-up), on a terminal
 
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
     assert main(cmd[3:]) == 0
     err = capsys.readouterr().err
-    assert "6 of 6 runs already done" in err and "0 run now" in err
+    assert "6 of 6 runs already done" in err and "0 of 6 runs done now, 6 already done" in err
 
 
 def test_cli_dask_argument_errors(tmp_path, capsys):

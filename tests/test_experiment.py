@@ -178,7 +178,7 @@ def test_workers_give_the_same_records(tmp_path):
 def test_progress_goes_to_stderr_only_when_asked(tmp_path, fake_run, capsys):
     run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path / "a", progress=True)
     err = capsys.readouterr().err
-    assert "[2/2 runs]" in err and "ETA" in err
+    assert "/2 [" in err and "runs/s" in err and "zdt1/nsga2" in err         # tqdm: done/total [elapsed<ETA, rate]
     run_experiment("zdt1", "nsga2", runs=1, evals=300, out=tmp_path / "b")   # stderr not a TTY under pytest
     assert capsys.readouterr().err == ""
 
@@ -271,7 +271,7 @@ def test_cli_rerun_with_other_evals_is_a_one_line_usage_error(tmp_path, fake_run
     capsys.readouterr()
     assert main([*args, "--evals", "400"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "holds runs with other settings: budget 300 (this grid: 400)" in err
+    assert err.count("\n") == 1 and "holds runs with other settings: --evals 300 (this grid: 400)" in err
     assert "settings.json" in err and "Traceback" not in err
 
 

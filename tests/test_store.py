@@ -60,9 +60,9 @@ def test_settings_are_recorded_once_and_another_budget_is_refused(tmp_path, caps
     # nsga3 at another budget in the nsga2 directory: its cells are empty, the directory is not
     assert main([*base, "--algorithms", "nsga3", "--evals", "60"]) == 2
     err = _one_line(capsys.readouterr().err)
-    assert f"{out / 'settings.json'}: the directory holds runs with other settings: budget 40 (this grid: 60)" in err
+    assert f"{out / 'settings.json'}: the directory holds runs with other settings: --evals 40 (this grid: 60)" in err
     assert main([*base, "--algorithms", "nsga3", "--evals", "40", "--seed", "7"]) == 2
-    assert "base_seed 0 (this grid: 7)" in capsys.readouterr().err
+    assert "--seed 0 (this grid: 7)" in capsys.readouterr().err
     assert not (out / "zdt1" / "nsga3").exists()
     assert main([*base, "--algorithms", "nsga3", "--evals", "40"]) == 0      # the same settings: added
 

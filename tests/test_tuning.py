@@ -109,8 +109,11 @@ def test_problem_penalty_rule_and_reference_points():
     fam = tuning.RLQRFamily(plants[1])
     prob = tuning.TuningProblem(fam, plants, [effort, radius], penalty=1e3)
     assert (prob.n_var, prob.n_obj, prob.n_ieq_constr) == (fam.n_var, 2, 0)
-    np.testing.assert_array_equal(prob.hv_ref_point, [1e3, 1e3])
-    np.testing.assert_array_equal(prob.molsp_ref_point, prob.hv_ref_point)
+    # the default reference points: from 500 designs sampled within the bounds (seed 0), not the penalty
+    hv, ms = prob.sample_reference_points(500, seed=0)
+    np.testing.assert_array_equal(prob.hv_ref_point, hv)
+    np.testing.assert_array_equal(prob.molsp_ref_point, ms)
+    assert prob.hv_ref_source == "sampled designs" and np.all(hv < 1e3)
     Z = np.random.default_rng(3).uniform(0.0, 200.0, (30, fam.n_var))
     F = prob.evaluate(Z)
     K = fam.gains(Z).K
@@ -160,7 +163,7 @@ def test_problem_bad_input():
         tuning.TuningProblem(fam, [], [effort])
     with pytest.raises(ValueError, match=r"bounds inverted.*xl\[1\]"):
         tuning.TuningProblem(fam, SCENARIOS, [effort], xl=[0, 2, 0], xu=[1, 1, 1])
-    with pytest.raises(ValueError, match="family gives gains of shape"):
+    with pytest.raises(ValueError, match="family gives controllers for n=3 states and m=1 inputs"):
         tuning.TuningProblem(tuning.LQRFamily(rc.Plant(0.5 * np.eye(3), np.ones((3, 1)), dt=0.1)), SCENARIOS, [effort])
     with pytest.raises(TypeError, match=r"objectives\[0\] must be callable"):
         tuning.TuningProblem(fam, SCENARIOS, ["x"])

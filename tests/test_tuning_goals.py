@@ -233,9 +233,9 @@ def test_bounds_on_goals_and_callables(plants, gains):
 # ---------------------------------------------------------------- bad input
 def test_bad_input(plants, gains):
     resp = Response(x0=[1.0, 0.0, 0.0], steps=20)
-    with pytest.raises(ValueError, match=r"states must be state indices in \[0, 3\)"):
+    with pytest.raises(ValueError, match=r"states must be measured signal indices in \[0, 3\)"):
         resp.error(states=[0, 3]).check(plants)
-    with pytest.raises(ValueError, match=r"states must be state indices"):
+    with pytest.raises(ValueError, match=r"states must be measured signal indices"):
         resp.settling_time(5).check(plants)
     with pytest.raises(ValueError, match=r"inputs must be input indices in \[0, 2\)"):
         resp.peak_input(2).check(plants)
@@ -279,13 +279,13 @@ def test_bad_input(plants, gains):
         RobustMargin(rc.NormBounded(np.ones((2, 1)), np.ones((1, 2)), np.ones((1, 1)))).check(plants)
     with pytest.raises(ValueError, match=r"plants\[1\] must have n=\d states .* like plants\[0\], got n=2"):
         check_scenarios([plants[0], rc.Plant(np.eye(2), np.ones((2, 2)), DT)])
-    with pytest.raises(ValueError, match=r"plants\[0\] must be discrete-time"):
+    with pytest.raises(ValueError, match=r"SpectralRadius needs discrete-time plants; these are continuous"):
         SpectralRadius().check([rc.Plant(A_C, B_C, None)])
     with pytest.raises(TypeError, match=r"plants must be a non-empty list of robustctl\.Plant, got an empty list"):
         SpectralRadius().check([])
-    with pytest.raises(ValueError, match="K must have 2 rows"):
+    with pytest.raises(ValueError, match=r"K must be a non-empty stack \(B, 2, 3\) of gains"):
         SpectralRadius()(np.zeros((2, 1, 3)), plants)
-    with pytest.raises(ValueError, match="K must have 3 columns"):
+    with pytest.raises(ValueError, match=r"K must be a non-empty stack \(B, 2, 3\) .* got shape \(2, 2, 4\)"):
         SpectralRadius()(np.zeros((2, 2, 4)), plants)
 
 
@@ -301,7 +301,7 @@ def test_goals_in_a_tuning_problem(plants, gains):
     np.testing.assert_allclose(J, np.column_stack([g(gains, plants) for g in objectives]))
     np.testing.assert_allclose(C[:, 0], constraints[0](gains, plants))
     # a goal that does not fit the plants is refused when the problem is built
-    with pytest.raises(ValueError, match=r"states must be state indices in \[0, 3\)"):
+    with pytest.raises(ValueError, match=r"states must be measured signal indices in \[0, 3\)"):
         TuningProblem(LQRFamily(plants[1]), plants, [resp.error([3])])
     with pytest.raises(ValueError, match="Bw must have 3 rows"):
         TuningProblem(LQRFamily(plants[1]), plants, [SpectralRadius()], [at_most(H2Norm([1.0, 0.0], [1.0]), 1.0)])

@@ -41,7 +41,7 @@ from importlib import import_module
 from .base import MIN_POP_SIZE
 from .operators import POP_SIZE
 
-__all__ = ["ALGORITHMS", "MIN_POP_SIZE", "POP_SIZE", "make_algorithm"]
+__all__ = ["ALGORITHMS", "MORE_ALGORITHMS", "ALGORITHM_NOTES", "MIN_POP_SIZE", "POP_SIZE", "make_algorithm"]
 
 ALGORITHMS: dict[str, str] = {
     "nsga2": "moo.algorithms.nsga:make_nsga2",
@@ -56,6 +56,38 @@ ALGORITHMS: dict[str, str] = {
     "bige": "moo.algorithms.bige:make_bige",
 }
 
+#: Algorithms beyond the ten of the study (``"all"`` of an experiment does not include them):
+#: the single-objective genetic algorithm and pymoo's own NSGA-II (pymoo's operators, not the paper's).
+MORE_ALGORITHMS: dict[str, str] = {
+    "ga": "moo.algorithms.ga:make_ga",
+    "pymoo-nsga2": "moo.algorithms.nsga:make_pymoo_nsga2",
+}
+
+_PAPER = "the paper's operators (SBX pc 1, eta 20; polynomial mutation, 0.5 expected mutated variables, eta 20)"
+#: What each registry name means: one line each (the command line's help and :func:`moo.tuning.tune` list them).
+ALGORITHM_NOTES: dict[str, str] = {
+    "nsga2": f"NSGA-II (Deb et al. 2002) with {_PAPER}, not pymoo's defaults",
+    "pymoo-nsga2": "pymoo's own NSGA-II, pymoo's default operators (SBX pc 0.9, eta 15; mutation 1/n, eta 20)",
+    "nsga3": f"NSGA-III (Deb & Jain 2014) with {_PAPER}",
+    "theta-dea": f"theta-DEA (Yuan et al. 2016) with {_PAPER}",
+    "mombi2": f"MOMBI-II (Hernandez Gomez & Coello 2015) with {_PAPER}",
+    "moea-igd-ns": f"MOEA/IGD-NS (Tian et al. 2016) with {_PAPER}",
+    "efr-rr": f"EFR-RR (Yuan et al. 2016) with {_PAPER}",
+    "maoea-ddfc": f"MaOEA-DDFC (Cheng et al. 2015) with {_PAPER}",
+    "spea-r": f"SPEA/R (Jiang & Yang 2017) with {_PAPER}",
+    "spea2-sde": f"SPEA2+SDE (Li et al. 2014) with {_PAPER}",
+    "bige": f"BiGE (Li et al. 2015) with {_PAPER}",
+    "ga": f"a single-objective genetic algorithm (pymoo's GA) with {_PAPER}: for problems with one objective",
+}
+
+
+def _single_objective_hint(key: str, n_obj) -> str | None:
+    """The message for a MOEA of :data:`ALGORITHMS` asked for one objective (else None)."""
+    if key in ALGORITHMS and isinstance(n_obj, int) and not isinstance(n_obj, bool) and n_obj == 1:
+        return (f"n_obj must be >= 2 for the MOEA {key!r}, got 1: a problem with one objective runs with "
+                "algorithm 'ga' (a single-objective genetic algorithm with the paper's operators)")
+    return None
+
 
 def make_algorithm(name: str, *, n_obj: int, pop_size: int = POP_SIZE, **options):
     """A pymoo algorithm by registry name, configured with the paper's defaults.
@@ -63,9 +95,10 @@ def make_algorithm(name: str, *, n_obj: int, pop_size: int = POP_SIZE, **options
     Parameters
     ----------
     name : str
-        A name of :data:`ALGORITHMS` (case-insensitive).
+        A name of :data:`ALGORITHMS` or :data:`MORE_ALGORITHMS`
+        (case-insensitive; :data:`ALGORITHM_NOTES` says what each means).
     n_obj : int
-        Number of objectives (>= 2).
+        Number of objectives (>= 2; 1 for ``"ga"``).
     pop_size : int
         Population size, at least :data:`MIN_POP_SIZE` (default
         :data:`POP_SIZE`, the paper's 92; the reference-direction
@@ -104,9 +137,13 @@ def make_algorithm(name: str, *, n_obj: int, pop_size: int = POP_SIZE, **options
     ('ThetaDEA', 92, (91, 3))
     """
     key = name.lower() if isinstance(name, str) else name
-    if key not in ALGORITHMS:
-        raise ValueError(f"unknown algorithm {name!r}; valid: {', '.join(ALGORITHMS)}")
-    module, func = ALGORITHMS[key].split(":")
+    registry = {**ALGORITHMS, **MORE_ALGORITHMS}
+    if key not in registry:
+        raise ValueError(f"unknown algorithm {name!r}; valid: {', '.join(registry)}")
+    hint = _single_objective_hint(key, n_obj)
+    if hint is not None:
+        raise ValueError(hint)
+    module, func = registry[key].split(":")
     try:
         factory = getattr(import_module(module), func)
     except (ImportError, AttributeError) as exc:  # an algorithm not built yet

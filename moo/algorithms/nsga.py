@@ -13,7 +13,7 @@ from pymoo.algorithms.moo.nsga3 import NSGA3
 from .base import factory_arguments, factory_ref_dirs
 from .operators import POP_SIZE, OperatorSettings
 
-__all__ = ["make_nsga2", "make_nsga3", "NSGA2_ORIGINAL_OPERATORS", "NSGA3_ORIGINAL_OPERATORS"]
+__all__ = ["make_nsga2", "make_nsga3", "make_pymoo_nsga2", "NSGA2_ORIGINAL_OPERATORS", "NSGA3_ORIGINAL_OPERATORS"]
 
 #: NSGA-II's own settings (Deb et al. 2002, Sec. VI: SBX pc = 0.9, eta_c = 20; pm = 1/n, eta_m = 20).
 NSGA2_ORIGINAL_OPERATORS = OperatorSettings(crossover_prob=0.9, crossover_eta=20.0, mutation_rate=1.0,
@@ -30,6 +30,25 @@ def make_nsga2(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | Operato
     """
     _, pop_size, variation = factory_arguments(n_obj, pop_size, operators, NSGA2_ORIGINAL_OPERATORS)
     return NSGA2(pop_size=pop_size, eliminate_duplicates=True, **variation)
+
+
+def make_pymoo_nsga2(*, n_obj: int, pop_size: int = POP_SIZE) -> NSGA2:
+    """The NSGA-II of pymoo itself, every operator at pymoo's default (registry name ``"pymoo-nsga2"``).
+
+    pymoo 0.6's defaults: SBX with ``prob = 0.9``, ``eta = 15``; polynomial
+    mutation with ``eta = 20`` at rate ``1 / n_var``; binary tournament on rank
+    and crowding. ``"nsga2"`` is the same algorithm with the paper's
+    operators (:data:`~moo.algorithms.operators.PAPER_OPERATORS`).
+
+    Examples
+    --------
+    >>> from moo.algorithms import make_algorithm
+    >>> alg = make_algorithm("pymoo-nsga2", n_obj=2, pop_size=40)
+    >>> alg.mating.crossover.eta.value, alg.mating.crossover.prob.value
+    (15, 0.9)
+    """
+    _, pop_size, _ = factory_arguments(n_obj, pop_size, "paper", NSGA2_ORIGINAL_OPERATORS)
+    return NSGA2(pop_size=pop_size)
 
 
 def make_nsga3(*, n_obj: int, pop_size: int = POP_SIZE, operators: str | OperatorSettings = "paper",

@@ -28,6 +28,7 @@ vehicles", Control Engineering Practice 85 (2019) (the doubled steering column).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import ClassVar, Literal
 
 import numpy as np
@@ -42,7 +43,7 @@ from robustctl.validation import check_positive_scalar
 
 from ..tuning import RLQRFamily, TuningProblem
 from .generic import positive_ref_point
-from .scenario_errors import ErrorColumn, ScenarioErrors
+from .scenario_errors import ErrorColumn, ScenarioErrors, same_plants
 
 __all__ = ["AppliedRLQRProblem", "PathFollowingErrors", "PathFollowingError"]
 
@@ -76,9 +77,9 @@ class PathFollowingErrors(ScenarioErrors):
         super().__init__(plants, aggregate, backend)
         self.sim = sim
 
-    def per_scenario(self, K: np.ndarray, plants: list[rc.Plant] | None = None) -> np.ndarray:
+    def per_scenario(self, K: np.ndarray, plants: Sequence[rc.Plant] | None = None) -> np.ndarray:
         """MSEs (B, S, 4) of gains ``K`` (B, 2, 4), in the order f1..f4 (no penalties)."""
-        if plants is not None and plants is not self.plants:
+        if plants is not None and not same_plants(plants, self.plants):
             raise ValueError("the applied MOP's goals simulate its own payload scenarios only; "
                              "use moo.problems.selection for other payloads")
         return self.sim.run(K, keep_trajectories=False, backend=self.backend).mse()

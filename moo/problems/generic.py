@@ -33,6 +33,7 @@ discrete-time state-space systems", ACC 2009 (the RLQR).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Literal
 
 import numpy as np
@@ -42,7 +43,7 @@ from robustctl.sim.simulator import LinearSimulator
 
 from ..tuning import RLQRFamily, TuningProblem
 from ..validation import as_matrix, check_int
-from .scenario_errors import ErrorColumn, ScenarioErrors
+from .scenario_errors import ErrorColumn, ScenarioErrors, same_plants
 
 __all__ = ["GenericRLQRProblem", "RegulationErrors", "RegulationError", "positive_ref_point"]
 
@@ -93,16 +94,16 @@ class RegulationErrors(ScenarioErrors):
         self.initial_states, self.horizon = initial_states, horizon
         self._sim = self._simulator(plants)
 
-    def _simulator(self, plants: list[rc.Plant]) -> LinearSimulator:
+    def _simulator(self, plants: Sequence[rc.Plant]) -> LinearSimulator:
         n0, n = self.initial_states.shape
         F_s, G_s = np.stack([p.F for p in plants]), np.stack([p.G for p in plants])
         # one regulation run per (scenario, initial state): scenario index s * n0 + i
         return LinearSimulator(np.repeat(F_s, n0, axis=0), np.repeat(G_s, n0, axis=0), np.zeros((self.horizon + 1, n)),
                                x0=np.tile(self.initial_states, (len(plants), 1)), bound=_REGULATION_BOUND)
 
-    def per_scenario(self, K: np.ndarray, plants: list[rc.Plant] | None = None) -> np.ndarray:
+    def per_scenario(self, K: np.ndarray, plants: Sequence[rc.Plant] | None = None) -> np.ndarray:
         """Errors (B, S, n) of gains ``K`` (B, m, n) whose closed loops are all stable."""
-        sim = self._sim if plants is None or plants is self.plants else self._simulator(plants)
+        sim = self._sim if plants is None or same_plants(plants, self.plants) else self._simulator(plants)
         S = len(self.plants if plants is None else plants)
         n0, n = self.initial_states.shape
         sums = sim.run(K, keep_trajectories=False, backend=self.backend).sq_state_sum

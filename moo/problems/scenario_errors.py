@@ -22,6 +22,7 @@ each returning its column ``j``.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from typing import Literal, cast
 
 import numpy as np
@@ -32,7 +33,7 @@ from robustctl.sim.simulator import BACKENDS
 from ..tuning.goals import OVER
 from ..validation import check_choice
 
-__all__ = ["ScenarioErrors", "ErrorColumn"]
+__all__ = ["ScenarioErrors", "ErrorColumn", "same_plants"]
 
 
 class ScenarioErrors(ABC):
@@ -79,18 +80,23 @@ class ScenarioErrors(ABC):
         self._last: tuple = (None, None, None)
 
     @abstractmethod
-    def per_scenario(self, K: np.ndarray, plants: list[rc.Plant] | None = None) -> np.ndarray:
+    def per_scenario(self, K: np.ndarray, plants: Sequence[rc.Plant] | None = None) -> np.ndarray:
         """Errors ``e`` (B, S, k) of gains ``K`` (B, m, n) on ``plants`` (default: the own scenarios)."""
 
-    def __call__(self, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+    def __call__(self, K: np.ndarray, plants: Sequence[rc.Plant]) -> np.ndarray:
         """Combined errors ``f`` (B, k), ``mean_s`` or ``max_s`` of :meth:`per_scenario` (memoised)."""
         last_K, last_plants, last_value = self._last
-        if K is last_K and plants is last_plants:
+        if K is last_K and same_plants(plants, last_plants):
             return last_value
-        e = self.per_scenario(K) if plants is self.plants else self.per_scenario(K, plants)
+        e = self.per_scenario(K) if same_plants(plants, self.plants) else self.per_scenario(K, plants)
         value = e.mean(axis=1) if self.aggregate == "mean" else e.max(axis=1)
         self._last = (K, plants, value)
         return value
+
+
+def same_plants(a: Sequence[rc.Plant] | None, b: Sequence[rc.Plant] | None) -> bool:
+    """Whether ``a`` and ``b`` hold the same plant objects in the same order (a list and its tuple copy do)."""
+    return a is not None and b is not None and len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True))
 
 
 class ErrorColumn:

@@ -355,13 +355,17 @@ def _design_set(X: np.ndarray, K_front: np.ndarray, extras: list[tuple[str, str,
 
 def _general_designs(problem: TuningProblem, X: np.ndarray, seed) -> DesignSet:
     """Front, the family's nominal design (if it has ``nominal()``), random: for any TuningProblem."""
+    if problem.feedback == "output":
+        raise TypeError("select_design's extra designs are state feedbacks; for an output-feedback problem use "
+                        "moo.tuning.select_front (the front alone)")
     z_random = np.asarray(_rng(seed).uniform(problem.xl, problem.xu))
-    K_all = problem.gains(np.vstack([X, z_random])).K
+    K_all = np.asarray(problem.designs(np.vstack([X, z_random]))[0])
     N = X.shape[0]
     extras = []
     nominal = getattr(problem.family, "nominal", None)
     if callable(nominal):
-        extras.append(("nominal", "nominal", problem.check_gains(nominal()), np.full((1, problem.n_var), np.nan)))
+        extras.append(("nominal", "nominal", np.asarray(problem.check_gains(nominal())),
+                       np.full((1, problem.n_var), np.nan)))
     return _design_set(X, K_all[:N], extras, z_random, K_all[N:])
 
 
@@ -392,8 +396,8 @@ def build_designs(problem: TuningProblem, X_front, *, seed=None) -> DesignSet:
     if np.any(X[:, -1] < 0):
         raise ValueError(f"X_front's last variable, (log10 mu)^2, must be >= 0, got {X[:, -1].min():g}")
     z_random = np.asarray(_rng(seed).uniform(problem.xl, problem.xu))      # (n_var,): pymoo's bounds are arrays
-    batch = problem.gains(np.vstack([X, z_random]))
-    K_rlqr = np.where(batch.ok[:, None, None], batch.K, np.nan)
+    K_rlqr, ok, _ = problem.designs(np.vstack([X, z_random]))
+    K_rlqr = np.where(ok[:, None, None], np.asarray(K_rlqr), np.nan)
     K_nom = rc.lqr(problem.plant, Q=problem.Q, R=problem.R).K
     assert K_nom is not None                                 # lqr designs a state feedback
     N = X.shape[0]

@@ -1,12 +1,16 @@
-"""Tune a robust state feedback for your own plant: the paper's method as a tool.
+"""Tune a robust controller for your own plant: the paper's method as a tool, with the full state or with sensors.
 
-A *design family* maps a decision vector ``z`` to a gain (:class:`RLQRFamily`,
-:class:`LQRFamily`, or any object of the :class:`DesignFamily` protocol); a
-:class:`TuningProblem` scores every design of a population against a set of
-scenario plants with goals ``f(K, plants) -> (B,)`` (objectives; constraints
-hold where ``<= 0``); :func:`tune` runs a MOEA with MO-LSP on it and returns a
-:class:`TuningResult`, whose :meth:`~TuningResult.select` picks one design by
-the paper's Monte Carlo selection.
+A *design family* maps a decision vector ``z`` to a controller: a state
+feedback (:class:`RLQRFamily`, :class:`LQRFamily`) or a dynamic output
+feedback of the plant's measured outputs (:class:`StaticOutputFeedbackFamily`,
+:class:`PIDFamily`, :class:`FixedOrderFamily`, :class:`LQGFamily`,
+:class:`RobustLQGFamily`), or any object of the :class:`DesignFamily`
+protocol; a :class:`TuningProblem` scores every design of a population
+against a set of scenario plants with goals ``f(K, plants) -> (B,)``
+(objectives; constraints hold where ``<= 0``; ``K`` the gains or an
+:class:`robustctl.ControllerBatch`); :func:`tune` runs a MOEA with MO-LSP on
+it and returns a :class:`TuningResult`, whose :meth:`~TuningResult.select`
+picks one design by the paper's Monte Carlo selection.
 
 >>> import numpy as np, robustctl as rc
 >>> from moo import tuning
@@ -28,27 +32,36 @@ based on multiobjective evolutionary optimization", Expert Systems with
 Applications 192 (2022) 116304.
 """
 
-from .families import DesignFamily, FamilyGains, LQRFamily, RLQRFamily, dlqr_gains
+from .families import DesignFamily, FamilyControllers, FamilyGains, LQRFamily, RLQRFamily, dlqr_gains
 from .goals import (
     Bound,
+    ControllerPoles,
     ErrorGoal,
     Goal,
     H2Norm,
     HinfNorm,
+    Overshoot,
     PeakInput,
     PoleRegion,
     Response,
     RobustMargin,
     SettlingTime,
     SpectralRadius,
+    StepTracking,
+    Variance,
     at_least,
     at_most,
 )
+from .margins import DiskMargin, Margins, SensitivityPeak
+from .output_feedback import FixedOrderFamily, LQGFamily, PIDFamily, RobustLQGFamily, StaticOutputFeedbackFamily
 from .problem import TuningProblem, penalise
 from .selection import Selection, SelectionResult, monte_carlo_selection, select
 from .tune import TuningResult, select_front, tune
 
-__all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains", "TuningProblem", "penalise",
+__all__ = ["DesignFamily", "FamilyGains", "FamilyControllers", "RLQRFamily", "LQRFamily", "dlqr_gains",
+           "StaticOutputFeedbackFamily", "PIDFamily", "FixedOrderFamily", "LQGFamily", "RobustLQGFamily",
+           "TuningProblem", "penalise",
            "tune", "TuningResult", "select_front", "select", "Selection", "SelectionResult", "monte_carlo_selection",
-           "Goal", "Response", "ErrorGoal", "PeakInput", "SettlingTime", "SpectralRadius", "PoleRegion", "H2Norm",
-           "HinfNorm", "RobustMargin", "Bound", "at_most", "at_least"]
+           "Goal", "Response", "StepTracking", "ErrorGoal", "PeakInput", "SettlingTime", "Overshoot", "SpectralRadius",
+           "PoleRegion", "ControllerPoles", "H2Norm", "HinfNorm", "Variance", "RobustMargin", "DiskMargin", "Margins",
+           "SensitivityPeak", "Bound", "at_most", "at_least"]

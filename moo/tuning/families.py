@@ -39,7 +39,7 @@ from robustctl.validation import check_plant, check_positive_scalar
 
 from ..validation import as_float_array, as_matrix, check_int
 
-__all__ = ["DesignFamily", "FamilyGains", "RLQRFamily", "LQRFamily", "dlqr_gains"]
+__all__ = ["DesignFamily", "FamilyGains", "FamilyControllers", "RLQRFamily", "LQRFamily", "dlqr_gains"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -84,6 +84,57 @@ class FamilyGains:
         return f"FamilyGains(B={B}, m={m}, n={n}, failed={int((~self.ok).sum())})"
 
 
+@dataclass(frozen=True, eq=False, repr=False)
+class FamilyControllers:
+    """Dynamic output feedbacks of a population of designs, with the designs that failed flagged.
+
+    What the ``gains`` of an output-feedback family returns (its
+    ``feedback`` attribute is ``"output"``): the controllers
+    ``x_c^+ = A_c x_c + B_c y``, ``u = C_c x_c + D_c y`` as one
+    :class:`robustctl.ControllerBatch` of the family's plant. A failed design
+    is a flagged row (NaN matrices), never an exception for the population.
+
+    Parameters
+    ----------
+    controllers : robustctl.ControllerBatch
+        ``B`` controllers (NaN matrices where ``ok`` is False).
+    ok : (B,) bool ndarray
+        The design was computed.
+    reason : (B,) object ndarray of str
+        ``""`` where ``ok``, otherwise why not.
+
+    See Also
+    --------
+    FamilyGains : the same for state feedback.
+    DesignFamily : the protocol.
+
+    Examples
+    --------
+    Two static output feedbacks ``u = D_c y`` of a plant with one output:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo.tuning import FamilyControllers
+    >>> plant = rc.Plant([[1.1, 0.1], [0.0, 0.9]], [[0.0], [0.1]], 0.1, C=[[0.0, 1.0]])
+    >>> Dc = np.array([[[-2.0]], [[-8.0]]])
+    >>> batch = rc.ControllerBatch(plant, np.zeros((2, 0, 0)), np.zeros((2, 0, 1)), np.zeros((2, 1, 0)), Dc)
+    >>> fc = FamilyControllers(batch, np.ones(2, bool), np.full(2, "", object))
+    >>> fc
+    FamilyControllers(B=2, order=0, m=1, p=1, failed=0)
+    >>> bool(np.allclose(fc.controllers.closed_loops()[1], plant.F + plant.G @ Dc[1] @ plant.C))
+    True
+    """
+
+    controllers: rc.ControllerBatch
+    ok: np.ndarray
+    reason: np.ndarray
+
+    def __repr__(self) -> str:
+        c = self.controllers
+        return (f"FamilyControllers(B={len(c)}, order={c.order}, m={c.plant.m}, p={c.plant.p}, "
+                f"failed={int((~self.ok).sum())})")
+
+
 @runtime_checkable
 class DesignFamily(Protocol):
     """What :class:`~moo.tuning.TuningProblem` needs of a design family (any object with these works).
@@ -95,17 +146,23 @@ class DesignFamily(Protocol):
     xl, xu : (n_var,) ndarray
         Default bounds of ``z`` (``xl < xu``).
     n_states, n_inputs : int
-        The gains are ``(n_inputs, n_states)``: the scenario plants' ``m`` and ``n``.
+        The scenario plants' ``n`` and ``m`` (a state feedback's gains are ``(n_inputs, n_states)``).
+    feedback : {"state", "output"}, optional
+        ``"output"`` for a family of dynamic output feedbacks (whose ``gains``
+        return :class:`FamilyControllers` and which has a ``plant`` with the
+        outputs it reads); missing means ``"state"``.
 
     Methods
     -------
     gains(Z)
-        ``Z`` (B, n_var) -> :class:`FamilyGains`; a design that cannot be
+        ``Z`` (B, n_var) -> :class:`FamilyGains` (state feedback) or
+        :class:`FamilyControllers` (output feedback); a design that cannot be
         computed is flagged (``ok`` False, NaN row), never raised.
 
     See Also
     --------
-    RLQRFamily, LQRFamily : the two families provided.
+    RLQRFamily, LQRFamily : state-feedback families.
+    moo.tuning.StaticOutputFeedbackFamily, moo.tuning.PIDFamily, moo.tuning.FixedOrderFamily : output feedback.
     moo.tuning.TuningProblem : what uses a family.
 
     Examples
@@ -128,6 +185,28 @@ class DesignFamily(Protocol):
     True
     >>> fam.gains(np.array([[-1.0, -2.0]])).K
     array([[[-1., -2.]]])
+
+    An output-feedback family in a few lines: a first-order controller
+    ``x_c^+ = a x_c + y``, ``u = c x_c + d y`` with ``z = (a, c, d)``:
+
+    >>> import robustctl as rc
+    >>> from moo.tuning import FamilyControllers
+    >>> class FirstOrder:
+    ...     feedback, n_var = "output", 3
+    ...     xl, xu = np.array([-1.0, -5.0, -5.0]), np.array([1.0, 5.0, 5.0])
+    ...
+    ...     def __init__(self, plant):
+    ...         self.plant, self.n_states, self.n_inputs = plant, plant.n, plant.m
+    ...
+    ...     def gains(self, Z):
+    ...         B = Z.shape[0]
+    ...         batch = rc.ControllerBatch(self.plant, Z[:, 0, None, None], np.ones((B, 1, 1)),
+    ...                                    Z[:, 1, None, None], Z[:, 2, None, None])
+    ...         return FamilyControllers(batch, np.ones(B, bool), np.full(B, "", object))
+    >>> plant = rc.Plant([[1.2]], [[1.0]], 0.1, C=[[1.0]])
+    >>> fam = FirstOrder(plant)
+    >>> fam.gains(np.array([[0.5, 0.0, -0.6]])).controllers.is_stabilizing().tolist()
+    [True]
     """
 
     n_var: int
@@ -204,7 +283,10 @@ class RLQRFamily:
     plant : robustctl.Plant
         Nominal discrete-time design model ``(F, G)`` (``n`` states, ``p`` inputs).
     H : (n, l) array_like, optional
-        Uncertainty input; default ``ones((n, 1))`` (the paper's).
+        Uncertainty input; default ``ones((n, 1))`` (the paper's: one
+        uncertainty row reaching every state; the ``repr`` says which). With a
+        model fitted to the plants, its ``H`` (:meth:`robustctl.NormBounded.from_plants`)
+        is the natural choice (user guide, "Choosing the robust LQR's mu, alpha and H").
     Q : (n, n) array_like, optional
         State weight, default identity.
     R : (m, m) array_like, optional
@@ -238,10 +320,11 @@ class RLQRFamily:
     Raises
     ------
     TypeError, ValueError
-        ``plant`` not a discrete-time :class:`robustctl.Plant`; ``H``, ``Q``,
-        ``R`` or ``input_map`` of the wrong shape (the message names it and
-        the shapes); a non-positive ``alpha``, ``e_bound`` or
-        ``log_mu_bound``; an unknown ``fallback``.
+        ``plant`` not a discrete-time :class:`robustctl.Plant`, or not
+        stabilisable (with the input map); ``H``, ``Q``, ``R`` or
+        ``input_map`` of the wrong shape (the message names it and the
+        shapes); a non-positive ``alpha``, ``e_bound`` or ``log_mu_bound``;
+        an unknown ``fallback``.
 
     See Also
     --------
@@ -293,8 +376,11 @@ class RLQRFamily:
         plant = check_plant(plant, "plant", discrete_for="RLQRFamily")
         self.plant = plant
         self.input_map, self.design_plant = _input_map(input_map, plant)
+        if not self.design_plant.is_stabilizable:
+            raise ValueError("plant must be stabilisable (with the input map) for RLQRFamily")
         n, m = self.design_plant.n, self.design_plant.m
         self.H = np.ones((n, 1)) if H is None else as_matrix(H, "H", rows=n, rows_what="the number of states")
+        self._H_given = H is not None
         self.l = self.H.shape[1]
         self.Q = np.eye(n) if Q is None else as_matrix(Q, "Q")
         self.R = np.eye(m) if R is None else as_matrix(R, "R")
@@ -349,7 +435,8 @@ class RLQRFamily:
         return K if self.input_map is None else self.input_map @ K
 
     def __repr__(self) -> str:
-        return (f"RLQRFamily(n={self.design_plant.n}, m={self.design_plant.m}, l={self.l}, n_var={self.n_var}, "
+        H = f"given ({self.H.shape[0]}x{self.l})" if self._H_given else f"ones(({self.H.shape[0]}, 1)), the default"
+        return (f"RLQRFamily(n={self.design_plant.n}, m={self.design_plant.m}, l={self.l}, n_var={self.n_var}, H={H}, "
                 f"input_map={'none' if self.input_map is None else self.input_map.shape})")
 
 
@@ -389,7 +476,9 @@ def dlqr_gains(F, G, Q, R, *, tol: float = 1e-12, max_iter: int = 100) -> tuple[
         The Riccati solutions.
     ok : (B,) bool ndarray
         Converged, finite, and ``F + G K`` Schur-stable; a design that is not
-        is flagged here, never raised.
+        (weights that are not finite, an ``R_b`` that is not positive definite,
+        e.g. weights ``10**-400`` that underflow to 0, a singular step) is
+        flagged here, never raised.
 
     See Also
     --------
@@ -427,31 +516,57 @@ def dlqr_gains(F, G, Q, R, *, tol: float = 1e-12, max_iter: int = 100) -> tuple[
     True
     """
     B, n = Q.shape[0], F.shape[0]
+    eye, eye_m = np.eye(n), np.eye(G.shape[1])
+    # weights that are not finite, or an R that is not positive definite (e.g. 10**-400 == 0): flagged, not solved
+    with np.errstate(all="ignore"):
+        good = np.isfinite(Q).all(axis=(1, 2)) & np.isfinite(R).all(axis=(1, 2))
+        good[good] &= np.linalg.eigvalsh(0.5 * (R[good] + np.swapaxes(R[good], 1, 2)))[:, 0] > 0
+    if not good.all():
+        Q, R = np.where(good[:, None, None], Q, eye), np.where(good[:, None, None], R, eye_m)
     A = np.broadcast_to(F, (B, n, n)).copy()
-    S = G @ np.linalg.solve(R, np.broadcast_to(G.T, (B, *G.T.shape)))
+    S, solved = _solve(R, np.broadcast_to(G.T, (B, *G.T.shape)))
+    S = G @ S
+    good &= solved
     X = Q.copy()
-    eye = np.eye(n)
-    done = np.zeros(B, dtype=bool)
+    done = ~good
     with np.errstate(all="ignore"):
         for _ in range(max_iter):
-            act = ~done
+            act = np.flatnonzero(~done)
             a, s, x = A[act], S[act], X[act]
             W = eye + s @ x
-            WA = np.linalg.solve(W, a)                        # W^{-1} A
-            WS = np.linalg.solve(W, s)                        # W^{-1} S
+            WA, ok_a = _solve(W, a)                           # W^{-1} A
+            WS, ok_s = _solve(W, s)                           # W^{-1} S
             x_new = x + np.swapaxes(a, 1, 2) @ x @ WA
             step = np.linalg.norm(x_new - x, axis=(1, 2))
             A[act], S[act], X[act] = a @ WA, s + a @ WS @ np.swapaxes(a, 1, 2), x_new
-            conv = ~(step > tol * np.linalg.norm(x_new, axis=(1, 2)))   # NaN counts as settled (flagged below)
-            done[np.flatnonzero(act)[conv]] = True
+            good[act[~(ok_a & ok_s)]] = False
+            conv = ~(step > tol * np.linalg.norm(x_new, axis=(1, 2))) | ~(ok_a & ok_s)   # NaN: settled (flagged)
+            done[act[conv]] = True
             if done.all():
                 break
         X = 0.5 * (X + np.swapaxes(X, 1, 2))
         GX = G.T @ X                                          # (B, m, n)
-        K = -np.linalg.solve(R + GX @ G, GX @ F)
-    ok = done & np.all(np.isfinite(K), axis=(1, 2))
+        K, solved = _solve(R + GX @ G, GX @ F)
+        K = -K
+    ok = good & solved & done & np.all(np.isfinite(K), axis=(1, 2))
     ok[ok] = np.asarray(rc.is_schur_stable(F + G @ K[ok]), dtype=bool)
     return K, X, ok
+
+
+def _solve(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``A_b^{-1} B_b`` for stacks, and which designs were solved: a singular ``A_b`` is a NaN row, not an error."""
+    try:
+        return np.linalg.solve(A, B), np.ones(A.shape[0], dtype=bool)
+    except np.linalg.LinAlgError:
+        out = np.full(np.broadcast_shapes((*A.shape[:-1], B.shape[-1]), B.shape), np.nan)
+        ok = np.zeros(A.shape[0], dtype=bool)
+        for b in range(A.shape[0]):
+            try:
+                out[b] = np.linalg.solve(A[b], B[b])
+                ok[b] = True
+            except np.linalg.LinAlgError:
+                pass
+        return out, ok
 
 
 class LQRFamily:
@@ -536,20 +651,28 @@ class LQRFamily:
         self.max_iter = check_int(max_iter, "max_iter", 1)
 
     def weights(self, Z) -> tuple[np.ndarray, np.ndarray]:
-        """``(Q (B, n, n), R (B, m, m))``, the diagonal weights of a population ``Z``."""
+        """``(Q (B, n, n), R (B, m, m))``, the diagonal weights of a population ``Z`` (``10**z``: may be 0 or inf)."""
         z = population(Z, self.n_var, "Z")
         n = self.design_plant.n
-        eye_n, eye_m = np.eye(n), np.eye(self.design_plant.m)
-        return 10.0 ** z[:, :n, None] * eye_n, 10.0 ** z[:, n:, None] * eye_m
+        with np.errstate(over="ignore"):
+            w = 10.0 ** z
+        return w[:, :n, None] * np.eye(n), w[:, n:, None] * np.eye(self.design_plant.m)
 
     def gains(self, Z) -> FamilyGains:
-        """:class:`FamilyGains` of a population ``Z`` (B, n_var)."""
+        """:class:`FamilyGains` of a population ``Z`` (B, n_var).
+
+        A design whose weights ``10**z`` under- or overflow (0 or inf) is
+        flagged (``reason``), as is one whose Riccati iteration does not converge.
+        """
         Q, R = self.weights(Z)
         K, _, ok = dlqr_gains(self.design_plant.F, self.design_plant.G, Q, R, tol=self.tol, max_iter=self.max_iter)
         K = np.where(ok[:, None, None], K, np.nan)
         if self.input_map is not None:
             K = self.input_map @ K
-        return FamilyGains(K=K, ok=ok, reason=np.where(ok, "", "not converged").astype(object))
+        w = np.concatenate([np.diagonal(Q, axis1=1, axis2=2), np.diagonal(R, axis1=1, axis2=2)], axis=1)
+        in_range = np.all(np.isfinite(w) & (w > 0), axis=1)
+        reason = np.where(ok, "", np.where(in_range, "not converged", "weights under- or overflow"))
+        return FamilyGains(K=K, ok=ok, reason=reason.astype(object))
 
     def __repr__(self) -> str:
         return f"LQRFamily(n={self.design_plant.n}, m={self.design_plant.m}, n_var={self.n_var})"

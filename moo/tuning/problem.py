@@ -39,9 +39,11 @@ from pymoo.core.problem import Problem
 import robustctl as rc
 from robustctl.validation import check_positive_scalar
 
-from ..validation import as_float_array, as_matrix, check_int
-from .families import DesignFamily, FamilyGains, bound_vector, check_bounds, population
-from .goals import check_scenarios, plant_stacks
+from ..validation import as_float_array, as_matrix, check_choice, check_int
+from .families import DesignFamily, FamilyControllers, FamilyGains, bound_vector, check_bounds, population
+from .goals import check_scenarios
+from .loops import Controllers, check_controllers, closed_loops, count, is_output_feedback, take, with_outputs
+from .loops import stability as loop_stability
 
 __all__ = ["TuningProblem", "penalise", "goal_name", "Goal"]
 
@@ -138,6 +140,33 @@ def _goals(goals, kind: str) -> tuple[list, list[str]]:
     return goals, names
 
 
+def _with_outputs(plants: Sequence[rc.Plant], plant: rc.Plant) -> list[rc.Plant]:
+    """The scenarios as an output feedback reads them: ``plant``'s ``C``, ``D`` where a scenario has none."""
+    for i, p in enumerate(plants):
+        if p.has_outputs and p.p != plant.p:
+            raise ValueError(f"scenarios[{i}] has p={p.p} outputs, the family's controllers read p={plant.p}")
+    return [with_outputs(p, plant) for p in plants]
+
+
+def _finite(K: Controllers) -> np.ndarray:
+    """(B,) designs without NaN or inf entries."""
+    if is_output_feedback(K):
+        return np.all([np.isfinite(M).all(axis=(1, 2)) for M in (K.Ac, K.Bc, K.Cc, K.Dc)], axis=0)
+    return np.all(np.isfinite(K), axis=(1, 2))
+
+
+def _zeroed(K: Controllers) -> Controllers:
+    """The designs with their non-finite entries set to 0 (flagged separately), read-only."""
+    if is_output_feedback(K):
+        if _finite(K).all():
+            return K
+        return rc.ControllerBatch(K.plant, *(np.nan_to_num(M, nan=0.0, posinf=0.0, neginf=0.0)
+                                             for M in (K.Ac, K.Bc, K.Cc, K.Dc)))
+    out = np.where(np.isfinite(K), K, 0.0)
+    out.flags.writeable = False
+    return out
+
+
 def _ref_point(value, name: str, default: np.ndarray) -> np.ndarray:
     if value is None:
         return default.copy()
@@ -172,16 +201,20 @@ class TuningProblem(Problem):
         ``p`` of the penalty rule; it must exceed every goal value of an
         acceptable design (values above it are clipped to it). Default ``1e6``.
     hv_ref_point : (n_obj,) array_like, optional
-        Hypervolume reference point of the runs' records. Default: ``penalty``
-        on every objective, which every design that is computed, stabilises
-        every scenario and scores below ``p`` dominates. It is always
-        valid but on a scale far above good designs, so the hypervolume
-        differences of good fronts are tiny: give a point just beyond the
-        values you accept (e.g. a front's nadir enlarged by 10-30 %,
-        :meth:`sample_reference_points`) to compare runs.
+        Hypervolume reference point of the runs' records. Default: from
+        ``reference_samples`` designs drawn uniformly within the bounds
+        (:meth:`sample_reference_points`, seed 0, computed when first needed):
+        the nadir of their acceptable non-dominated designs enlarged by 25 %
+        of the front's extent, a point on the scale of good designs. If none
+        of the sampled designs is acceptable, ``penalty`` on every objective
+        (valid, but far above good designs). ``hv_ref_source`` says which.
     molsp_ref_point : (n_obj,) array_like, optional
-        MO-LSP's leader reference point; default ``hv_ref_point`` (MO-LSP
-        chooses its leaders among the designs that dominate it).
+        MO-LSP's leader reference point (MO-LSP chooses its leaders among the
+        designs that dominate it); default the sampled one of
+        :meth:`sample_reference_points` (every acceptable sampled design
+        dominates it), or ``hv_ref_point`` when that is given.
+    reference_samples : int
+        Designs sampled for the default reference points (default 500).
 
     Attributes
     ----------
@@ -191,6 +224,15 @@ class TuningProblem(Problem):
         The goals.
     objective_names, constraint_names : list of str
         Their labels (a goal's ``name``, a function's name, or ``objectives[i]``).
+    hv_ref_point, molsp_ref_point : (n_obj,) ndarray
+        The reference points (the defaults are sampled on first access).
+    hv_ref_source : str
+        Where ``hv_ref_point`` comes from: ``"given"``, ``"sampled designs"``
+        or ``"penalty"`` (no sampled design was acceptable).
+    feedback : {"state", "output"}
+        The family's kind: the goals get gains (B, m, n) or an
+        :class:`robustctl.ControllerBatch`; for an output feedback the
+        scenarios without an output model get the family plant's ``C``, ``D``.
     last_flags : (B,) object ndarray
         Why each design of the last evaluated population was penalised
         (``""`` for none): the family's reason, ``"unstable"``, or
@@ -252,17 +294,29 @@ class TuningProblem(Problem):
 
     def __init__(self, family: DesignFamily, scenarios: Sequence[rc.Plant], objectives: Sequence[Goal],
                  constraints: Sequence[Goal] = (), *, xl=None, xu=None, penalty: float = 1e6,
-                 hv_ref_point=None, molsp_ref_point=None):
+                 hv_ref_point=None, molsp_ref_point=None, reference_samples: int = 500):
         for attr in ("n_var", "xl", "xu", "n_states", "n_inputs", "gains"):
             if not hasattr(family, attr):
                 raise TypeError(f"family must follow the DesignFamily protocol (missing {attr!r}), "
                                 f"got {type(family).__name__}")
         self.family = family
-        self.scenarios = check_scenarios(scenarios, "scenarios")
+        self.feedback = check_choice(getattr(family, "feedback", "state"), "family.feedback", ("state", "output"))
+        plant = getattr(family, "plant", None)
+        if self.feedback == "output" and not isinstance(plant, rc.Plant):
+            raise TypeError("family: an output-feedback family needs a plant attribute (a robustctl.Plant with the "
+                            "outputs its controllers read)")
+        continuous = isinstance(plant, rc.Plant) and plant.dt is None and self.feedback == "output"
+        self.scenarios = check_scenarios(scenarios, "scenarios", continuous=continuous)
         n, m = self.scenarios[0].n, self.scenarios[0].m
         if (family.n_states, family.n_inputs) != (n, m):
-            raise ValueError(f"family gives gains of shape ({family.n_inputs}, {family.n_states}), but the scenarios "
-                             f"have m={m} inputs and n={n} states")
+            raise ValueError(f"family gives controllers for n={family.n_states} states and m={family.n_inputs} "
+                             f"inputs, but the scenarios have m={m} inputs and n={n} states")
+        if isinstance(plant, rc.Plant) and plant.dt != self.scenarios[0].dt:
+            raise ValueError(f"family.plant has dt={plant.dt} but the scenarios have dt={self.scenarios[0].dt}: "
+                             "design the family on a plant of the scenarios' sampling time")
+        self._outputs_of = plant if self.feedback == "output" else None      # the C, D the controllers read
+        if self._outputs_of is not None:
+            self.scenarios = _with_outputs(self.scenarios, self._outputs_of)
         self.objectives, self.objective_names = _goals(objectives, "objectives")
         if not self.objectives:
             raise ValueError("objectives must not be empty")
@@ -277,40 +331,113 @@ class TuningProblem(Problem):
         check_bounds(lo, hi)
         self.penalty = check_positive_scalar(penalty, "penalty")
         n_obj = len(self.objectives)
-        self.hv_ref_point = _ref_point(hv_ref_point, "hv_ref_point", np.full(n_obj, self.penalty))
-        self.molsp_ref_point = _ref_point(molsp_ref_point, "molsp_ref_point", self.hv_ref_point)
-        self._F_s, self._G_s = plant_stacks(self.scenarios)
+        self._hv_ref = None if hv_ref_point is None else _ref_point(hv_ref_point, "hv_ref_point", np.zeros(n_obj))
+        self._molsp_ref = None if molsp_ref_point is None else \
+            _ref_point(molsp_ref_point, "molsp_ref_point", np.zeros(n_obj))
+        if self._molsp_ref is None and self._hv_ref is not None:
+            self._molsp_ref = self._hv_ref.copy()
+        self.hv_ref_source = "given" if self._hv_ref is not None else "sampled designs (not yet drawn)"
+        self.reference_samples = check_int(reference_samples, "reference_samples", 2)
+        self._plants = tuple(self.scenarios)               # what the goals get (immutable)
         self.last_flags = np.zeros(0, dtype=object)
         super().__init__(n_var=n_var, n_obj=n_obj, n_ieq_constr=len(self.constraints), xl=lo, xu=hi, vtype=float)
 
-    # -- gains and closed loops ----------------------------------------------------
+    # -- reference points ------------------------------------------------------------
+    @property
+    def hv_ref_point(self) -> np.ndarray:
+        """The hypervolume reference point (the default is sampled on first access; see the class docstring)."""
+        if self._hv_ref is None:
+            self._sample_defaults()
+        assert self._hv_ref is not None
+        return self._hv_ref
+
+    @hv_ref_point.setter
+    def hv_ref_point(self, value) -> None:
+        self._hv_ref = _ref_point(value, "hv_ref_point", np.zeros(self.n_obj))
+        self.hv_ref_source = "given"
+
+    @property
+    def molsp_ref_point(self) -> np.ndarray:
+        """MO-LSP's reference point (the default is sampled on first access)."""
+        if self._molsp_ref is None:
+            self._sample_defaults()
+        assert self._molsp_ref is not None
+        return self._molsp_ref
+
+    @molsp_ref_point.setter
+    def molsp_ref_point(self, value) -> None:
+        self._molsp_ref = _ref_point(value, "molsp_ref_point", np.zeros(self.n_obj))
+
+    def _sample_defaults(self) -> None:
+        """Fill the reference points not given from :meth:`sample_reference_points` (else the penalty)."""
+        try:
+            hv, molsp = self.sample_reference_points(self.reference_samples, seed=0)
+            source = "sampled designs"
+        except ValueError:
+            hv = molsp = np.full(self.n_obj, self.penalty)
+            source = f"penalty: none of {self.reference_samples} sampled designs was acceptable"
+        if self._hv_ref is None:
+            self._hv_ref, self.hv_ref_source = hv, source
+        if self._molsp_ref is None:
+            self._molsp_ref = molsp
+
+    # -- designs and closed loops ----------------------------------------------------
     @property
     def n_states(self) -> int:
         """Number of states of the scenario plants."""
-        return int(self._F_s.shape[-1])
+        return self.scenarios[0].n
 
     @property
     def n_inputs(self) -> int:
         """Number of inputs of the scenario plants."""
-        return int(self._G_s.shape[-1])
+        return self.scenarios[0].m
 
     def population(self, Z, name: str = "Z") -> np.ndarray:
         """``Z`` as a finite (B, n_var) float array (a single (n_var,) vector becomes B = 1)."""
         return population(Z, self.n_var, name)
 
-    def gains(self, Z) -> FamilyGains:
-        """The family's :class:`~moo.tuning.families.FamilyGains` of a population ``Z`` (B, n_var)."""
+    def gains(self, Z) -> FamilyGains | FamilyControllers:
+        """The family's designs of a population ``Z`` (B, n_var), checked.
+
+        :class:`~moo.tuning.FamilyGains` (``K`` (B, m, n)) for a state-feedback
+        family, :class:`~moo.tuning.FamilyControllers` for an output-feedback
+        one; failed designs have NaN rows and ``ok`` False.
+        """
         z = self.population(Z)
         fg = self.family.gains(z)
-        K = np.asarray(fg.K, dtype=float)
-        if K.shape != (z.shape[0], self.n_inputs, self.n_states):
+        B = z.shape[0]
+        if self.feedback == "output":
+            if not isinstance(fg, FamilyControllers) or len(fg.controllers) != B:
+                raise ValueError(f"family.gains must return FamilyControllers of {B} designs (an output-feedback "
+                                 f"family), got {fg!r}")
+            batch = fg.controllers
+            check_controllers(batch, self.scenarios, "family.gains(...).controllers")
+            ok = np.asarray(fg.ok, dtype=bool) & _finite(batch)
+            return FamilyControllers(batch, ok, np.asarray(fg.reason, dtype=object))
+        K = np.asarray(getattr(fg, "K", None), dtype=float)
+        if K.shape != (B, self.n_inputs, self.n_states):
             raise ValueError(f"family.gains returned K of shape {K.shape}, expected "
-                             f"({z.shape[0]}, {self.n_inputs}, {self.n_states})")
+                             f"({B}, {self.n_inputs}, {self.n_states})")
         ok = np.asarray(fg.ok, dtype=bool) & np.all(np.isfinite(K), axis=(1, 2))
         return FamilyGains(K=np.where(ok[:, None, None], K, np.nan), ok=ok, reason=np.asarray(fg.reason, dtype=object))
 
-    def check_gains(self, K) -> np.ndarray:
-        """``K`` as a (B, m, n) float array (NaN rows allowed: failed designs); one (m, n) gain becomes B = 1."""
+    def designs(self, Z) -> tuple[Controllers, np.ndarray, np.ndarray]:
+        """``(controllers, ok, reason)`` of a population: gains (B, m, n) or a :class:`robustctl.ControllerBatch`."""
+        fg = self.gains(Z)
+        return (fg.controllers if isinstance(fg, FamilyControllers) else fg.K), fg.ok, fg.reason
+
+    def check_gains(self, K) -> Controllers:
+        """The designs ``K`` checked: (B, m, n) gains, or an output-feedback problem's controllers.
+
+        Gains may have NaN rows (failed designs); one (m, n) gain becomes
+        B = 1. An output-feedback problem takes a
+        :class:`robustctl.ControllerBatch` of the scenarios' plant.
+        """
+        if is_output_feedback(K):
+            return check_controllers(K, self.scenarios, "K")
+        if self.feedback == "output":
+            raise TypeError(f"K must be a robustctl.ControllerBatch for this output-feedback problem, got "
+                            f"{type(K).__name__}")
         K = as_float_array(K, "K")
         if K.ndim == 2:
             K = K[None]
@@ -318,69 +445,97 @@ class TuningProblem(Problem):
             raise ValueError(f"K must have shape (B, {self.n_inputs}, {self.n_states}), got shape {K.shape}")
         return K
 
-    def closed_loops(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
-        """The closed loops ``F_s + G_s K`` (B, S, n, n) of gains ``K`` (B, m, n) (default: the problem's scenarios)."""
-        K = self.check_gains(K)
+    def _plants_of(self, scenarios) -> tuple[rc.Plant, ...]:
         if scenarios is None:
-            F_s, G_s = self._F_s, self._G_s
-        else:
-            F_s, G_s = plant_stacks(check_scenarios(scenarios, "scenarios"))
-        return F_s[None] + G_s[None] @ K[:, None]
+            return self._plants
+        plants = check_scenarios(scenarios, "scenarios", continuous=not self.scenarios[0].is_discrete)
+        if self._outputs_of is not None:
+            plants = _with_outputs(plants, self._outputs_of)
+        return tuple(plants)
+
+    def closed_loops(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
+        """The closed loops (B, S, N, N) of the designs ``K`` on the scenarios (default the problem's).
+
+        ``F_s + G_s K`` for gains (``N = n``), the loops in ``(x, x_c)`` for a
+        :class:`robustctl.ControllerBatch` (``N = n + n_c``); NaN for designs
+        with non-finite entries.
+        """
+        Kc = self.check_gains(K)
+        A = np.array(closed_loops(_zeroed(Kc), self._plants_of(scenarios)).A)
+        A[~_finite(Kc)] = np.nan
+        return A
 
     def closed_loop_radius(self, K, scenarios: Sequence[rc.Plant] | None = None) -> np.ndarray:
-        """Spectral radius (B, S) of the closed loop per scenario (inf for non-finite K)."""
-        return np.asarray(rc.spectral_radius(self.closed_loops(K, scenarios)))      # a stack: an array
+        """Spectral radius (B, S) of the closed loop per scenario (inf for non-finite designs)."""
+        return np.asarray(rc.spectral_radius(self.closed_loops(K, scenarios)))     # inf where A is NaN
 
     def stability(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """``(stable (B, S), rho (B,))``: Schur stability per scenario, and the worst spectral radius.
+        """``(stable (B, S), rho (B,))``: stability per scenario, and the worst "radius" of the unstable designs.
 
-        ``rho`` is the largest spectral radius over the scenarios of the designs
+        ``rho`` is the largest spectral radius over the scenarios (continuous
+        plants: ``exp`` of the largest real part of the poles) of the designs
         unstable somewhere (NaN for the others, which need no eigenvalues; inf
-        for non-finite K).
+        for non-finite designs and ill-posed loops).
         """
-        A = self.closed_loops(K, scenarios)
-        stable = np.asarray(rc.is_schur_stable(A))                         # a stack: an array
-        rho = np.full(A.shape[0], np.nan)
-        bad = ~stable.all(axis=1)
-        if bad.any():
-            rho[bad] = np.asarray(rc.spectral_radius(A[bad])).max(axis=1)
+        Kc = self.check_gains(K)
+        finite = _finite(Kc)
+        stable, rho = loop_stability(closed_loops(_zeroed(Kc), self._plants_of(scenarios)))
+        stable &= finite[:, None]
+        rho[~finite] = np.inf
         return stable, rho
 
     # -- goals ---------------------------------------------------------------------
-    def _call(self, goal, name: str, K: np.ndarray, plants: list[rc.Plant]) -> np.ndarray:
+    def _call(self, goal, name: str, K: Controllers, plants: tuple[rc.Plant, ...]) -> np.ndarray:
+        """``goal(K, plants)``, its value checked (``K`` read-only and ``plants`` a tuple: see :meth:`_goals_of`)."""
+        B = count(K)
         value = goal(K, plants)
-        try:
-            arr = np.asarray(value, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise ValueError(f"goal {name!r} must return a ({K.shape[0]},) array of numbers (one per design), "
-                             f"got {type(value).__name__}") from None
-        if arr.shape != (K.shape[0],):
-            raise ValueError(f"goal {name!r} must return shape ({K.shape[0]},) (one value per design), "
-                             f"got shape {arr.shape}")
+        arr = np.asarray(value)
+        real = arr.dtype.kind in "biuf" or (arr.dtype.kind == "O" and all(
+            isinstance(v, (int, float, np.integer, np.floating)) for v in arr.ravel()))
+        if not real:
+            kind = {"c": "complex", "U": "str", "S": "bytes"}.get(arr.dtype.kind, "objects")
+            raise ValueError(f"goal {name!r} must return real numbers ({B}, one per design), got "
+                             f"{type(value).__name__} of {kind} (dtype {arr.dtype})")
+        arr = arr.astype(np.float64)
+        if arr.shape != (B,):
+            raise ValueError(f"goal {name!r} must return shape ({B},) (one value per design), got shape {arr.shape}")
         return arr
 
     def evaluate_gains(self, K, scenarios: Sequence[rc.Plant] | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Goal values of given gains on the scenarios (default the problem's): ``(F (B, n_obj), G (B, n_constr))``.
+        """Goal values of given designs on the scenarios (default the problem's): ``(F (B, n_obj), G (B, n_constr))``.
 
-        Every goal is called once, on the designs that stabilise every
-        scenario; the others, and rows of ``K`` with NaN, get ``+inf``. No
-        penalty, no clipping; a goal's NaN stays NaN.
+        ``K``: gains (B, m, n) or a :class:`robustctl.ControllerBatch`. Every
+        goal is called once, on the designs that stabilise every scenario; the
+        others, and designs with NaN entries, get ``+inf``. No penalty, no
+        clipping; a goal's NaN stays NaN.
         """
-        K = self.check_gains(K)
-        plants = self.scenarios if scenarios is None else check_scenarios(scenarios, "scenarios")
-        finite = np.all(np.isfinite(K), axis=(1, 2))
-        Kf = np.where(finite[:, None, None], K, 0.0)
-        stable, _ = self.stability(Kf, plants)
-        run = finite & stable.all(axis=1)
-        F = np.full((K.shape[0], self.n_obj), np.inf)
-        G = np.full((K.shape[0], self.n_ieq_constr), np.inf)
+        Kc = self.check_gains(K)
+        plants = self._plants_of(scenarios)
+        stable, _ = self.stability(Kc, plants)
+        run = stable.all(axis=1)
+        B = count(Kc)
+        F = np.full((B, self.n_obj), np.inf)
+        G = np.full((B, self.n_ieq_constr), np.inf)
         if run.any():
-            Kr = np.ascontiguousarray(K[run])
-            for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
-                F[run, j] = self._call(g, name, Kr, plants)
-            for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
-                G[run, j] = self._call(g, name, Kr, plants)
+            F[run], G[run] = self._goals_of(take(Kc, run), plants)
         return F, G
+
+    def _goals_of(self, K: Controllers, plants: tuple[rc.Plant, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """Objective and constraint values (B, n_obj), (B, n_constr) of the designs ``K``, every goal called once.
+
+        Every goal gets the same read-only designs (``take`` copies gains
+        read-only; a :class:`robustctl.ControllerBatch` is frozen) and the same
+        tuple of plants: a goal cannot change what the next one sees (goals
+        that share a simulation recognise the same objects).
+        """
+        B = count(K)
+        J = np.empty((B, self.n_obj))
+        C = np.empty((B, self.n_ieq_constr))
+        for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
+            J[:, j] = self._call(g, name, K, plants)
+        for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
+            C[:, j] = self._call(g, name, K, plants)
+        return J, C
 
     def sample_reference_points(self, n: int = 500, *, seed=0, margin: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
         r"""Reference points from the scale of the objectives, by the rule the paper's two MOPs use.
@@ -443,20 +598,15 @@ class TuningProblem(Problem):
         return super().evaluate(arr[0] if np.ndim(X) == 1 else arr, *args, **kwargs)
 
     def _evaluate(self, x, out, *args, **kwargs):
-        fg = self.gains(x)                     # checks the population
-        ok, K = fg.ok, fg.K
+        K, ok, reason = self.designs(x)                  # checks the population
         stable, rho = self.stability(K)
         run = ok & stable.all(axis=1)
-        B = K.shape[0]
+        B = count(K)
         J = np.full((B, self.n_obj), np.inf)
         C = np.full((B, self.n_ieq_constr), np.inf)
-        flags = np.where(ok, np.where(run, "", "unstable"), fg.reason).astype(object)
+        flags = np.where(ok, np.where(run, "", "unstable"), reason).astype(object)
         if run.any():
-            Kr = K[run]
-            for j, (g, name) in enumerate(zip(self.objectives, self.objective_names, strict=True)):
-                J[run, j] = self._call(g, name, Kr, self.scenarios)
-            for j, (g, name) in enumerate(zip(self.constraints, self.constraint_names, strict=True)):
-                C[run, j] = self._call(g, name, Kr, self.scenarios)
+            J[run], C[run] = self._goals_of(take(K, run), self._plants)
             vals = np.concatenate([J[run], C[run]], axis=1)
             bad = ~np.all(np.isfinite(vals), axis=1)
             if bad.any():
@@ -478,3 +628,5 @@ class TuningProblem(Problem):
     def __repr__(self) -> str:
         return (f"TuningProblem(family={self.family!r}, S={len(self.scenarios)}, n_var={self.n_var}, "
                 f"objectives={self.objective_names}, constraints={self.constraint_names})")
+
+    __str__ = __repr__                                  # not pymoo's table

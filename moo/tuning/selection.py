@@ -42,6 +42,7 @@ import numpy as np
 import robustctl as rc
 
 from ..validation import as_float_array, check_int
+from .loops import count, is_output_feedback
 
 __all__ = ["SelectionResult", "monte_carlo_selection", "Selection", "select", "scenario_errors", "draw_errors",
            "check_weights", "default_weights"]
@@ -217,46 +218,60 @@ def check_weights(weights, n_obj: int) -> np.ndarray:
     w = as_float_array(weights, "weights").ravel()
     if w.shape != (n_obj,) or not np.all(np.isfinite(w)) or np.any(w < 0):
         raise ValueError(f"weights must be {n_obj} finite non-negative numbers (one per objective), got {w}")
+    if not w.any():
+        raise ValueError(f"weights must not all be zero (every design would tie), got {w}")
     return w
 
 
 def draw_errors(problem, K, n_sims: int, rng: np.random.Generator,
-                sampler: Callable[[np.random.Generator], rc.Plant] | None, weights) -> tuple[np.ndarray, np.ndarray]:
+                sampler: Callable[[np.random.Generator], rc.Plant] | None, weights,
+                progress: Callable[[int, int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The (designs, simulations) errors of ``K`` on ``n_sims`` drawn plants, and the draws.
 
     Each simulation draws a scenario of ``problem`` (its index in ``draws``),
     or a plant from ``sampler(rng)`` (``draws`` -1); every used scenario is
-    simulated once (:func:`scenario_errors`).
+    simulated once (:func:`scenario_errors`, which calls ``progress(done, total)``
+    after each plant).
     """
     if sampler is None:
         draws = rng.integers(0, len(problem.scenarios), size=n_sims)
         used = np.unique(draws)
-        per = scenario_errors(problem, K, [problem.scenarios[i] for i in used], weights)
+        per = scenario_errors(problem, K, [problem.scenarios[i] for i in used], weights, progress)
         return per[:, np.searchsorted(used, draws)], draws
     if not callable(sampler):
         raise TypeError(f"sampler must be callable as sampler(rng) -> robustctl.Plant, got {type(sampler).__name__}")
     plants = []
+    ref = problem.scenarios[0]
     for _ in range(n_sims):
         p = sampler(rng)
         if not isinstance(p, rc.Plant):
             raise TypeError(f"sampler must return a robustctl.Plant, got {type(p).__name__}")
+        if (p.n, p.m) != (ref.n, ref.m):
+            raise ValueError(f"sampler returned a plant with n={p.n} states and m={p.m} inputs; the scenarios "
+                             f"have n={ref.n}, m={ref.m}")
+        if p.dt != ref.dt:
+            raise ValueError(f"sampler returned a plant with dt={p.dt}; the scenarios have dt={ref.dt}")
         plants.append(p)
-    return scenario_errors(problem, K, plants, weights), np.full(n_sims, -1)
+    return scenario_errors(problem, K, plants, weights, progress), np.full(n_sims, -1)
 
 
-def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights) -> np.ndarray:
+def scenario_errors(problem, K, plants: Sequence[rc.Plant], weights,
+                    progress: Callable[[int, int], None] | None = None) -> np.ndarray:
     """Cumulative errors (D, P): ``sum_j w_j f_j(K_d, [plant_p])`` of every design on every plant alone.
 
     ``+inf`` where a design has NaN gains, is unstable on that plant or a goal is not finite there.
+    ``progress(done, P)`` is called after each plant.
     """
     K = problem.check_gains(K)
     w = check_weights(weights, problem.n_obj)
-    E = np.empty((K.shape[0], len(plants)))
+    E = np.empty((count(K), len(plants)))
     for p, plant in enumerate(plants):
         F, _ = problem.evaluate_gains(K, [plant])
         with np.errstate(invalid="ignore"):
             e = (np.where(w > 0, F, 0.0) * w).sum(axis=1)
         E[:, p] = np.where(np.isfinite(e), e, np.inf)
+        if progress is not None:
+            progress(p + 1, len(plants))
     return E
 
 
@@ -270,11 +285,11 @@ class Selection:
     Parameters
     ----------
     index : int
-        Row of the chosen design in the candidate gains.
-    K : (m, n) ndarray
-        Its gain ``u = K x``.
+        Row of the chosen design in the candidates.
+    K : (m, n) ndarray or None
+        Its gain ``u = K x`` (None for an output feedback: see ``controller``).
     controller : robustctl.Controller
-        Its controller.
+        Its controller (a dynamic one for an output-feedback problem).
     counts : (D,) int ndarray
         Simulations won by each candidate.
     winners : (S,) int ndarray
@@ -309,7 +324,7 @@ class Selection:
     """
 
     index: int
-    K: np.ndarray
+    K: np.ndarray | None
     controller: rc.Controller
     counts: np.ndarray
     winners: np.ndarray
@@ -336,15 +351,17 @@ def _rng(seed) -> np.random.Generator:
 
 def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
            sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None,
-           plant: rc.Plant | None = None, method: str = "tuned") -> Selection:
+           plant: rc.Plant | None = None, method: str = "tuned",
+           progress: Callable[[int, int], None] | None = None) -> Selection:
     r"""The paper's Monte Carlo selection, for any tuning problem (module docstring).
 
     Parameters
     ----------
     problem : TuningProblem
         The problem whose objectives make the cumulative error.
-    K : (D, m, n) array_like
-        Candidate gains (e.g. a front's, ``TuningResult.gains``).
+    K : (D, m, n) array_like or robustctl.ControllerBatch
+        Candidate gains (e.g. a front's, ``TuningResult.gains``), or the
+        candidate controllers of an output-feedback problem.
     F : (D, n_obj) array_like, optional
         Their objectives, for the default weights (:func:`default_weights`);
         default: evaluated on the problem's scenarios.
@@ -361,6 +378,8 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
         The plant of the returned :class:`~robustctl.Controller` (default: the first scenario).
     method : str
         The controller's ``method``.
+    progress : callable, optional
+        ``progress(done, total)`` after each plant simulated (a drawn scenario, or a sampler's plant).
 
     Returns
     -------
@@ -371,8 +390,10 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     ------
     TypeError, ValueError
         Gains of the wrong shape, ``n_sims`` not a positive integer, a bad
-        seed, weights not ``n_obj`` non-negative numbers, a sampler that is
-        not callable or does not return a plant, no design with a finite
+        seed, weights not ``n_obj`` non-negative numbers or all zero, a
+        sampler that is not callable or returns anything but a plant of the
+        scenarios' size and sampling time, no candidate that stabilises every
+        scenario (a front that is all penalised), no design with a finite
         error in any simulation.
 
     See Also
@@ -382,8 +403,9 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
 
     Notes
     -----
-    Simulation :math:`s` draws a plant :math:`P_s`; every design :math:`d`
-    gets the cumulative error
+    Only the candidates that stabilise every scenario of the problem take
+    part (the others get ``+inf`` everywhere). Simulation :math:`s` draws a
+    plant :math:`P_s`; every design :math:`d` gets the cumulative error
 
     .. math::
 
@@ -422,17 +444,32 @@ def select(problem, K, *, F=None, n_sims: int = 1000, seed=None,
     Kc = problem.check_gains(K)
     n_sims = check_int(n_sims, "n_sims", 1)
     rng = _rng(seed)
+    stable, _ = problem.stability(Kc)
+    candidates = stable.all(axis=1)
+    if not candidates.any():
+        raise ValueError("no candidate stabilises every scenario of the problem (the whole front is penalised): "
+                         "nothing to select; tune longer, widen the bounds or revise the goals")
     if weights is None:
         if F is None:
             F, _ = problem.evaluate_gains(Kc)
         Ff = as_float_array(F, "F")
-        fin = np.all(np.isfinite(Ff), axis=1) if Ff.ndim == 2 else None
-        weights = default_weights(Ff[fin] if fin is not None and fin.any() else Ff)
+        if Ff.shape != (count(Kc), problem.n_obj):
+            raise ValueError(f"F must have shape ({count(Kc)}, {problem.n_obj}) (candidates, objectives), "
+                             f"got shape {Ff.shape}")
+        use = candidates & np.all(np.isfinite(Ff), axis=1)
+        weights = default_weights(Ff[use] if use.any() else Ff[candidates])
     w = check_weights(weights, problem.n_obj)
-    E, draws = draw_errors(problem, Kc, n_sims, rng, sampler, w)
+    E, draws = draw_errors(problem, Kc, n_sims, rng, sampler, w, progress)
+    E[~candidates] = np.inf                     # a design unstable on a scenario never wins
     res = monte_carlo_selection(E)
-    Kbest = Kc[res.best]
-    ctrl = rc.Controller(Kbest, method, problem.scenarios[0] if plant is None else plant,
-                         {"selection_wins": int(res.counts[res.best]), "n_sims": n_sims})
-    return Selection(index=res.best, K=Kbest.copy(), controller=ctrl, counts=res.counts, winners=res.winners,
+    info = {"selection_wins": int(res.counts[res.best]), "n_sims": n_sims}
+    owner = problem.scenarios[0] if plant is None else plant
+    if is_output_feedback(Kc):
+        one = Kc[res.best]
+        Kbest = None
+        ctrl = rc.Controller.dynamic(one.Ac, one.Bc, one.Cc, one.Dc, method, owner, info)
+    else:
+        Kbest = Kc[res.best].copy()
+        ctrl = rc.Controller(Kbest, method, owner, info)
+    return Selection(index=res.best, K=Kbest, controller=ctrl, counts=res.counts, winners=res.winners,
                      errors=E, draws=draws, weights=w)

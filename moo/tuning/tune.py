@@ -10,6 +10,7 @@ hypervolume history at ``hv_ref_point``), so a tuning run is the same run
 from __future__ import annotations
 
 import functools
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -18,8 +19,9 @@ import numpy as np
 import robustctl as rc
 
 from ..algorithms.operators import POP_SIZE
+from ..progress import ProgressBar, check_progress, front_summary
 from ..runner import RunResult, prepare_on
-from ..validation import check_int
+from ..validation import as_float_array, check_int
 from .problem import TuningProblem
 from .selection import Selection, select
 
@@ -28,7 +30,9 @@ __all__ = ["tune", "TuningResult", "select_front", "design_plant"]
 
 def _method(family) -> str:
     name = type(family).__name__
-    return {"RLQRFamily": "rlqr", "LQRFamily": "lqr"}.get(name, "tuned")
+    return {"RLQRFamily": "rlqr", "LQRFamily": "lqr", "StaticOutputFeedbackFamily": "static output feedback",
+            "PIDFamily": "pid", "FixedOrderFamily": "fixed order", "LQGFamily": "lqg",
+            "RobustLQGFamily": "rlqg"}.get(name, "tuned")
 
 
 def design_plant(problem: TuningProblem) -> rc.Plant:
@@ -38,7 +42,8 @@ def design_plant(problem: TuningProblem) -> rc.Plant:
 
 
 def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=None,
-                 sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None) -> Selection:
+                 sampler: Callable[[np.random.Generator], rc.Plant] | None = None, weights=None,
+                 progress: Callable[[int, int], None] | None = None) -> Selection:
     """The Monte Carlo selection (:func:`moo.tuning.selection.select`) of one design of a front ``X``.
 
     What :meth:`TuningResult.select` does, for decision vectors from anywhere
@@ -55,7 +60,7 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
         Decision vectors of the front (N >= 1).
     F : (N, n_obj) array_like, optional
         Their objectives (for the default weights; default: evaluated).
-    n_sims, seed, sampler, weights
+    n_sims, seed, sampler, weights, progress
         As in :func:`moo.tuning.selection.select`.
 
     Returns
@@ -99,8 +104,8 @@ def select_front(problem: TuningProblem, X, F=None, *, n_sims: int = 1000, seed=
     if len(X) == 0:
         raise ValueError("the front is empty (no design stabilised every scenario): nothing to select")
     X = problem.population(X, "X")
-    return select(problem, problem.gains(X).K, F=F, n_sims=n_sims, seed=seed, sampler=sampler, weights=weights,
-                  plant=design_plant(problem), method=_method(problem.family))
+    return select(problem, problem.designs(X)[0], F=F, n_sims=n_sims, seed=seed, sampler=sampler, weights=weights,
+                  plant=design_plant(problem), method=_method(problem.family), progress=progress)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -152,10 +157,15 @@ class TuningResult:
     run: RunResult
 
     @functools.cached_property
-    def gains(self) -> np.ndarray:
-        """Gains (N, m, n) of the front (``u = K x`` for the scenarios; NaN rows: failed designs), designed once."""
-        K = self.problem.gains(self.X).K
-        K.flags.writeable = False
+    def gains(self) -> np.ndarray | rc.ControllerBatch:
+        """The front's designs, computed once.
+
+        Gains (N, m, n) (``u = K x``; NaN rows: failed designs), or the
+        :class:`robustctl.ControllerBatch` of an output-feedback family.
+        """
+        K = self.problem.designs(self.X)[0]
+        if isinstance(K, np.ndarray):
+            K.flags.writeable = False
         return K
 
     def _plant(self) -> rc.Plant:
@@ -168,8 +178,13 @@ class TuningResult:
         design of the run was acceptable, so the front holds penalised ones) is left out.
         """
         method, plant = _method(self.problem.family), self._plant()
-        return [rc.Controller(K, method, plant, {"z": x.copy(), "objectives": f.copy()})
-                for K, x, f in zip(self.gains, self.X, self.F, strict=True) if np.all(np.isfinite(K))]
+        K = self.gains
+        if isinstance(K, rc.ControllerBatch):
+            mats = [(K.Ac[i], K.Bc[i], K.Cc[i], K.Dc[i]) for i in range(len(K))]
+            return [rc.Controller.dynamic(*M, method, plant, {"z": x.copy(), "objectives": f.copy()})
+                    for M, x, f in zip(mats, self.X, self.F, strict=True) if all(np.isfinite(a).all() for a in M)]
+        return [rc.Controller(k, method, plant, {"z": x.copy(), "objectives": f.copy()})
+                for k, x, f in zip(K, self.X, self.F, strict=True) if np.all(np.isfinite(k))]
 
     def select(self, *, n_sims: int = 1000, seed=None, sampler: Callable[[np.random.Generator], rc.Plant] | None = None,
                weights=None) -> Selection:
@@ -202,7 +217,9 @@ class TuningResult:
             selection = self.select(n_sims=200, seed=0)
         steps = check_int(steps, "steps", 1)
         n = self.problem.n_states
-        x = np.ones(n) if x0 is None else np.asarray(x0, dtype=float).reshape(n)
+        x = np.ones(n) if x0 is None else as_float_array(x0, "x0")
+        if x.shape != (n,) or not np.all(np.isfinite(x)):
+            raise ValueError(f"x0 must have {n} entries (the number of states), got shape {x.shape}")
         fig, (ax_f, ax_r) = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
         F = self.F
         j = 1 if F.shape[1] > 1 else 0
@@ -212,9 +229,10 @@ class TuningResult:
         ax_f.set_ylabel(self.problem.objective_names[j])
         ax_f.set_title("front")
         ax_f.legend()
-        A = self.problem.closed_loops(selection.K[None])[0]         # (S, n, n)
-        traj = np.empty((A.shape[0], steps + 1, n))
-        traj[:, 0] = x
+        chosen = selection.controller.as_batch() if selection.K is None else selection.K[None]
+        A = self.problem.closed_loops(chosen)[0]                    # (S, N, N): states (x, xc)
+        traj = np.zeros((A.shape[0], steps + 1, A.shape[-1]))
+        traj[:, 0, :n] = x
         for k in range(steps):
             traj[:, k + 1] = np.einsum("sij,sj->si", A, traj[:, k])
         for s in range(A.shape[0]):
@@ -225,14 +243,23 @@ class TuningResult:
         ax_r.legend()
         return fig
 
+    @property
+    def hv_reference(self) -> str:
+        """Where the hypervolume's reference point comes from (the problem's ``hv_ref_source``)."""
+        return str(getattr(self.problem, "hv_ref_source", "given"))
+
+    def summary(self, where: str | None = None) -> str:
+        """One line: front size, hypervolume and its reference, best value per goal (and ``where`` it was written)."""
+        return front_summary(self.F, self.problem.objective_names, self.run.hv, self.hv_reference, where)
+
     def __repr__(self) -> str:
         return (f"TuningResult(front={len(self.X)}, n_obj={self.F.shape[1]}, evaluations={self.run.n_evals}, "
-                f"hv={self.run.hv:.6g})")
+                f"hv={self.run.hv:.6g} (reference: {self.hv_reference}))")
 
 
-def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True, evals: int = 10000, seed: int = 0,
-         pop_size: int | None = None, max_leaders: int | None = None,
-         progress: Callable[[int, int], None] | None = None) -> TuningResult:
+def tune(problem: TuningProblem, algorithm: str | None = None, *, molsp: bool = True, evals: int = 10000,
+         seed: int = 0, pop_size: int | None = None, max_leaders: int | None = None,
+         progress: bool | Callable[[int, int], None] = False) -> TuningResult:
     """Tune: one MOEA run on ``problem``, optionally with MO-LSP; the final non-dominated set.
 
     The run is the one ``python -m moo run`` makes (:mod:`moo.runner`), on a
@@ -245,8 +272,23 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
     ----------
     problem : TuningProblem
         The problem to tune.
-    algorithm : str
-        A name of :data:`moo.algorithms.ALGORITHMS` (default ``"nsga2"``).
+    algorithm : str, optional
+        A name of :data:`moo.algorithms.ALGORITHMS` or
+        :data:`moo.algorithms.MORE_ALGORITHMS`; default ``"nsga2"``, or
+        ``"ga"`` for a problem with one objective. The names
+        (:data:`moo.algorithms.ALGORITHM_NOTES`):
+
+        * ``"nsga2"`` - NSGA-II with the paper's operators (SBX pc 1, eta 20;
+          polynomial mutation with 0.5 expected mutated variables, eta 20),
+          not pymoo's defaults;
+        * ``"pymoo-nsga2"`` - pymoo's own NSGA-II with pymoo's default
+          operators (SBX pc 0.9, eta 15; mutation rate 1/n, eta 20);
+        * ``"ga"`` - a single-objective genetic algorithm (pymoo's GA with
+          the paper's operators), for a problem with one objective;
+        * ``"nsga3"``, ``"theta-dea"``, ``"mombi2"``, ``"moea-igd-ns"``,
+          ``"efr-rr"``, ``"maoea-ddfc"``, ``"spea-r"``, ``"spea2-sde"``,
+          ``"bige"`` - the other MOEAs of the paper's study, each with the
+          paper's operators.
     molsp : bool
         Add the MO-LSP local search (reference point ``problem.molsp_ref_point``).
     evals : int
@@ -257,8 +299,11 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
         Population size (default the paper's 92).
     max_leaders : int, optional
         MO-LSP's cap on leaders per generation.
-    progress : callable, optional
-        ``progress(n_evals, evals)`` after every generation.
+    progress : bool or callable
+        ``True``: a progress bar on stderr and one summary line at the end
+        (:meth:`TuningResult.summary`), when stderr is a terminal (silent
+        otherwise); a callable: ``progress(n_evals, evals)`` after every
+        generation; ``False`` (default): nothing.
 
     Returns
     -------
@@ -268,11 +313,12 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
     Raises
     ------
     TypeError
-        ``problem`` not a :class:`TuningProblem`, or a run argument of the
-        wrong type (the message names it).
+        ``problem`` not a :class:`TuningProblem`, ``progress`` neither a bool
+        nor a callable, or a run argument of the wrong type (the message names it).
     ValueError
         A bad run argument (the message names it): an unknown algorithm, a
-        budget below the population size, a negative seed, ...
+        multiobjective one for a problem of one objective (the message names
+        ``"ga"``), a budget below the population size, a negative seed, ...
 
     See Also
     --------
@@ -305,6 +351,17 @@ def tune(problem: TuningProblem, algorithm: str = "nsga2", *, molsp: bool = True
     """
     if not isinstance(problem, TuningProblem):
         raise TypeError(f"problem must be a moo.tuning.TuningProblem, got {type(problem).__name__}")
-    record = prepare_on(problem, "tuning", algorithm, seed=seed, evals=evals, molsp=molsp,
-                        pop_size=POP_SIZE if pop_size is None else pop_size, max_leaders=max_leaders).run(progress)
-    return TuningResult(problem=problem, X=record.X, F=record.F, run=record)
+    progress = check_progress(progress)
+    if algorithm is None:
+        algorithm = "ga" if problem.n_obj == 1 else "nsga2"
+    job = prepare_on(problem, "tuning", algorithm, seed=seed, evals=evals, molsp=molsp,
+                     pop_size=POP_SIZE if pop_size is None else pop_size, max_leaders=max_leaders)
+    if progress is not True:
+        record = job.run(progress if callable(progress) else None)
+        return TuningResult(problem=problem, X=record.X, F=record.F, run=record)
+    with ProgressBar(f"{job.algorithm_name}{'+molsp' if molsp else ''}", unit="evals", total=evals) as bar:
+        record = job.run(bar)
+    res = TuningResult(problem=problem, X=record.X, F=record.F, run=record)
+    if bar.enabled:
+        print(res.summary(), file=sys.stderr)
+    return res

@@ -309,16 +309,16 @@ def _input_map(input_map, p: int) -> np.ndarray:
 
 
 def _limits(u_limit, p: int) -> np.ndarray:
-    """(p,) saturation levels, ``inf`` for none."""
+    """(p,) saturation levels, ``inf`` for none (``inf`` entries: those inputs are not limited)."""
     if u_limit is None:
         return np.full(p, np.inf)
     try:
         lim = np.broadcast_to(np.asarray(u_limit, dtype=float), (p,)).copy()
     except (TypeError, ValueError):
         lim = None
-    if lim is None or not np.all(lim > 0) or not np.all(np.isfinite(lim)) or isinstance(u_limit, bool):
-        raise ValueError(f"u_limit must be a positive scalar or a ({p},) array (one per plant input), "
-                         f"got {u_limit!r}")
+    if lim is None or not np.all(lim > 0) or isinstance(u_limit, bool):
+        raise ValueError(f"u_limit must be a positive scalar or a ({p},) array (one per plant input; inf: no "
+                         f"limit), got {u_limit!r}")
     return lim
 
 
@@ -344,7 +344,8 @@ class LinearSimulator:
     x0 : (n,) or (S, n) array_like, optional
         Initial *error* ``x[0] - x_ref[0]`` (default zero).
     u_limit : float or (p,) array_like, optional
-        Symmetric saturation ``|u_j| <= u_limit_j`` (default: none).
+        Symmetric saturation ``|u_j| <= u_limit_j`` (default: none; an ``inf``
+        entry leaves that input unlimited).
     input_map : (p, m) array_like, optional
         ``M`` mapping the controller's m inputs to the plant's p inputs
         (default identity, m = p). The doubled steering column of the truck

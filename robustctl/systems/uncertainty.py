@@ -18,6 +18,24 @@ from .plant import Plant, check_plant, check_plants
 __all__ = ["NormBounded", "check_norm_bounded"]
 
 
+def _domain(value) -> float | str | None:
+    """``None``, ``"continuous"`` or a positive finite sampling time (``ValueError`` naming ``domain``)."""
+    if value is None or value == "continuous":
+        return value
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) \
+            and np.isfinite(value) and value > 0:
+        return float(value)
+    raise ValueError(f"domain must be None, 'continuous' or a positive sampling time, got {value!r}")
+
+
+def _domain_of(plant: Plant) -> float | str:
+    return "continuous" if plant.dt is None else float(plant.dt)
+
+
+def _domain_text(domain: float | str) -> str:
+    return "continuous-time plants" if domain == "continuous" else f"discrete-time plants with dt={domain:g}"
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class NormBounded:
     r"""Uncertainty ``dF = H Delta EF``, ``dG = H Delta EG`` with ``||Delta||_2 <= 1``.
@@ -36,6 +54,12 @@ class NormBounded:
         State part of the uncertainty's output (a 1-D array is one row).
     EG : (l, m) array_like
         Input part of the uncertainty's output (a 1-D array is one row).
+    domain : None, "continuous" or float
+        The time domain of the plants the model is about: ``"continuous"``, or
+        the sampling time ``dt`` of discrete-time plants. :meth:`check_plant`
+        (and so every analysis that takes the model) refuses a plant of another
+        domain. ``None`` (the default of a hand-built model) leaves it
+        unchecked; :meth:`from_plants` records the plants' domain.
 
     Attributes
     ----------
@@ -43,12 +67,15 @@ class NormBounded:
         The matrices, read-only.
     n, m, p, l : int
         States, inputs, rows and columns of ``Delta`` (the properties below).
+    domain : None, "continuous" or float
+        The time domain (see Parameters).
 
     Raises
     ------
     ValueError
         Shapes that do not agree (the message names the matrix and both
-        shapes), non-finite entries.
+        shapes), non-finite entries, a ``domain`` that is not None,
+        ``"continuous"`` or a positive sampling time.
     TypeError
         A non-numeric entry.
 
@@ -97,8 +124,9 @@ class NormBounded:
     H: np.ndarray
     EF: np.ndarray
     EG: np.ndarray
+    domain: float | str | None = None
 
-    def __init__(self, H, EF, EG):
+    def __init__(self, H, EF, EG, *, domain: float | str | None = None):
         EF = as_matrix(EF, "EF")
         l, n = EF.shape
         H = as_matrix(H, "H", rows=n, vector="column", rows_what="the number of states, from EF's columns")
@@ -106,6 +134,7 @@ class NormBounded:
         object.__setattr__(self, "H", frozen(H))
         object.__setattr__(self, "EF", frozen(EF))
         object.__setattr__(self, "EG", frozen(EG))
+        object.__setattr__(self, "domain", _domain(domain))
 
     @property
     def n(self) -> int:
@@ -128,7 +157,7 @@ class NormBounded:
         return self.EF.shape[0]
 
     def check_plant(self, plant: Plant) -> None:
-        """Raise ``TypeError`` if ``plant`` is not a :class:`Plant`, ``ValueError`` if the sizes do not match it.
+        """Raise ``TypeError`` if ``plant`` is not a :class:`Plant`, ``ValueError`` if its sizes or domain differ.
 
         Parameters
         ----------
@@ -140,12 +169,17 @@ class NormBounded:
         TypeError
             ``plant`` is not a :class:`~robustctl.Plant`.
         ValueError
-            Its number of states or inputs differs from the uncertainty's.
+            Its number of states or inputs differs from the uncertainty's,
+            or its time domain (continuous, or the sampling time) from the
+            uncertainty's ``domain`` when that is set.
         """
         check_plant(plant)
         if (plant.n, plant.m) != (self.n, self.m):
             raise ValueError(f"uncertainty is for n={self.n} states and m={self.m} inputs, "
                              f"plant has n={plant.n}, m={plant.m}")
+        if self.domain is not None and _domain_of(plant) != self.domain:
+            got = "continuous time" if plant.dt is None else f"dt={plant.dt:g}"
+            raise ValueError(f"uncertainty is for {_domain_text(self.domain)} (its domain), plant has {got}")
 
     def _deltas(self, Delta) -> np.ndarray:
         D = as_float_array(Delta, "Delta")
@@ -293,7 +327,8 @@ class NormBounded:
         Returns
         -------
         NormBounded
-            ``H`` (n x p), ``EF`` (l x n), ``EG`` (l x m).
+            ``H`` (n x p), ``EF`` (l x n), ``EG`` (l x m); its ``domain`` is
+            the plants' (``"continuous"`` or their ``dt``).
 
         Raises
         ------
@@ -316,7 +351,7 @@ class NormBounded:
         >>> plants = [rc.Plant(nominal.F, nominal.G * s, dt=0.1) for s in (0.8, 1.2)]
         >>> unc = rc.NormBounded.from_plants(nominal, plants)
         >>> unc
-        NormBounded(n=2, m=1, p=1, l=1)
+        NormBounded(n=2, m=1, p=1, l=1, domain=0.1)
         >>> bool(np.allclose(abs(unc.H @ unc.EG), [[0.0], [0.02]]))
         True
 
@@ -356,10 +391,11 @@ class NormBounded:
                              f"plants[{worst}] only to a relative error of {resid[worst]:.3g} > tol={tol:g}; "
                              "allow a larger rank (or a larger tol)")
         n = nominal.n
-        return cls(H, E[:, :n], E[:, n:])
+        return cls(H, E[:, :n], E[:, n:], domain=_domain_of(nominal))
 
     def __repr__(self) -> str:
-        return f"NormBounded(n={self.n}, m={self.m}, p={self.p}, l={self.l})"
+        domain = "" if self.domain is None else f", domain={self.domain!r}"
+        return f"NormBounded(n={self.n}, m={self.m}, p={self.p}, l={self.l}{domain})"
 
 
 def check_norm_bounded(value, plant: Plant, name: str = "uncertainty") -> NormBounded:
