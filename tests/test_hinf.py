@@ -454,3 +454,10 @@ def test_unstabilisable_plant_gives_a_plain_error():
     with pytest.raises(InfeasibleError, match=r"vertices\[0\] is not stabilisable"):
         hinf(good, Bw=np.eye(2), Cz=np.vstack([np.eye(2), [[0, 0]]]), Dzu=[[0.0], [0.0], [1.0]],
              vertices=[bad_vertex])
+
+
+def test_an_empty_vertex_list_is_named_not_read_as_no_polytope():
+    """Issue 35's fault probe: vertices=[] was silently the plant alone."""
+    plant = rc.Plant([[1.1]], [[1.0]], 0.1)
+    with pytest.raises(TypeError, match=r"^vertices must be a non-empty list of robustctl\.Plant"):
+        rc.hinf(plant, Bw=[[1.0]], Cz=[[1.0], [0.0]], Dzu=[[0.0], [1.0]], vertices=[])

@@ -508,3 +508,15 @@ def test_module_and_function_names():
     doc = sys.modules["robustctl.analysis.loop_margins"].__doc__
     assert "robust-stability radius" in doc
     assert "robust_stability" in rc.loop_margins.__doc__
+
+
+def test_disk_only_gives_the_same_disk_margins_and_leaves_the_rest():
+    rng = np.random.default_rng(3)
+    plant = rc.Plant(0.5 * rng.standard_normal((4, 4)), rng.standard_normal((4, 2)), 0.1)
+    K = np.stack([rc.lqr(plant, Q=q * np.eye(4)).K for q in (0.1, 1.0, 10.0)])
+    full, disk = rc.loop_margins((plant, K)), rc.loop_margins((plant, K), what="disk")
+    np.testing.assert_array_equal(disk.alpha, full.alpha)
+    np.testing.assert_array_equal(disk.alpha_loops, full.alpha_loops)
+    assert np.isnan(disk.gain_margin).all() and np.isnan(disk.T_peak).all()
+    with pytest.raises(ValueError, match=r"^what must be"):
+        rc.loop_margins((plant, K), what="peaks")

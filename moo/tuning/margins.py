@@ -42,7 +42,7 @@ __all__ = ["DiskMargin", "Margins", "SensitivityPeak", "loop_margins_of", "requi
 AT = ("input", "output")
 
 
-def loop_margins_of(K: Controllers, plants, at: str, skew: float = 0.0) -> list:
+def loop_margins_of(K: Controllers, plants, at: str, skew: float = 0.0, what: str = "all") -> list:
     """:func:`robustctl.loop_margins` of every design on each plant: one :class:`~robustctl.LoopMargins` per plant.
 
     ``K``: gains (B, m, n) (broken at the input, or at the state with
@@ -55,7 +55,7 @@ def loop_margins_of(K: Controllers, plants, at: str, skew: float = 0.0) -> list:
             loop: Any = rc.ControllerBatch(_with_outputs(plant, K), K.Ac, K.Bc, K.Cc, K.Dc)
         else:
             loop = (plant, np.asarray(K))
-        out.append(rc.loop_margins(loop, at=at, skew=skew))
+        out.append(rc.loop_margins(loop, at=at, skew=skew, what=what))
     return out
 
 
@@ -195,7 +195,7 @@ class DiskMargin(_LoopGoal):
     def _inverse(self, K, plants) -> np.ndarray:
         K, plants, _ = _loops(K, plants)
         per = []
-        for m in loop_margins_of(K, plants, self.at, self.skew):
+        for m in loop_margins_of(K, plants, self.at, self.skew, what="disk"):
             a = np.asarray(m.alpha_loops if self.each else m.alpha, dtype=float)
             per.append(a.min(axis=-1) if a.ndim == 2 else a)
         with np.errstate(divide="ignore"):
@@ -296,7 +296,7 @@ class Margins(_LoopGoal):
         K, plants, _ = _loops(K, plants)
         per = []
         with np.errstate(divide="ignore", invalid="ignore"):
-            for m in loop_margins_of(K, plants, self.at):
+            for m in loop_margins_of(K, plants, self.at, what="disk" if self.kind == "disk" else "all"):
                 if self.kind == "disk":
                     per.append(required_disk_margin(self.gain_db, self.phase_deg) / np.asarray(m.alpha, float))
                     continue

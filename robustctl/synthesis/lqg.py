@@ -230,8 +230,8 @@ def rlqg(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, W, 
     form : {"filter", "predictor"}
         The estimate fed back (see :func:`observer_controller`).
     check_stability : bool, default True
-        Raise :class:`~robustctl.NotStabilizingError` when the nominal loop
-        is not stable (``False`` returns the design anyway).
+        Raise :class:`~robustctl.NotStabilizingError` when the robust LQR or
+        the nominal loop is not stable (``False`` returns the design anyway).
 
     Returns
     -------
@@ -286,7 +286,7 @@ def rlqg(plant: Plant, EF=None, EG=None, mu=None, *, Q=None, R=None, H=None, W, 
     """
     check_plant(plant, discrete_for="rlqg")
     form = check_choice(form, "form", ("filter", "predictor"))
-    regulator = rlqr(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha)
+    regulator = rlqr(plant, EF, EG, mu, Q=Q, R=R, H=H, alpha=alpha, check_stability=check_stability)
     est = robust_kalman(plant, W, V, Bw=Bw, H=regulator.info["H"], EF=EF, EG=EG, HC=HC, EC=EC,
                         mu=mu if mu_filter is None else mu_filter, alpha=alpha, form=form)
     ctrl = observer_controller(regulator, est, method="rlqg", info={"rlqr": regulator, "form": form})

@@ -88,7 +88,7 @@ def validate(plant, *, Bw, Cz, Dzu, Dzw, vertices, gamma, u_max, w_energy, backo
     full check (:func:`robustctl._cvx.check_solver`, which imports cvxpy) is left
     to the caller, for a path that may not need an SDP solver at all.
     """
-    plants = check_vertices(check_plant(plant), vertices)
+    plants = check_vertices(check_plant(plant), vertices, non_empty=vertices is not None)
     Bw, Cz, Dzu, Dzw = check_performance(plant.n, plant.m, Bw, Cz, Dzu, Dzw)
     if gamma is not None:
         gamma = check_positive_scalar(gamma, "gamma")
