@@ -66,13 +66,18 @@ def _augmented_uncertainty(uncertainty: NormBounded, order: int) -> NormBounded:
     return NormBounded(np.vstack([H, np.zeros((order, H.shape[1]))]), np.hstack([EF, pad]), np.hstack([EG, pad]))
 
 
+def _controller_plant(controller) -> Plant:
+    """The plant a controller (or a ``(plant, K)`` pair) was given with: what its arguments are checked against."""
+    return controller[0] if isinstance(controller, tuple) else controller.plant
+
+
 def _uncertain_loop(controller, uncertainty, batch: bool = False) -> tuple[Plant, np.ndarray, NormBounded]:
     """``(plant, K, uncertainty)`` of :func:`_loop`, the uncertainty checked against the controller's plant.
 
     For a dynamic controller all three are those of the augmented loop.
     """
     plant, K = _loop(controller, batch)
-    base = controller[0] if isinstance(controller, tuple) else controller.plant
+    base = _controller_plant(controller)
     return plant, K, _augmented_uncertainty(check_norm_bounded(uncertainty, base), plant.n - base.n)
 
 

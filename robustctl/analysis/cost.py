@@ -25,6 +25,7 @@ from ._common import (
     _COST_LMI_TOL,
     _block,
     _blocks,
+    _controller_plant,
     _Coordinates,
     _diag,
     _lyapunov_factor,
@@ -311,7 +312,7 @@ def guaranteed_cost(controller: Controller | tuple[Plant, ArrayLike], uncertaint
     import cvxpy as cp
 
     plant, K, unc = _uncertain_loop(controller, uncertainty, batch=True)
-    base = controller[0] if isinstance(controller, tuple) else controller.plant
+    base = _controller_plant(controller)
     n, m, order = base.n, base.m, plant.n - base.n
     Q = check_spd(as_matrix(Q, "Q", rows=n, cols=n, rows_what="the number of states",
                             cols_what="the number of states"), "Q", semidefinite=True)
@@ -437,7 +438,7 @@ def robust_hinf_bound(controller: Controller | tuple[Plant, ArrayLike], uncertai
     import cvxpy as cp
 
     plant, K, A, H, E = _robust_loop(controller, uncertainty, "robust H-infinity bound")
-    base = controller[0] if isinstance(controller, tuple) else controller.plant
+    base = _controller_plant(controller)
     n, p, order = plant.n, H.shape[1], plant.n - base.n
     Bw, Cz, Dzu, Dzw = check_performance(base.n, base.m, Bw, Cz, Dzu, Dzw)
     if order:   # a dynamic controller: w and z act on the plant's states and inputs only

@@ -36,6 +36,7 @@ from ._common import (
     _augmented_plant,
     _block,
     _blocks,
+    _controller_plant,
     _Coordinates,
     _diag,
     _loop,
@@ -607,7 +608,7 @@ def robust_stability(controller: Controller | tuple[Plant, ArrayLike], uncertain
         raise ValueError("give exactly one of uncertainty (a NormBounded) and vertices (a list of Plant)")
     if vertices is not None:
         plant, K = _loop(controller, batch=True)
-        base = controller[0] if isinstance(controller, tuple) else controller.plant
+        base = _controller_plant(controller)
         # a polytope needs a vertex besides the nominal plant
         plants = check_vertices(base, vertices, reference="the controller's plant", non_empty=True)
         plants = [plant, *(_augmented_plant(v, plant.n - base.n) for v in plants[1:])]
