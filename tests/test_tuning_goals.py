@@ -10,17 +10,11 @@ import numpy as np
 import pytest
 
 import robustctl as rc
-from moo.tuning.goals import (
-    H2Norm,
-    HinfNorm,
-    PoleRegion,
-    Response,
-    RobustMargin,
-    SpectralRadius,
-    at_least,
-    at_most,
-    check_scenarios,
-)
+from moo.tuning.goals import at_least, at_most, check_scenarios
+from moo.tuning.margins import RobustMargin
+from moo.tuning.norms import H2Norm, HinfNorm
+from moo.tuning.poles import PoleRegion, SpectralRadius
+from moo.tuning.response import Response
 
 A_C = np.array([[0.0, 1.0, 0.0], [-2.0, -0.5, 1.0], [0.0, 0.0, -1.0]])
 B_C = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])

@@ -33,28 +33,13 @@ Applications 192 (2022) 116304.
 """
 
 from .families import DesignFamily, FamilyControllers, FamilyGains, LQRFamily, RLQRFamily, dlqr_gains
-from .goals import (
-    Bound,
-    ControllerPoles,
-    ErrorGoal,
-    Goal,
-    H2Norm,
-    HinfNorm,
-    Overshoot,
-    PeakInput,
-    PoleRegion,
-    Response,
-    RobustMargin,
-    SettlingTime,
-    SpectralRadius,
-    StepTracking,
-    Variance,
-    at_least,
-    at_most,
-)
-from .margins import DiskMargin, Margins, SensitivityPeak
+from .goals import Bound, Goal, at_least, at_most
+from .margins import DiskMargin, Margins, RobustMargin, SensitivityPeak
+from .norms import H2Norm, HinfNorm, Variance
 from .output_feedback import FixedOrderFamily, LQGFamily, PIDFamily, RobustLQGFamily, StaticOutputFeedbackFamily
+from .poles import ControllerPoles, PoleRegion, SpectralRadius
 from .problem import TuningProblem, penalise
+from .response import ErrorGoal, Overshoot, PeakInput, Response, SettlingTime, StepTracking
 from .selection import Selection, SelectionResult, monte_carlo_selection, select
 from .tune import TuningResult, select_front, tune
 

@@ -1,7 +1,7 @@
-r"""Loop goals: disk, gain and phase margins and sensitivity peaks of the loops of a population.
+r"""Margin goals: how far each loop of a population is from instability (loop margins, certified robust margin).
 
-Every goal here breaks each design's loop on each scenario at the plant input
-(or output) and reads :func:`robustctl.loop_margins`, one batched call per
+The loop goals break each design's loop on each scenario at the plant input
+(or output) and read :func:`robustctl.loop_margins`, one batched call per
 scenario for the whole population (state feedbacks ``(plant, K)`` or a
 :class:`robustctl.ControllerBatch`); python-control's negative-feedback
 convention for the loop transfer: ``L = -K(z) P(z)`` at the input,
@@ -15,6 +15,15 @@ convention for the loop transfer: ``L = -K(z) P(z)`` at the input,
   ``PM_req / PM`` (classical): ``<= 1`` where they are met;
 * :class:`SensitivityPeak` - ``||S||_inf`` or ``||T||_inf``, optionally
   weighted (``max_w |W(jw)| sigma_max(S(jw))``).
+
+Robustness: :class:`RobustMargin` - the certified margin of
+:func:`robustctl.robust_stability` against a :class:`robustctl.NormBounded`
+uncertainty about a nominal plant, ``1 / ||E (zI - A)^-1 H||_inf`` with
+``A = F + G K``, ``E = EF + EG K`` (the augmented loop for a dynamic
+controller); ``at_least(RobustMargin(unc), 1.0)`` is "certified for every
+``||Delta|| <= 1``".
+
+The protocol every goal follows is in :mod:`moo.tuning.goals`.
 
 References
 ----------
@@ -33,13 +42,18 @@ import numpy as np
 import robustctl as rc
 from robustctl.validation import check_choice, check_positive_scalar, check_real
 
-from .goals import OVER, Goal, _loops, _reduce, _set, _with_outputs, check_scenarios
-from .loops import Controllers, is_output_feedback
+from .goals import OVER, Goal, check_scenarios, checked_loops, reduce, set_fields
+from .loops import Controllers, is_output_feedback, with_outputs
 
-__all__ = ["DiskMargin", "Margins", "SensitivityPeak", "loop_margins_of", "required_disk_margin", "AT"]
+__all__ = ["DiskMargin", "Margins", "SensitivityPeak", "RobustMargin", "loop_margins_of", "required_disk_margin", "AT"]
 
 #: Where a loop is broken.
 AT = ("input", "output")
+
+
+def _with_outputs(plant: rc.Plant, K: Controllers) -> rc.Plant:
+    """``plant`` with the output model the controllers read (an output feedback's batch plant's, if it has none)."""
+    return with_outputs(plant, K.plant) if is_output_feedback(K) else plant
 
 
 def loop_margins_of(K: Controllers, plants, at: str, skew: float = 0.0, what: str = "all") -> list:
@@ -57,6 +71,21 @@ def loop_margins_of(K: Controllers, plants, at: str, skew: float = 0.0, what: st
             loop = (plant, np.asarray(K))
         out.append(rc.loop_margins(loop, at=at, skew=skew, what=what))
     return out
+
+
+def robust_margins(plant: rc.Plant, K: Controllers, unc: rc.NormBounded) -> np.ndarray:
+    """``robust_stability`` margins of each design on ``plant``, shape (B,).
+
+    ``K``: gains (B, m, n) (``(plant, K)``) or a :class:`robustctl.ControllerBatch`
+    (its loops through ``plant``'s outputs, the augmented uncertainty). One
+    batched call of :func:`robustctl.robust_stability` (margins only: the
+    certificates of a stack are computed on request). Unstable loops get 0,
+    a design the analysis cannot answer NaN (the tuning problem penalises it).
+    """
+    if is_output_feedback(K):
+        loop: Any = rc.ControllerBatch(_with_outputs(plant, K), K.Ac, K.Bc, K.Cc, K.Dc)
+        return np.array(rc.robust_stability(loop, unc).margin, dtype=float)
+    return np.array(rc.robust_stability((plant, np.asarray(K)), unc).margin, dtype=float)
 
 
 def required_disk_margin(gain_db: float | None, phase_deg: float | None) -> float:
@@ -188,12 +217,12 @@ class DiskMargin(_LoopGoal):
     name: str = ""
 
     def __post_init__(self):
-        _set(self, at=check_choice(self.at, "at", AT), skew=check_real(self.skew, "skew"),
+        set_fields(self, at=check_choice(self.at, "at", AT), skew=check_real(self.skew, "skew"),
              over=check_choice(self.over, "over", OVER), each=bool(self.each),
              name=self.name or "1/disk margin")
 
     def _inverse(self, K, plants) -> np.ndarray:
-        K, plants, _ = _loops(K, plants)
+        K, plants, _ = checked_loops(K, plants)
         per = []
         for m in loop_margins_of(K, plants, self.at, self.skew, what="disk"):
             a = np.asarray(m.alpha_loops if self.each else m.alpha, dtype=float)
@@ -208,7 +237,7 @@ class DiskMargin(_LoopGoal):
 
     def __call__(self, K, plants) -> np.ndarray:
         """``1 / alpha`` of each design (to minimise), shape (B,)."""
-        return _reduce(self._inverse(K, plants), self.over)
+        return reduce(self._inverse(K, plants), self.over)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -283,7 +312,7 @@ class Margins(_LoopGoal):
         required_disk_margin(gain, self.phase_deg)                             # checks the requirements
         label = ", ".join(part for part in (None if gain is None else f"{gain:g} dB",
                                             None if self.phase_deg is None else f"{self.phase_deg:g} deg") if part)
-        _set(self, gain_db=gain, at=check_choice(self.at, "at", AT),
+        set_fields(self, gain_db=gain, at=check_choice(self.at, "at", AT),
              kind=check_choice(self.kind, "kind", ("disk", "classical")),
              over=check_choice(self.over, "over", OVER), name=self.name or f"margins ({label})")
 
@@ -293,7 +322,7 @@ class Margins(_LoopGoal):
 
     def measure(self, K, plants) -> np.ndarray:
         """The requirement ratio of each design, shape (B,) (``<= 1``: met)."""
-        K, plants, _ = _loops(K, plants)
+        K, plants, _ = checked_loops(K, plants)
         per = []
         with np.errstate(divide="ignore", invalid="ignore"):
             for m in loop_margins_of(K, plants, self.at, what="disk" if self.kind == "disk" else "all"):
@@ -308,7 +337,7 @@ class Margins(_LoopGoal):
                     pm = np.asarray(m.phase_margin, dtype=float)
                     ratio = np.maximum(ratio, np.where(pm > 0, self.phase_deg / pm, np.inf))
                 per.append(ratio.max(axis=-1) if ratio.ndim == 2 else ratio)
-        return _reduce(np.stack(per, axis=1), self.over)
+        return reduce(np.stack(per, axis=1), self.over)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -395,7 +424,7 @@ class SensitivityPeak(_LoopGoal):
         points = int(self.points)
         if points < 16:
             raise ValueError(f"points must be >= 16, got {self.points}")
-        _set(self, which=which, at=check_choice(self.at, "at", AT), weight=weight, points=points,
+        set_fields(self, which=which, at=check_choice(self.at, "at", AT), weight=weight, points=points,
              over=check_choice(self.over, "over", OVER), name=self.name or f"{which} peak")
 
     def check(self, plants) -> None:
@@ -407,12 +436,12 @@ class SensitivityPeak(_LoopGoal):
     def measure(self, K, plants) -> np.ndarray:
         """The (weighted) peak of each design, shape (B,)."""
         self.check(plants)
-        K, plants, loops = _loops(K, plants)
+        K, plants, loops = checked_loops(K, plants)
         if self.weight is None:
             per = [np.asarray(m.S_peak if self.which == "S" else m.T_peak, dtype=float)
                    for m in loop_margins_of(K, plants, self.at)]
-            return _reduce(np.stack(per, axis=1), self.over)
-        return _reduce(_weighted_peak(loops, plants[0].dt, self), self.over)
+            return reduce(np.stack(per, axis=1), self.over)
+        return reduce(_weighted_peak(loops, plants[0].dt, self), self.over)
 
 
 def _sensitivity_at(loops, z: np.ndarray, which: str) -> np.ndarray:
@@ -464,3 +493,113 @@ def _weighted_peak(loops, dt: float | None, goal: SensitivityPeak) -> np.ndarray
         b, a = np.where(left, d, b), np.where(left, a, c)
         best = np.maximum(best, np.maximum(fc, fd))
     return best
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class RobustMargin(Goal):
+    r"""The certified robust-stability margin against a norm-bounded uncertainty (a quantity to maximise).
+
+    The margin of :func:`robustctl.robust_stability` ``((nominal, K),
+    uncertainty)``: the loop is quadratically stable for every
+    ``||Delta|| <= margin`` (``inf`` if the uncertainty does not reach the
+    loop). :meth:`measure` returns the margin, to which bounds refer
+    (``at_least(RobustMargin(unc), 1.0)``: certified); as an objective the
+    goal is minimised as ``1 / margin`` (the small-gain norm; 0 for an
+    unreachable loop).
+
+    Parameters
+    ----------
+    uncertainty : robustctl.NormBounded
+        E.g. :meth:`robustctl.NormBounded.from_plants` of the scenarios.
+    nominal : robustctl.Plant, optional
+        The plant the uncertainty is about (default: the first scenario).
+    name : str, optional
+        Label for tables and plots.
+
+    Raises
+    ------
+    TypeError
+        ``uncertainty`` not a :class:`robustctl.NormBounded`, ``nominal`` not
+        a :class:`robustctl.Plant`.
+    ValueError
+        (When checked against the plants.) An uncertainty or a nominal plant
+        whose sizes do not fit the plants.
+
+    See Also
+    --------
+    robustctl.robust_stability : the analysis it calls (batched over the designs).
+    at_least : the constraint form.
+    HinfNorm : the norm of a performance channel.
+
+    Notes
+    -----
+    For :math:`[\delta F\ \delta G] = H \Delta [E_F\ E_G]` about the nominal
+    plant, with :math:`A = F + G K`, :math:`E = E_F + E_G K`,
+
+    .. math::
+
+        \text{margin}(K) = \frac{1}{\|E (zI - A)^{-1} H\|_\infty},
+
+    and the small-gain theorem certifies stability for every
+    :math:`\|\Delta\| < \text{margin}` [1]_.
+
+    References
+    ----------
+    .. [1] K. Zhou, J. C. Doyle, K. Glover, *Robust and Optimal Control*,
+       Prentice Hall, 1996, Ch. 9.
+
+    Examples
+    --------
+    An uncertain entry ``F[1, 0]`` (``H = e_2``, ``E_F = e_1^T``): the
+    margin is the inverse of the ``H -> E`` gain, 9 for this gain:
+
+    >>> import numpy as np
+    >>> import robustctl as rc
+    >>> from moo.tuning import RobustMargin
+    >>> plant = rc.Plant([[1.0, 0.1], [0.0, 1.0]], [[0.005], [0.1]], dt=0.1)
+    >>> goal = RobustMargin(rc.NormBounded([[0.0], [1.0]], [[1.0, 0.0]], [[0.0]]))
+    >>> K = np.array([[[-1.0, -2.0]]])
+    >>> goal.measure(K, [plant]), goal(K, [plant])
+    (array([0.11111111]), array([9.]))
+    """
+
+    uncertainty: rc.NormBounded
+    nominal: rc.Plant | None = None
+    name: str = "1/robust margin"
+    bound_label = "robust margin"
+
+    def __post_init__(self):
+        if not isinstance(self.uncertainty, rc.NormBounded):
+            raise TypeError(f"uncertainty must be a robustctl.NormBounded, got {type(self.uncertainty).__name__}")
+        if self.nominal is not None and not isinstance(self.nominal, rc.Plant):
+            raise TypeError(f"nominal must be a robustctl.Plant or None, got {type(self.nominal).__name__}")
+
+    def _plant(self, plants) -> rc.Plant:
+        plants = check_scenarios(plants, continuous=True)
+        nominal = plants[0] if self.nominal is None else self.nominal
+        try:
+            self.uncertainty.check_plant(nominal)
+        except ValueError as exc:
+            raise ValueError(f"uncertainty does not fit the plants: {exc}") from None
+        if (nominal.n, nominal.m, nominal.dt) != (plants[0].n, plants[0].m, plants[0].dt):
+            raise ValueError(f"nominal must have n={plants[0].n}, m={plants[0].m}, dt={plants[0].dt} like the "
+                             f"plants, got n={nominal.n}, m={nominal.m}, dt={nominal.dt}")
+        return nominal
+
+    def check(self, plants) -> None:
+        """``ValueError`` if the uncertainty or the nominal plant does not fit ``plants``."""
+        self._plant(plants)
+
+    def measure(self, K, plants) -> np.ndarray:
+        """The margin of each design, shape (B,) (to maximise)."""
+        nominal = self._plant(plants)
+        K, plants, _ = checked_loops(K, plants)
+        return robust_margins(nominal, K, self.uncertainty)
+
+    def __call__(self, K, plants) -> np.ndarray:
+        """``1 / margin`` of each design (to minimise)."""
+        with np.errstate(divide="ignore"):
+            return 1.0 / self.measure(K, plants)
+
+    def __repr__(self) -> str:
+        return f"RobustMargin({self.uncertainty!r}, name={self.name!r})"
