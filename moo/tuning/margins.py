@@ -63,14 +63,14 @@ def loop_margins_of(K: Controllers, plants, at: str, skew: float = 0.0, what: st
     ``at="output"``) or a :class:`robustctl.ControllerBatch` (each plant with
     the outputs the controllers read). Entries are (B,) arrays, or (B, loops).
     """
-    out = []
-    for plant in plants:
-        if is_output_feedback(K):
-            loop: Any = rc.ControllerBatch(_with_outputs(plant, K), K.Ac, K.Bc, K.Cc, K.Dc)
-        else:
-            loop = (plant, np.asarray(K))
-        out.append(rc.loop_margins(loop, at=at, skew=skew, what=what))
-    return out
+    return [rc.loop_margins(_loop(plant, K), at=at, skew=skew, what=what) for plant in plants]
+
+
+def _loop(plant: rc.Plant, K: Controllers) -> Any:
+    """The designs on ``plant`` as robustctl's analyses take them: ``(plant, K)`` or a ControllerBatch."""
+    if is_output_feedback(K):
+        return rc.ControllerBatch(_with_outputs(plant, K), K.Ac, K.Bc, K.Cc, K.Dc)
+    return (plant, np.asarray(K))
 
 
 def robust_margins(plant: rc.Plant, K: Controllers, unc: rc.NormBounded) -> np.ndarray:
@@ -82,10 +82,7 @@ def robust_margins(plant: rc.Plant, K: Controllers, unc: rc.NormBounded) -> np.n
     certificates of a stack are computed on request). Unstable loops get 0,
     a design the analysis cannot answer NaN (the tuning problem penalises it).
     """
-    if is_output_feedback(K):
-        loop: Any = rc.ControllerBatch(_with_outputs(plant, K), K.Ac, K.Bc, K.Cc, K.Dc)
-        return np.array(rc.robust_stability(loop, unc).margin, dtype=float)
-    return np.array(rc.robust_stability((plant, np.asarray(K)), unc).margin, dtype=float)
+    return np.array(rc.robust_stability(_loop(plant, K), unc).margin, dtype=float)
 
 
 def required_disk_margin(gain_db: float | None, phase_deg: float | None) -> float:
