@@ -482,42 +482,51 @@ def hinf(plant: Plant, *, Bw: ArrayLike, Cz: ArrayLike, Dzu: ArrayLike, Dzw: Arr
     Returns
     -------
     HinfController
-        Output feedback: ``Ac``, ``Bc``, ``Cc``, ``Dc`` (``K`` None),
-        ``gamma``, ``gamma_opt`` and ``info`` with ``feedback``
-        (``"output"``), ``synthesis``, ``gain_from`` (``"centred"``: the
-        centring solve at the backed-off level; ``"central"``: the Riccati
-        path), ``certificate`` (of the closed loop: ``stability``, its
-        spectral abscissa or ``1 -`` its spectral radius with the sign that
-        makes it positive, and ``hinf[0]``, the distance of its Hamiltonian's
-        eigenvalues from the imaginary axis relative to the Hamiltonian's
-        norm, see ``robustctl.synthesis.hinf``), ``margin`` (centring
-        margin), ``solves``, ``status``, ``solve_time``, ``iterations``,
-        ``backoff``, ``poles`` and, with ``synthesis="riccati"``,
-        ``riccati`` and ``fallback``. State feedback:
-        ``K`` (``u = K x``), ``gamma``, ``gamma_opt`` and ``info`` with
-        ``status``, ``solve_time`` (s, summed over solves), ``iterations``,
-        ``certificate`` (smallest eigenvalue of each LMI block at the
-        returned point), ``gain_from`` (``"optimum-certified"``,
-        ``"optimum"`` for ``backoff=0``, or the centring variant),
-        ``X_min_eig``, ``margin`` (centring margin ``t``), ``solves``
-        (per-solve diagnostics), ``X`` (Lyapunov matrix, ``x' X^-1 x <= 1``
-        on the states reached by disturbances of energy ``w_energy``, 1
-        without ``u_max``; ``P`` of the nominal vertex when ``extended``),
-        ``u_bound`` (guaranteed ``max |u_j|`` for ``w_energy``, when
-        ``u_max`` is given), ``scaling`` (state balancing), ``lmi``,
-        ``vertices``, ``backoff``
-        (the value used), ``poles`` (the regions), ``uncertainty`` and, with
-        one, ``multipliers`` (the S-procedure multipliers). Each entry of
-        ``solves`` has the solver's ``status``, ``value``, ``tol``,
-        ``solve_time``, ``iterations`` and ``certificate`` (of the blocks
-        that solve imposed: ``hinf_projected[0]`` and ``hinf_phi[0]`` when
-        the level of the plain discrete problem was minimised with ``Y``
-        eliminated, see ``robustctl.synthesis.hinf``); centring solves also name
-        their ``centring`` variant. ``synthesis`` (``"lmi"`` or
-        ``"riccati"``: the path that returned the gain) and, with
-        ``synthesis="riccati"``, ``riccati`` (bisection ``iterations`` and
-        the bracket ``gamma_low``) and ``fallback`` (why the SDP was solved,
-        or ``None``).
+        State feedback: ``K`` (``u = K x``); output feedback: ``Ac``,
+        ``Bc``, ``Cc``, ``Dc`` (``K`` None). Both: ``gamma`` (guaranteed),
+        ``gamma_opt`` and ``info``, read-only, with these keys ("SF": state
+        feedback only, "OF": output feedback only):
+
+        ====================  =============================================================
+        key                   value
+        ====================  =============================================================
+        ``"synthesis"``       ``"lmi"`` or ``"riccati"``: the path that returned the controller
+        ``"riccati"``         with ``synthesis="riccati"``: bisection ``iterations`` and
+                              the bracket's ``gamma_low``
+        ``"fallback"``        with ``synthesis="riccati"``: why the LMI path ran, or None
+        ``"gain_from"``       the route of the controller: SF ``"optimum-certified"``,
+                              ``"optimum"`` (``backoff=0``) or a centring variant;
+                              OF ``"centred"`` (LMI) or ``"central"`` (Riccati)
+        ``"certificate"``     SF: smallest eigenvalue of each LMI block at the returned
+                              point; OF: the closed loop's ``stability`` margin and
+                              ``hinf[0]``, the distance of its Hamiltonian's eigenvalues
+                              from the imaginary axis at ``gamma`` (relative)
+        ``"margin"``          the centring margin ``t`` (OF: LMI path only)
+        ``"backoff"``         the backoff used
+        ``"status"``          the solver's status of the last solve
+        ``"solve_time"``      seconds, summed over the solves
+        ``"iterations"``      interior-point iterations, summed
+        ``"solves"``          per solve: ``status``, ``value``, ``tol``, ``solve_time``,
+                              ``iterations``, ``certificate`` of the blocks it imposed
+                              (``hinf_projected[0]``, ``hinf_phi[0]`` when ``Y`` was
+                              eliminated), and ``centring`` for centring solves
+        ``"poles"``           the pole regions
+        ``"feedback"``        OF: ``"output"``
+        ``"gamma"``           SF: the guaranteed level (as ``ctrl.gamma``)
+        ``"gamma_opt"``       SF: the optimal level (as ``ctrl.gamma_opt``)
+        ``"solver"``          SF: the SDP solver
+        ``"X"``               SF: the Lyapunov matrix (``x' X^-1 x <= 1`` on the states
+                              reached by disturbances of energy ``w_energy``; ``P`` of
+                              the nominal vertex when ``extended``)
+        ``"X_min_eig"``       SF: its smallest eigenvalue
+        ``"u_bound"``         SF with ``u_max``: the guaranteed ``max |u_j|``, with the
+                              ``"u_max"`` and ``"w_energy"`` it was given
+        ``"scaling"``         SF: the state balancing
+        ``"lmi"``             SF: the LMI form, e.g. ``"standard-discrete"``, ``"extended-continuous"``
+        ``"vertices"``        SF: the number of plants (the polytope's vertices)
+        ``"uncertainty"``     SF: the norm-bounded uncertainty given, or None
+        ``"multipliers"``     SF with uncertainty: the S-procedure multipliers
+        ====================  =============================================================
 
     Raises
     ------
