@@ -182,83 +182,109 @@ def lu_solve(A, b):
 
 
 @jit
+def fill(A, value):
+    """``A[i, j] = value`` everywhere."""
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            A[i, j] = value
+
+
+@jit
+def copy_into(A, out):
+    """``out[i, j] = A[i, j]`` over ``out``'s shape."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            out[i, j] = A[i, j]
+
+
+@jit
+def product(A, B, out):
+    """``out = A B`` (A (i, t), B (t, j); views such as ``A.T`` too) into ``out[:i, :j]``."""
+    for i in range(A.shape[0]):
+        for j in range(B.shape[1]):
+            s = 0.0
+            for t in range(A.shape[1]):
+                s += A[i, t] * B[t, j]
+            out[i, j] = s
+
+
+@jit
+def eye_plus_product(A, B, out):
+    """``out = I + A B`` (A (k, t), B (t, k)) into ``out[:k, :k]``."""
+    product(A, B, out)
+    for i in range(A.shape[0]):
+        for j in range(B.shape[1]):
+            out[i, j] = (1.0 if i == j else 0.0) + out[i, j]
+
+
+@jit
+def relchange_one(new, old, tiny):
+    """``||new - old||_F / max(||new||_F, tiny)`` (NaN stays NaN)."""
+    num, den = 0.0, 0.0
+    for i in range(new.shape[0]):
+        for j in range(new.shape[1]):
+            num += (new[i, j] - old[i, j]) ** 2
+            den += new[i, j] * new[i, j]
+    den = np.sqrt(den)
+    return np.sqrt(num) / (tiny if den < tiny else den)  # noqa: FURB136 (NaN stays NaN, as np.maximum)
+
+
+@jit
+def healthy_one(P, bound):
+    """Every entry of ``P`` below ``bound`` in magnitude (NaN is not)."""
+    for i in range(P.shape[0]):
+        for j in range(P.shape[1]):
+            if not abs(P[i, j]) < bound:
+                return False
+    return True
+
+
+@jit
 def _doubling(A, G, H, tol, max_steps, bound, tiny, steps, settled, active):
-    """The steps of :func:`doubling` for every ``active`` design; ``A``, ``G``, ``H`` (B, n, n) are overwritten."""
+    """The steps of :func:`doubling` for every ``active`` design; ``A``, ``G``, ``H`` (B, n, n) are overwritten.
+
+    Per step ``W = I + G H``, ``[WA, WG] = W^-1 [A, G]``, ``H <- sym(H + (A'H) WA)``, ``A <- A WA``,
+    ``G <- sym(G + (A WG) A')``, until ``H`` changes by less than ``tol`` or is not healthy.
+    """
     n = H.shape[1]
-    W, T1, T2, hn = np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
-    sol = np.empty((n, 2 * n))
+    W, sol, AH, AW, hn = np.empty((n, n)), np.empty((n, 2 * n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
     for b in range(H.shape[0]):
         a, g, h = A[b], G[b], H[b]
         k = 0
         while active[b] and k < max_steps:
             k += 1
-            for i in range(n):                                 # W = I + g h, sol = [a, g]
+            eye_plus_product(g, h, W)
+            for i in range(n):
                 for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += g[i, t] * h[t, j]
-                    W[i, j] = s + (1.0 if i == j else 0.0)
                     sol[i, j] = a[i, j]
                     sol[i, n + j] = g[i, j]
             if not lu_solve(W, sol):
-                for i in range(n):
-                    for j in range(2 * n):
-                        sol[i, j] = np.nan
-            for i in range(n):                                 # T1 = a' h
+                fill(sol, np.nan)
+            product(a.T, h, AH)                           # h_new = sym(h + (a'h) WA)
+            product(AH, sol[:, :n], hn)
+            for i in range(n):
                 for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += a[t, i] * h[t, j]
-                    T1[i, j] = s
-            num, den, ok = 0.0, 0.0, True
-            for i in range(n):                                 # hn = h + T1 WA (symmetrised below)
-                for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += T1[i, t] * sol[t, j]
-                    hn[i, j] = h[i, j] + s
+                    hn[i, j] = h[i, j] + hn[i, j]
             for i in range(n):
                 for j in range(i, n):
                     v = 0.5 * (hn[i, j] + hn[j, i])
                     hn[i, j] = v
                     hn[j, i] = v
+            ok = healthy_one(hn, bound)
+            change = relchange_one(hn, h, tiny) if ok else np.inf
+            product(a, sol[:, n:], AW)                    # g = sym(g + (a WG) a')
+            product(AW, a.T, W)
             for i in range(n):
                 for j in range(n):
-                    v = hn[i, j]
-                    if not abs(v) < bound:
-                        ok = False
-                    num += (v - h[i, j]) ** 2
-                    den += v * v
-            den = np.sqrt(den)
-            change = np.sqrt(num) / max(den, tiny) if ok else np.inf
-            for i in range(n):                                 # T2 = a WG
-                for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += a[i, t] * sol[t, n + j]
-                    T2[i, j] = s
-            for i in range(n):                                 # g = sym(g + T2 a')
-                for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += T2[i, t] * a[j, t]
-                    T1[i, j] = g[i, j] + s
+                    W[i, j] = g[i, j] + W[i, j]
             for i in range(n):
                 for j in range(n):
-                    g[i, j] = 0.5 * (T1[i, j] + T1[j, i])
-            for i in range(n):                                 # a = a WA
-                for j in range(n):
-                    s = 0.0
-                    for t in range(n):
-                        s += a[i, t] * sol[t, j]
-                    T2[i, j] = s
-            for i in range(n):
-                for j in range(n):
-                    a[i, j] = T2[i, j]
-                    h[i, j] = hn[i, j]
+                    g[i, j] = 0.5 * (W[i, j] + W[j, i])
+            product(a, sol[:, :n], AW)                    # a = a WA
+            copy_into(AW, a)
+            copy_into(hn, h)
             steps[b] += 1
-            if change < tol:
-                settled[b] = True
+            settled[b] |= change < tol
             active[b] = change >= tol and ok
 
 

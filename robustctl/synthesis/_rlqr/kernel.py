@@ -40,60 +40,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..._jit import jit
-from ..._kkt import lu_solve
+from ..._kkt import copy_into, eye_plus_product, fill, healthy_one, lu_solve, product, relchange_one
 from .model import Model
 from .step import Step
 
 __all__ = ["kkt_step", "recursion"]
 
 _TINY = np.finfo(float).tiny
-
-
-@jit
-def _fill(A, value):
-    for i in range(A.shape[0]):
-        for j in range(A.shape[1]):
-            A[i, j] = value
-
-
-@jit
-def _copy(A, out):
-    """``out[i, j] = A[i, j]`` over ``out``'s shape."""
-    for i in range(out.shape[0]):
-        for j in range(out.shape[1]):
-            out[i, j] = A[i, j]
-
-
-@jit
-def _product(A, B, out):
-    """``out = A B`` (A (i, t), B (t, j); views such as ``A.T`` too) into ``out[:i, :j]``."""
-    for i in range(A.shape[0]):
-        for j in range(B.shape[1]):
-            s = 0.0
-            for t in range(A.shape[1]):
-                s += A[i, t] * B[t, j]
-            out[i, j] = s
-
-
-@jit
-def _eye_plus_product(A, B, out):
-    """``out = I + A B`` (A (k, t), B (t, k)) into ``out[:k, :k]``."""
-    _product(A, B, out)
-    for i in range(A.shape[0]):
-        for j in range(B.shape[1]):
-            out[i, j] = (1.0 if i == j else 0.0) + out[i, j]
-
-
-@jit
-def _relchange(new, old, tiny):
-    """``||new - old||_F / max(||new||_F, tiny)`` (NaN stays NaN)."""
-    num, den = 0.0, 0.0
-    for i in range(new.shape[0]):
-        for j in range(new.shape[1]):
-            num += (new[i, j] - old[i, j]) ** 2
-            den += new[i, j] * new[i, j]
-    den = np.sqrt(den)
-    return np.sqrt(num) / (tiny if den < tiny else den)  # noqa: FURB136 (NaN stays NaN, as np.maximum)
 
 
 @jit
@@ -105,16 +58,16 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
     n, m = G.shape
     l = EF.shape[0]
     if soft:                                            # Pt = sym((I + P S)^-1 P)
-        _eye_plus_product(P, S, M)
-        _copy(P, Lc)
+        eye_plus_product(P, S, M)
+        copy_into(P, Lc)
         if not lu_solve(M, Lc):
-            _fill(Lc, np.nan)
+            fill(Lc, np.nan)
         for i in range(n):
             for j in range(n):
                 Pt[i, j] = 0.5 * (Lc[i, j] + Lc[j, i])
     else:
-        _copy(P, Pt)
-    _product(G.T, Pt, GP)                               # GP = G'Pt
+        copy_into(P, Pt)
+    product(G.T, Pt, GP)                               # GP = G'Pt
     for a in range(m):                                  # kkt = [[R + G'Pt G, EG'], [EG, -li I]]
         for c in range(m):                              # sol = -[G'Pt F; EF]
             s = 0.0
@@ -135,31 +88,31 @@ def _step(P, F, G, Q, R, EF, EG, S, li, soft, Pn, K, L, Pt, M, GP, kkt, sol, Lc)
         for j in range(n):
             sol[m + r, j] = -EF[r, j]
     if not lu_solve(kkt, sol):
-        _fill(sol, np.nan)
-    _copy(sol, K)
+        fill(sol, np.nan)
+    copy_into(sol, K)
     for i in range(n):                                  # Lc = F + G K
         for j in range(n):
             s = 0.0
             for a in range(m):
                 s += G[i, a] * K[a, j]
             Lc[i, j] = F[i, j] + s
-    _copy(Lc, L)
+    copy_into(Lc, L)
     if soft:                                            # L = (I + S P)^-1 Lc
-        _eye_plus_product(S, P, M)
+        eye_plus_product(S, P, M)
         if not lu_solve(M, L):
-            _fill(L, np.nan)
+            fill(L, np.nan)
     # Pn = sym(((Q + (K'R) K) + li (nu'nu)) + (Lc' Pt) Lc); M holds K'R, then Lc'Pt; Pt, last read
     # for Lc'Pt, then takes (Lc'Pt) Lc
-    _product(K.T, R, M)
-    _product(M[:, :m], K, Pn)
+    product(K.T, R, M)
+    product(M[:, :m], K, Pn)
     for i in range(n):
         for j in range(n):
             v = 0.0
             for r in range(l):
                 v += sol[m + r, i] * sol[m + r, j]
             Pn[i, j] = (Q[i, j] + Pn[i, j]) + li * v
-    _product(Lc.T, Pt, M)
-    _product(M[:, :n], Lc, Pt)
+    product(Lc.T, Pt, M)
+    product(M[:, :n], Lc, Pt)
     for i in range(n):
         for j in range(n):
             Pn[i, j] += Pt[i, j]
@@ -179,15 +132,6 @@ def _work(n, m, l):
 
 
 @jit
-def _healthy(P, bound):
-    for i in range(P.shape[0]):
-        for j in range(P.shape[1]):
-            if not abs(P[i, j]) < bound:
-                return False
-    return True
-
-
-@jit
 def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, tiny, K, L, iterations, active):
     """The recursion from ``P`` (B, n, n, overwritten with the result) for every design.
 
@@ -203,9 +147,9 @@ def _recursion(P, F, G, Q, R, EF, EG, S, lam_inv, soft, tol, max_iter, bound, ti
         while act and it < max_iter:
             it += 1
             _step(Pb, F, G, Q, R, EF[b], EG[b], S[b], lam_inv[b], soft, Pn, K[b], L[b], Pt, M, GP, kkt, sol, Lc)
-            change = _relchange(Pn, Pb, tiny)
-            _copy(Pn, Pb)
-            act = not change < tol and _healthy(Pn, bound)
+            change = relchange_one(Pn, Pb, tiny)
+            copy_into(Pn, Pb)
+            act = not change < tol and healthy_one(Pn, bound)
         iterations[b] = it
         active[b] = act
 
